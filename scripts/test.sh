@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Every test of aemstep, on a fresh machine: installs what it needs, fails loudly.
+# This is the test command README.md names; .ci/run calls it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+step() { printf '\n==> %s\n' "$*"; }
+fail() { printf '\nFAILED: %s\n' "$*" >&2; exit 1; }
+
+step "toolchain: thumb targets (idempotent)"
+rustup target add thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi
+
+step "format and lints"
+cargo fmt --all -- --check || fail "cargo fmt: run 'cargo fmt --all'"
+cargo clippy --all-targets -- -D warnings || fail "clippy"
+cargo clippy --all-targets --features std -- -D warnings || fail "clippy (std)"
+
+step "host tests (debug: overflow checks on)"
+cargo test --all-targets || fail "host tests"
+cargo test --doc || fail "doctests"
+
+step "long host tests (release)"
+cargo test --release --all-targets -- --ignored || fail "long tests"
+
+step "no_std builds for thumb targets"
+for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi; do
+    cargo build --lib --release --target "$t" || fail "no_std build for $t"
+done
+cargo check --lib --target thumbv7em-none-eabihf --features defmt || fail "defmt feature"
+
+step "docs build without warnings"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps || fail "rustdoc"
+
+printf '\nall test stages passed\n'

@@ -1,0 +1,46 @@
+//! # aemstep
+//!
+//! A `no_std`, allocation-free stepping kernel for the equations of motion of structures,
+//!
+//! ```text
+//! M u'' + C u' + K u = p(t)
+//! ```
+//!
+//! by Katsikadelis' analog equation method (AEM): the acceleration `q = u''` is the
+//! "fictitious load" of the analog equation `u'' = q`, taken as the mean of its end values
+//! on each step; the equation of motion is enforced at the end of the step. For linear
+//! systems the step is second-order accurate and unconditionally stable (it coincides with
+//! Newmark's average-acceleration rule).
+//!
+//! - [`Linear`]: constant `M, C, K`; operators built once (at run time, or by the compiler
+//!   into flash with [`Linear::from_rows`]); `3N²` multiply-adds a step.
+//! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference and
+//!   inspection.
+//! - [`State`], [`Stepper`]: the state and the interface every scheme shares.
+//! - [`Error`]: the one error type; a failed step never changes the caller's state.
+//!
+//! Scalars are `f32` or `f64` ([`Real`]); sizes are const generics; nothing allocates.
+#![no_std]
+#![deny(missing_docs)]
+#![forbid(unsafe_code)]
+
+#[cfg(feature = "std")]
+extern crate std;
+
+mod aform;
+mod error;
+mod linear;
+mod ops;
+mod scalar;
+mod state;
+
+pub use aform::AForm;
+pub use error::Error;
+pub use linear::Linear;
+pub use scalar::Real;
+pub use state::{State, Stepper};
+
+/// The README's code blocks, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

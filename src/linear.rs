@@ -1,0 +1,283 @@
+//! The linear AEM kernel: `M u'' + C u' + K u = p(t)` with constant `M, C, K`.
+//!
+//! With `q = u''` taken as the mean of its end values on each step (paper §2, eqs. 19–23)
+//! and the equation of motion enforced at `t_n`, eliminating `v_n, u_n` gives
+//!
+//! ```text
+//! v̂ = v_{n−1} + (h/2) q_{n−1}             û = u_{n−1} + h v_{n−1} + (h²/4) q_{n−1}
+//! q_n = G p_n − (G C) v̂ − (G K) û          G = (M + (h/2) C + (h²/4) K)⁻¹
+//! v_n = v̂ + (h/2) q_n                      u_n = û + (h²/4) q_n
+//! ```
+//!
+//! `G`, `GC`, `GK` are computed once, in `f64`, and rounded once to `T`. A step costs
+//! `3N²` multiply-adds plus `7N` for the kinematics. The same numbers, in the paper's
+//! literal `U_n = A U_{n−1} + b p_n` form, come from [`Linear::a_form`].
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::ops::{self, Mat};
+use crate::{AForm, Error, Real, State, Stepper};
+
+/// Operators for the start-up acceleration `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StartOps<T, const N: usize> {
+    pub minv: [[T; N]; N],
+    pub minv_c: [[T; N]; N],
+    pub minv_k: [[T; N]; N],
+}
+
+/// The linear constant-coefficient AEM stepper (paper Algorithm 1, eliminated form).
+///
+/// `T` is `f32` or `f64`; `N` the number of degrees of freedom. Build it once with
+/// [`Linear::new`] (run time, from `nalgebra` matrices) or [`Linear::from_rows`]
+/// (`const fn`, from row-major arrays: operators computed by the compiler into flash);
+/// then [`Stepper::start`] and [`Stepper::step`].
+///
+/// Size: `6N² + 3` values of `T` (`3N²` for stepping, `3N²` for start-up).
+///
+/// ```
+/// use aemstep::{Linear, Stepper};
+/// use nalgebra::{matrix, vector};
+///
+/// // u'' + 25 u = 0 (paper Example 1), h = 0.01 s
+/// let sys = Linear::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], 0.01)?;
+/// let mut s = sys.start(&vector![1.0], &vector![0.0], &vector![0.0])?;
+/// for _ in 0..100 {
+///     sys.step(&mut s, &vector![0.0]);
+/// }
+/// assert!((s.u()[0] - 5.0f64.cos()).abs() < 2e-3); // t = 1 s, O(h²) phase error
+/// # Ok::<(), aemstep::Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Linear<T, const N: usize> {
+    h: T,
+    half_h: T,
+    quarter_h2: T,
+    /// `G = M_eff⁻¹`, row-major.
+    g: [[T; N]; N],
+    /// `G·C`, row-major.
+    gc: [[T; N]; N],
+    /// `G·K`, row-major.
+    gk: [[T; N]; N],
+    start: Option<StartOps<T, N>>,
+}
+
+/// `SMatrix` (column-major) to a row-major `f64` array.
+fn rows_f64<T: Real, const N: usize>(a: &SMatrix<T, N, N>) -> Mat<N> {
+    let mut r = [[0.0; N]; N];
+    for (i, row) in r.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = a[(i, j)].as_f64();
+        }
+    }
+    r
+}
+
+fn round_rows<T: Real, const N: usize>(a: &Mat<N>) -> [[T; N]; N] {
+    a.map(|row| row.map(T::from_f64_rounded))
+}
+
+/// `y = A x` for a row-major `A`.
+#[inline(always)]
+pub(crate) fn mat_vec<T: Real, const N: usize>(
+    a: &[[T; N]; N],
+    x: &SVector<T, N>,
+) -> SVector<T, N> {
+    SVector::from_fn(|i, _| {
+        let mut s = T::zero();
+        for j in 0..N {
+            s += a[i][j] * x[j];
+        }
+        s
+    })
+}
+
+impl<T: Real, const N: usize> Linear<T, N> {
+    /// Precompute the step operators for `M u'' + C u' + K u = p(t)` with step `h` (s).
+    ///
+    /// `M, C, K` are `N×N`, fully populated, not necessarily symmetric. `M` may be
+    /// singular as long as `M + (h/2) C + (h²/4) K` is not (then start with
+    /// [`Stepper::start_with_acceleration`]). Computed in `f64`, rounded once to `T`.
+    ///
+    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (`h ≤ 0` or not
+    /// finite), [`Error::SingularEffectiveMatrix`].
+    ///
+    /// Cost: about `5N³` flops in `f64` and four `N×N` `f64` temporaries on the stack.
+    pub fn new(
+        m: &SMatrix<T, N, N>,
+        c: &SMatrix<T, N, N>,
+        k: &SMatrix<T, N, N>,
+        h: T,
+    ) -> Result<Self, Error> {
+        let hf = h.as_f64();
+        let op = ops::operators(&rows_f64(m), &rows_f64(c), &rows_f64(k), hf)?;
+        Ok(Self {
+            h,
+            half_h: T::from_f64_rounded(0.5 * hf),
+            quarter_h2: T::from_f64_rounded(0.25 * hf * hf),
+            g: round_rows(&op.g),
+            gc: round_rows(&op.gc),
+            gk: round_rows(&op.gk),
+            start: match op.start {
+                Some((mi, mc, mk)) => Some(StartOps {
+                    minv: round_rows(&mi),
+                    minv_c: round_rows(&mc),
+                    minv_k: round_rows(&mk),
+                }),
+                None => None,
+            },
+        })
+    }
+
+    /// `G = (M + (h/2) C + (h²/4) K)⁻¹`.
+    pub fn effective_inverse(&self) -> SMatrix<T, N, N> {
+        SMatrix::from_fn(|i, j| self.g[i][j])
+    }
+
+    /// The paper's literal form `U_n = A U_{n−1} + b p_n` of this stepper (`12N²`
+    /// multiply-adds a step): the reference the fast form is tested against, and a way to
+    /// inspect the amplification operator. Cost to build: about `6N³` flops in `T`.
+    pub fn a_form(&self) -> AForm<T, N> {
+        AForm::from_operators(self.h, &self.g, &self.gc, &self.gk, self.start)
+    }
+}
+
+/// Const-fn construction, for operators computed at compile time into flash.
+macro_rules! const_ctor {
+    ($t:ty) => {
+        impl<const N: usize> Linear<$t, N> {
+            /// `const fn` twin of [`Linear::new`]: `M, C, K` as row-major `f64` arrays
+            /// (`m[i][j]` is row `i`, column `j`), `h` in seconds. Computes in `f64` and
+            /// rounds once to the target type, so the result is bit-identical to
+            /// [`Linear::new`] given the same values.
+            ///
+            /// In a `static`, the operators are evaluated by the compiler and no inversion
+            /// code is linked in:
+            ///
+            /// ```
+            /// use aemstep::Linear;
+            /// static SYS: Linear<f32, 1> = match Linear::<f32, 1>::from_rows(
+            ///     [[1.0]], [[0.28]], [[4.0]], 0.002,
+            /// ) {
+            ///     Ok(s) => s,
+            ///     Err(e) => panic!("{}", e.as_str()),
+            /// };
+            /// assert_eq!(SYS.time_step_const(), 0.002);
+            /// ```
+            ///
+            /// Errors: as [`Linear::new`].
+            pub const fn from_rows(
+                m: [[f64; N]; N],
+                c: [[f64; N]; N],
+                k: [[f64; N]; N],
+                h: f64,
+            ) -> Result<Self, Error> {
+                let op = match ops::operators(&m, &c, &k, h) {
+                    Ok(op) => op,
+                    Err(e) => return Err(e),
+                };
+                Ok(Self {
+                    h: h as $t,
+                    half_h: (0.5 * h) as $t,
+                    quarter_h2: (0.25 * h * h) as $t,
+                    g: const_ctor!(@round $t, op.g),
+                    gc: const_ctor!(@round $t, op.gc),
+                    gk: const_ctor!(@round $t, op.gk),
+                    start: match op.start {
+                        Some((mi, mc, mk)) => Some(StartOps {
+                            minv: const_ctor!(@round $t, mi),
+                            minv_c: const_ctor!(@round $t, mc),
+                            minv_k: const_ctor!(@round $t, mk),
+                        }),
+                        None => None,
+                    },
+                })
+            }
+
+            /// The time step `h` (s), in `const` contexts.
+            pub const fn time_step_const(&self) -> $t {
+                self.h
+            }
+        }
+    };
+    (@round $t:ty, $a:expr) => {{
+        let a = $a;
+        let mut r = [[0.0 as $t; N]; N];
+        let mut i = 0;
+        while i < N {
+            let mut j = 0;
+            while j < N {
+                r[i][j] = a[i][j] as $t;
+                j += 1;
+            }
+            i += 1;
+        }
+        r
+    }};
+}
+const_ctor!(f32);
+const_ctor!(f64);
+
+impl<T: Real, const N: usize> Stepper<T, N> for Linear<T, N> {
+    #[inline]
+    fn time_step(&self) -> T {
+        self.h
+    }
+
+    fn start(
+        &self,
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        p0: &SVector<T, N>,
+    ) -> Result<State<T, N>, Error> {
+        let ops = self.start.as_ref().ok_or(Error::SingularMass)?;
+        initial_state(ops, u0, v0, p0)
+    }
+
+    /// Cost: `3N²` multiply-adds + `7N` (see the module docs for the recurrence).
+    #[inline]
+    fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
+        let (half_h, h, quarter_h2) = (self.half_h, self.h, self.quarter_h2);
+        let mut vh = [T::zero(); N];
+        let mut uh = [T::zero(); N];
+        for j in 0..N {
+            vh[j] = s.v[j] + half_h * s.a[j];
+            uh[j] = s.u[j] + h * s.v[j] + quarter_h2 * s.a[j];
+        }
+        for i in 0..N {
+            let (g, gc, gk) = (&self.g[i], &self.gc[i], &self.gk[i]);
+            let mut q = T::zero();
+            for j in 0..N {
+                q += g[j] * p[j] - gc[j] * vh[j] - gk[j] * uh[j];
+            }
+            s.a[i] = q;
+            s.v[i] = vh[i] + half_h * q;
+            s.u[i] = uh[i] + quarter_h2 * q;
+        }
+        s.n = s.n.wrapping_add(1);
+    }
+}
+
+/// `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0` and the state at step 0.
+pub(crate) fn initial_state<T: Real, const N: usize>(
+    ops: &StartOps<T, N>,
+    u0: &SVector<T, N>,
+    v0: &SVector<T, N>,
+    p0: &SVector<T, N>,
+) -> Result<State<T, N>, Error> {
+    let inputs_finite = u0
+        .iter()
+        .chain(v0.iter())
+        .chain(p0.iter())
+        .all(|x| x.is_finite());
+    if !inputs_finite {
+        return Err(Error::NonFiniteInput);
+    }
+    let a0 = mat_vec(&ops.minv, p0) - mat_vec(&ops.minv_c, v0) - mat_vec(&ops.minv_k, u0);
+    let s = State::from_parts(*u0, *v0, a0, 0);
+    if s.is_finite() {
+        Ok(s)
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
