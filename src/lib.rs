@@ -17,6 +17,7 @@
 //! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference and
 //!   inspection.
 //! - [`State`], [`Stepper`]: the state and the interface every scheme shares.
+//! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
 //!
 //! Scalars are `f32` or `f64` ([`Real`]); sizes are const generics; nothing allocates.
@@ -30,6 +31,7 @@ extern crate std;
 mod aform;
 mod error;
 mod linear;
+pub mod models;
 mod ops;
 mod scalar;
 mod state;
