@@ -3,16 +3,17 @@
 //!
 //! The benchmark building of this repository's tables is [`five_storey_building`].
 
+/// A row-major `N×N` matrix of `f64` (`a[i][j]`: row `i`, column `j`), the form
+/// [`Linear::from_rows`](crate::Linear::from_rows) takes.
+pub type Rows<const N: usize> = [[f64; N]; N];
+
 /// Lumped masses and storey stiffnesses of a shear building with `N` storeys, ground
 /// storey first: returns `(M, K)`, `M = diag(m)`, `K` tridiagonal with
 /// `K_ii = k_i + k_{i+1}` (`k_{N+1} = 0`), `K_{i,i+1} = K_{i+1,i} = −k_{i+1}`.
 ///
 /// Units: kg and N/m (or any consistent set). DOF `i` is the displacement of floor `i+1`
 /// relative to the ground. No checks here: `Linear::new`/`from_rows` check the result.
-pub const fn shear_building<const N: usize>(
-    m: [f64; N],
-    k: [f64; N],
-) -> ([[f64; N]; N], [[f64; N]; N]) {
+pub const fn shear_building<const N: usize>(m: [f64; N], k: [f64; N]) -> (Rows<N>, Rows<N>) {
     let mut mm = [[0.0; N]; N];
     let mut kk = [[0.0; N]; N];
     let mut i = 0;
@@ -30,12 +31,7 @@ pub const fn shear_building<const N: usize>(
 }
 
 /// Rayleigh damping `C = a0 M + a1 K`.
-pub const fn rayleigh<const N: usize>(
-    m: &[[f64; N]; N],
-    k: &[[f64; N]; N],
-    a0: f64,
-    a1: f64,
-) -> [[f64; N]; N] {
+pub const fn rayleigh<const N: usize>(m: &Rows<N>, k: &Rows<N>, a0: f64, a1: f64) -> Rows<N> {
     let mut c = [[0.0; N]; N];
     let mut i = 0;
     while i < N {
@@ -70,7 +66,7 @@ pub const FIVE_STOREY_DAMPING: f64 = 0.05;
 /// Its circular frequencies have the closed form
 /// `ω_r = 2 √(k/m) sin((2r − 1) π / 22)`, `r = 1…5` (ω₁ ≈ 9.00 rad/s, T₁ ≈ 0.70 s).
 /// Cost: `O(N²)` flops; `const`.
-pub const fn five_storey_building() -> ([[f64; 5]; 5], [[f64; 5]; 5], [[f64; 5]; 5]) {
+pub const fn five_storey_building() -> (Rows<5>, Rows<5>, Rows<5>) {
     let (m, k) = shear_building([FIVE_STOREY_MASS; 5], [FIVE_STOREY_STIFFNESS; 5]);
     // ω_r = 2 √(k/m) sin((2r−1)π/22) for r = 1, 2, with √(k/m) = √1000 and the sines
     // written out (no `const` sin): sin(π/22), sin(3π/22).
@@ -108,8 +104,8 @@ mod tests {
             );
         }
         // Rayleigh damping gives exactly 5 % in modes 1 and 2: ξ = a0/(2ω) + a1 ω/2.
-        for r in 0..2 {
-            let w = ev[r].sqrt();
+        for (r, l) in ev.iter().enumerate().take(2) {
+            let w = l.sqrt();
             // C = a0 M + a1 K, recovered from two entries: C_01 = −a1 k, C_44 = a0 m + a1 k.
             let a1 = -c[0][1] / FIVE_STOREY_STIFFNESS;
             let a0 = (c[4][4] - a1 * k[4][4]) / m[4][4];
