@@ -23,6 +23,19 @@ pub enum Error {
     /// The step would produce a NaN or infinite state (e.g. a NaN load sample);
     /// the state was left unchanged.
     NonFiniteState,
+    /// The mass matrix `M` is not symmetric positive definite (modal stepper: the
+    /// generalized eigenproblem needs its Cholesky factor).
+    MassNotSpd,
+    /// The stiffness matrix `K` is not symmetric (modal stepper).
+    StiffnessNotSymmetric,
+    /// The kept modes are not a valid selection: none (`R = 0`), more than `N`, an index
+    /// `≥ N`, or a repeated index.
+    InvalidModeSelection,
+    /// The damping matrix couples the modes (it is not classical), so the modes cannot be
+    /// stepped independently: use the full `Linear` stepper.
+    NonClassicalDamping,
+    /// The symmetric eigen-solver did not converge (only with pathological input).
+    EigenNotConverged,
 }
 
 impl Error {
@@ -41,6 +54,15 @@ impl Error {
             Error::NonFiniteState => {
                 "the step would make the state NaN or infinite; state unchanged"
             }
+            Error::MassNotSpd => "the mass matrix M is not symmetric positive definite",
+            Error::StiffnessNotSymmetric => "the stiffness matrix K is not symmetric",
+            Error::InvalidModeSelection => {
+                "invalid mode selection: need 1 <= R <= N distinct modes, each < N"
+            }
+            Error::NonClassicalDamping => {
+                "the damping is not classical (it couples the modes): use the full stepper"
+            }
+            Error::EigenNotConverged => "the symmetric eigen-solver did not converge",
         }
     }
 }

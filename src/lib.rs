@@ -16,6 +16,8 @@
 //!   into flash with [`Linear::from_rows`]); `3N²` multiply-adds a step.
 //! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference and
 //!   inspection.
+//! - [`LinearInput`]: inputs through an influence matrix, `p = B w(t)` (`2N² + N·I`).
+//! - [`Modal`]: `R` of the `N` modes, `I` inputs, `O` outputs (`R·I + 8R`; [`modal`]).
 //! - [`State`], [`Stepper`]: the state and the interface every scheme shares.
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
@@ -32,7 +34,9 @@ extern crate std;
 
 mod aform;
 mod error;
+mod input;
 mod linear;
+pub mod modal;
 pub mod models;
 mod ops;
 mod scalar;
@@ -40,7 +44,9 @@ mod state;
 
 pub use aform::AForm;
 pub use error::Error;
+pub use input::LinearInput;
 pub use linear::Linear;
+pub use modal::{Damping, Modal, ModalState};
 pub use scalar::Real;
 pub use state::{State, Stepper};
 

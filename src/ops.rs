@@ -186,6 +186,47 @@ pub(crate) const fn operators<const N: usize>(
     })
 }
 
+/// Rectangular product `a·b` (`a` is `R×K`, `b` is `K×C`, both row-major): for the
+/// input operators `G·B` and `M⁻¹B` (issue 6). `O(R·K·C)` flops.
+pub(crate) const fn mul_rect<const R: usize, const K: usize, const C: usize>(
+    a: &[[f64; K]; R],
+    b: &[[f64; C]; K],
+) -> [[f64; C]; R] {
+    let mut r = [[0.0; C]; R];
+    let mut i = 0;
+    while i < R {
+        let mut j = 0;
+        while j < C {
+            let mut s = 0.0;
+            let mut k = 0;
+            while k < K {
+                s += a[i][k] * b[k][j];
+                k += 1;
+            }
+            r[i][j] = s;
+            j += 1;
+        }
+        i += 1;
+    }
+    r
+}
+
+/// All entries of a rectangular row-major matrix finite.
+pub(crate) const fn all_finite_rect<const R: usize, const C: usize>(a: &[[f64; C]; R]) -> bool {
+    let mut i = 0;
+    while i < R {
+        let mut j = 0;
+        while j < C {
+            if !a[i][j].is_finite() {
+                return false;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
