@@ -17,7 +17,7 @@
 //! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference and
 //!   inspection.
 //! - [`LinearInput`]: inputs through an influence matrix, `p = B w(t)` (`2N² + N·I`).
-//! - [`Modal`]: `R` of the `N` modes, `I` inputs, `O` outputs (`R·I + 8R`; [`modal`]).
+//! - [`Modal`]: `R` of the `N` modes, `I` inputs, `O` outputs (`R·I + 7R`; [`modal`]).
 //! - [`State`], [`Stepper`]: the state and the interface every scheme shares.
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.

@@ -12,7 +12,7 @@
 //! [`Modal`] keeps `R` of them and steps each with the scalar AEM recurrence (the same
 //! scheme as [`Linear`](crate::Linear), which is invariant under this change of
 //! coordinates: with `R = N` both give the same sequence up to rounding). A step costs
-//! `R·I` multiply-adds for the inputs and `8R` for the oscillators; `O` outputs
+//! `R·I` multiply-adds for the inputs and `7R` for the oscillators; `O` outputs
 //! `y = Y u` (any `O×N` selection: DOFs, inter-storey drifts, …) cost `O·R` each time
 //! they are read; the full state (`3N·R`) only when asked for.
 //!
@@ -139,7 +139,7 @@ pub const fn base_excitation<const N: usize>(m: &Rows<N>) -> [[f64; 1]; N] {
 /// A modal (reduced) AEM stepper: `R` of the `N` modes of `M u'' + C u' + K u = B w(t)`,
 /// `I` input signals `w`, `O` outputs `y = Y u`.
 ///
-/// Per step: `R·I + 8R` multiply-adds ([`Modal::step`]); per output read: `O·R`
+/// Per step: `R·I + 7R` multiply-adds ([`Modal::step`]); per output read: `O·R`
 /// ([`Modal::output`]). With `R = N` it reproduces [`Linear`](crate::Linear) to rounding;
 /// with `R < N` the error is the truncation of the dropped modes (see the README table).
 ///
@@ -549,7 +549,7 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
     /// Advance `state` from `t_{n−1}` to `t_n` under the input `w_n = w(t_n)`: each kept
     /// mode takes one scalar AEM step.
     ///
-    /// Cost: `R·I + 8R` multiply-adds; fixed, no allocation, no panic. A NaN input gives a
+    /// Cost: `R·I + 7R` multiply-adds; fixed, no allocation, no panic. A NaN input gives a
     /// NaN state: use [`Modal::try_step`] where that must not happen.
     #[inline]
     pub fn step(&self, s: &mut ModalState<T, R>, w: &SVector<T, I>) {
