@@ -106,9 +106,11 @@ fn stepper() -> &'static Linear<f32, 1> {
     &SYS
 }
 
-/// The step, out of line so its code size and stack can be measured alone.
+/// The step, out of line so its code size (symbol `qemu_timer_step`, read by
+/// `scripts/qemu.sh`) and stack can be measured alone.
+#[unsafe(no_mangle)]
 #[inline(never)]
-fn step_once(
+fn qemu_timer_step(
     sys: &Linear<f32, 1>,
     s: &mut State<f32, 1>,
     p: &SVector<f32, 1>,
@@ -140,7 +142,7 @@ fn SysTick() {
         return;
     }
     let p = vector![load_sample(n)];
-    let msg = match step_once(sys, state, &p) {
+    let msg = match qemu_timer_step(sys, state, &p) {
         Ok(()) => Msg::Sample { n, u: state.u()[0] },
         Err(e) => Msg::Refused { n, e },
     };
@@ -168,7 +170,7 @@ fn main() -> ! {
     // Stack used by one step alone (run on a copy, before the timer starts).
     let mut probe = s0;
     let step_stack = fw::stack_used_by(|| {
-        let _ = core::hint::black_box(step_once(sys, &mut probe, &p0));
+        let _ = core::hint::black_box(qemu_timer_step(sys, &mut probe, &p0));
     });
     cortex_m::interrupt::free(|cs| CTX.borrow(cs).replace(Some((sys, tx, s0))));
 
