@@ -28,6 +28,9 @@ for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi; do
 done
 cargo check --lib --target thumbv7em-none-eabihf --features defmt || fail "defmt feature"
 
+step "firmware on QEMU (Cortex-M4F): run every example, broken variants must fail, cost table"
+bash scripts/qemu.sh || fail "firmware (scripts/qemu.sh)"
+
 step "docs build without warnings"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps || fail "rustdoc"
 

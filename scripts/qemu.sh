@@ -1,0 +1,154 @@
+#!/usr/bin/env bash
+# Firmware checks: builds and runs every bare-metal example on QEMU's Cortex-M4F board
+# (mps2-an386), fails if any exits non-zero or times out, runs the deliberately broken
+# variants and requires them to FAIL, checks that no inversion code is linked into the
+# compile-time-operator firmware, and writes the cost and memory tables to
+# docs/cortex-m4-cost.md (quoted by README.md).
+#
+# Installs what it needs (thumb target, llvm-tools, qemu-system-arm). Called by
+# scripts/test.sh; runs alone too: `bash scripts/qemu.sh`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+TARGET=thumbv7em-none-eabihf
+# Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
+# print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
+EXAMPLES=(qemu_timer qemu_cost)
+# Broken on purpose: "example feature" pairs that must exit with failure (status 1).
+BROKEN=("qemu_timer qemu-inject-nan" "qemu_timer qemu-tight-bound")
+RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
+OUT=target/qemu
+COST_DOC=docs/cortex-m4-cost.md
+
+step() { printf '\n==> %s\n' "$*"; }
+fail() { printf '\nFAILED: %s\n' "$*" >&2; exit 1; }
+
+step "qemu: tools (thumb target, llvm-tools, qemu-system-arm)"
+rustup target add "$TARGET"
+rustup component add llvm-tools
+LLVM_BIN="$(rustc --print sysroot)/lib/rustlib/$(rustc -vV | sed -n 's/^host: //p')/bin"
+NM="$LLVM_BIN/llvm-nm"
+SIZE="$LLVM_BIN/llvm-size"
+[[ -x $NM && -x $SIZE ]] || fail "llvm-nm/llvm-size not found in $LLVM_BIN"
+if ! command -v qemu-system-arm >/dev/null; then
+    SUDO=""
+    [[ $(id -u) -eq 0 ]] || SUDO=sudo
+    $SUDO apt-get update -q
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q qemu-system-arm
+fi
+qemu-system-arm --version | head -1
+
+mkdir -p "$OUT" docs
+example_args() { # <example> <features>
+    echo "--release --target $TARGET --features $2 --example $1"
+}
+build() { # <example> <features>: builds and keeps a copy of the ELF as $OUT/<example>-<features>
+    # shellcheck disable=SC2046
+    cargo build -q $(example_args "$1" "$2") || fail "build $1 ($2)"
+    cp "target/$TARGET/release/examples/$1" "$OUT/$1-$2"
+}
+run() { # <example> <features>: runs it under QEMU (the runner of .cargo/config.toml); sets RC
+    local log="$OUT/$1-$2.log"
+    set +e
+    # shellcheck disable=SC2046
+    timeout "$RUN_TIMEOUT" cargo run -q $(example_args "$1" "$2") >"$log" 2>&1
+    RC=$?
+    set -e
+    cat "$log"
+    [[ $RC -ne 124 ]] || fail "$1 ($2) timed out after ${RUN_TIMEOUT}s"
+}
+
+step "qemu: clippy of the firmware examples ($TARGET)"
+ex_flags=()
+for ex in "${EXAMPLES[@]}"; do ex_flags+=(--example "$ex"); done
+cargo clippy --release --target "$TARGET" --features qemu "${ex_flags[@]}" -- -D warnings ||
+    fail "clippy (firmware examples)"
+
+step "qemu: run every example (must exit 0)"
+for ex in "${EXAMPLES[@]}"; do
+    build "$ex" qemu
+    run "$ex" qemu
+    [[ $RC -eq 0 ]] || fail "$ex exited with $RC"
+    echo "ok: $ex exited 0"
+done
+
+step "qemu: deliberately broken variants (must exit 1)"
+for pair in "${BROKEN[@]}"; do
+    read -r ex feat <<<"$pair"
+    run "$ex" "$feat"
+    [[ $RC -eq 1 ]] || fail "$ex with --features $feat exited $RC, expected the failure status 1"
+    grep -q '^FAIL: ' "$OUT/$ex-$feat.log" || fail "$ex ($feat) failed without saying why"
+    echo "ok: $ex with --features $feat failed as it must (exit 1)"
+done
+
+step "qemu: no operator inversion code in the compile-time-operator firmware"
+# The build with run-time operators (Linear::new) is the control: the same check must find
+# the inversion code there, or the check proves nothing.
+INVERSION='aemstep::ops::|inverse|cholesky|::lu::'
+build qemu_timer qemu-runtime-ops
+"$NM" -C "$OUT/qemu_timer-qemu-runtime-ops" | grep -E "$INVERSION" >/dev/null ||
+    fail "control: the symbol check did not see the inversion code of the run-time build"
+if "$NM" -C "$OUT/qemu_timer-qemu" | grep -E "$INVERSION"; then
+    fail "qemu_timer links operator inversion code (symbols above)"
+fi
+echo "ok: qemu_timer has no symbol matching /$INVERSION/ (the run-time build has: $("$NM" -C \
+    "$OUT/qemu_timer-qemu-runtime-ops" | grep -E "$INVERSION" | awk '{print $3}' | tr '\n' ' '))"
+
+step "qemu: host and Cortex-M4F f32 runs are bit-identical (Example 2, u at 25 s)"
+host_bits=$(cargo test -q --release --test firmware_example2 -- --nocapture --exact \
+    f32_error_within_the_firmware_bound 2>&1 | sed -n 's/^host u(25 s) f32 bits = //p')
+target_bits=$(sed -n 's/^target u(25 s) f32 bits = //p' "$OUT/qemu_timer-qemu.log")
+[[ -n $host_bits && $host_bits == "$target_bits" ]] ||
+    fail "u(25 s): host '$host_bits', target '$target_bits'"
+echo "ok: both $host_bits"
+
+step "qemu: cost and memory tables -> $COST_DOC"
+sym_size() { # <elf> <symbol>: code bytes of a symbol, or "-"
+    local hex
+    hex=$("$NM" -S "$1" | awk -v s="$2" '$4 == s { print $2; exit }')
+    if [[ -n $hex ]]; then echo $((16#$hex)); else echo -; fi
+}
+mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
+    awk -v e="$1" -v k="$2" '$1 == "MEM" && $2 == e && $3 == k { v = $4 } END { printf "%s", v == "" ? "-" : v }' \
+        "$OUT/$1-qemu.log"
+}
+{
+    echo "# aemstep on a Cortex-M4F: instructions per step and memory"
+    echo
+    echo "Generated by \`bash scripts/qemu.sh\` — do not edit by hand. QEMU $(qemu-system-arm --version |
+        head -1 | awk '{print $4}') \`mps2-an386\` (Cortex-M4F) with \`-icount shift=0\`; $(rustc --version |
+        awk '{print $1, $2}'), \`--release\`, target \`$TARGET\`. Instruction counts do not depend on the host"
+    echo "($(lscpu | sed -n 's/^Model name: *//p' | head -1)); they are instructions, not cycles."
+    echo
+    echo "## Instructions per step (\`examples/qemu_cost.rs\`)"
+    echo
+    echo "Fast form: \`Linear<T, N>\` (3N² multiply-adds). A-form: \`AForm<T, N>\` (12N²). Building: N-storey"
+    echo "uniform shear building (N = 5 is the benchmark building's size), dense operators. \`f64\` is software"
+    echo "floating point on this core (its FPU is single precision)."
+    echo
+    echo "| form | type | N | instructions / step | multiply-adds | instructions / multiply-add | step code (bytes) | step stack (bytes) |"
+    echo "|---|---|---:|---:|---:|---:|---:|---:|"
+    grep '^ROW ' "$OUT/qemu_cost-qemu.log" | while read -r _ form ty n instr madds stack sym; do
+        ratio=$(awk -v a="$instr" -v b="$madds" 'BEGIN { printf "%.2f", a / b }')
+        name=$([[ $form == fast ]] && echo "fast (\`Linear\`)" || echo "A-form (\`AForm\`)")
+        echo "| $name | $ty | $n | $instr | $madds | $ratio | $(sym_size "$OUT/qemu_cost-qemu" "$sym") | $stack |"
+    done
+    echo
+    echo "## Memory of each example"
+    echo
+    echo "Flash = \`.text\` + \`.rodata\` + vector table + \`.data\` initialisers; static RAM = \`.data\` + \`.bss\`"
+    echo "(\`llvm-size\`); stack high-water = deepest stack use since reset, measured on target by scanning"
+    echo "the paint (\`0xCCCCCCCC\`) cortex-m-rt lays at reset. Step function: its own symbol's code bytes and the"
+    echo "stack one call uses (painted and scanned around the call)."
+    echo
+    echo "| example | flash (bytes) | static RAM (bytes) | stack high-water (bytes) | step function code (bytes) | step function stack (bytes) |"
+    echo "|---|---:|---:|---:|---:|---:|"
+    for ex in "${EXAMPLES[@]}"; do
+        read -r text data bss < <("$SIZE" -B "$OUT/$ex-qemu" | awk 'NR == 2 { print $1, $2, $3 }')
+        echo "| \`$ex\` | $((text + data)) | $((data + bss)) | $(mem_of "$ex" stack_high_water_bytes) |" \
+            "$(sym_size "$OUT/$ex-qemu" "${ex}_step") | $(mem_of "$ex" step_stack_bytes) |"
+    done
+} >"$COST_DOC"
+cat "$COST_DOC"
+
+printf '\nqemu: all firmware checks passed\n'
