@@ -13,8 +13,8 @@
 //! `J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u`, factorized by LU with partial pivoting at every
 //! iteration.
 //!
-//! **Cost per step**: `k · (N³/3 + N² + one tangent evaluation) + (k + 1)` force
-//! evaluations, where `k` is the number of Newton iterations (at most the budget). Without
+//! **Cost per step**: `k · (N³/3 + 4N² multiply-adds + one tangent evaluation) + (k + 1)`
+//! force evaluations, where `k` is the number of Newton iterations (at most the budget). Without
 //! an analytic tangent the tangent evaluation is `N` extra force evaluations (a directional
 //! finite difference per column of `J`). Stack: about three `N×N` matrices of `T`.
 
@@ -136,8 +136,18 @@ pub struct NewtonReport<T> {
 /// [`Error`] and leaves the caller's [`State`] bit-identical; [`Nonlinear::trial_step`]
 /// gives the unconverged candidate when the caller wants to decide itself.
 ///
-/// Cost per step: see the [module docs](self): `k (N³/3 + N² + tangent) + (k+1)` force
-/// evaluations for `k` Newton iterations.
+/// Each step solves, by Newton's method from the predictor `q_{n−1}`,
+///
+/// ```text
+/// v̂ = v_{n−1} + (h/2) q_{n−1},   û = u_{n−1} + h v_{n−1} + (h²/4) q_{n−1}
+/// R(q_n) = M q_n + F(û + (h²/4) q_n, v̂ + (h/2) q_n) − p_n = 0
+/// J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u          (LU with partial pivoting, every iteration)
+/// v_n = v̂ + (h/2) q_n,            u_n = û + (h²/4) q_n
+/// ```
+///
+/// **Cost per step**, for `k` Newton iterations: `k × (N³/3 + 4N² multiply-adds + one
+/// tangent evaluation) + (k + 1)` force evaluations. Without an analytic tangent, a
+/// tangent evaluation is `N` force evaluations. Stack: about three `N×N` matrices of `T`.
 ///
 /// A Duffing oscillator `u'' + 0.2 u' + u + u³ = p(t)` (paper Example 5), with two Newton
 /// iterations every step:
