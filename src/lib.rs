@@ -19,6 +19,8 @@
 //! - [`LinearInput`]: inputs through an influence matrix, `p = B w(t)` (`2N² + N·I`).
 //! - [`Modal`]: `R` of the `N` modes, `I` inputs, `O` outputs (`R·I + 7R`; [`modal`]).
 //! - [`State`], [`Stepper`]: the state and the interface every scheme shares.
+//! - [`Nonlinear`], [`Model`]: `M u'' + F(u, u') = p(t)` by Newton on the acceleration,
+//!   with a per-step [`NewtonReport`]; [`Varying`]: `M(t), C(t), K(t)` ([`TimeVarying`]).
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
 //!
@@ -38,17 +40,21 @@ mod input;
 mod linear;
 pub mod modal;
 pub mod models;
+mod nonlinear;
 mod ops;
 mod scalar;
 mod state;
+mod varying;
 
 pub use aform::AForm;
 pub use error::Error;
 pub use input::LinearInput;
 pub use linear::Linear;
 pub use modal::{Damping, Modal, ModalState};
+pub use nonlinear::{Iterations, Model, NewtonReport, NewtonSettings, Nonlinear, Tangent};
 pub use scalar::Real;
 pub use state::{State, Stepper};
+pub use varying::{Coefficients, TimeVarying, Varying};
 
 /// The README's code blocks, compiled and run as doctests.
 #[cfg(doctest)]

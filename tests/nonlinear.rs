@@ -1,0 +1,531 @@
+//! The nonlinear stepper against exact solutions (paper Examples 5, 6, 7, 11), against
+//! `Linear`, and on every failure path.
+//!
+//! Every bound below was set after measuring (the measured value is quoted next to it) and
+//! follows from the scheme's O(h²) error: the order itself is measured with two step sizes.
+
+use aemstep::{
+    Error, Linear, Model, NewtonSettings, Nonlinear, Real, State, Stepper, Tangent, models,
+};
+use nalgebra::{SMatrix, SVector, matrix, vector};
+
+fn r<T: Real>(x: f64) -> T {
+    T::from_f64_rounded(x)
+}
+
+/// Bit patterns of a state, so "unchanged" means bit-identical (NaN-safe).
+fn bits<T: Real, const N: usize>(s: &State<T, N>) -> Vec<u64> {
+    s.u()
+        .iter()
+        .chain(s.v().iter())
+        .chain(s.a().iter())
+        .map(|x| x.as_f64().to_bits())
+        .chain([s.steps()])
+        .collect()
+}
+
+// ---------------------------------------------------------------- Example 5: Duffing
+
+/// `u'' + 0.2 u' + u + u³ = p(t)`; the tangent is optional so both Jacobian paths run.
+struct Duffing {
+    analytic: bool,
+}
+
+impl<T: Real> Model<T, 1> for Duffing {
+    fn mass(&self) -> SMatrix<T, 1, 1> {
+        SMatrix::identity()
+    }
+    fn force(&self, u: &SVector<T, 1>, v: &SVector<T, 1>) -> SVector<T, 1> {
+        vector![r::<T>(0.2) * v[0] + u[0] + u[0] * u[0] * u[0]]
+    }
+    fn tangent(&self, u: &SVector<T, 1>, _v: &SVector<T, 1>) -> Option<Tangent<T, 1>> {
+        self.analytic.then(|| Tangent {
+            stiffness: matrix![T::one() + r::<T>(3.0) * u[0] * u[0]],
+            damping: matrix![r::<T>(0.2)],
+        })
+    }
+}
+
+/// Exact solution `u = e^{−0.1t} sin t` and its first two derivatives.
+fn duffing_exact(t: f64) -> (f64, f64, f64) {
+    let e = (-0.1 * t).exp();
+    let (s, c) = t.sin_cos();
+    (e * s, e * (c - 0.1 * s), e * (-0.99 * s - 0.2 * c))
+}
+
+/// The load that makes `duffing_exact` a solution, by substitution into the equation.
+fn duffing_load(t: f64) -> f64 {
+    let (u, v, a) = duffing_exact(t);
+    a + 0.2 * v + u + u * u * u
+}
+
+struct Run {
+    max_error: f64,
+    trajectory: Vec<f64>,
+    max_iterations: u32,
+}
+
+/// Duffing with `u0 = 0, v0 = 1` and step `h` to `t_end`; max |u − u_exact|.
+fn duffing_run<T: Real>(h: f64, t_end: f64, analytic: bool, settings: NewtonSettings<T>) -> Run {
+    let model = Duffing { analytic };
+    let stepper = Nonlinear::<T, 1>::new(r(h), settings).unwrap();
+    let p0 = vector![r(duffing_load(0.0))];
+    let mut s = stepper
+        .start(&model, &vector![r(0.0)], &vector![r(1.0)], &p0)
+        .unwrap();
+    let steps = (t_end / h).round() as u64;
+    let mut run = Run {
+        max_error: 0.0,
+        trajectory: Vec::new(),
+        max_iterations: 0,
+    };
+    for n in 1..=steps {
+        let t = n as f64 * h;
+        let rep = stepper
+            .step(&model, &mut s, &vector![r(duffing_load(t))])
+            .unwrap();
+        assert!(rep.converged && rep.residual <= settings.tolerance);
+        run.max_iterations = run.max_iterations.max(rep.iterations);
+        let u = s.u()[0].as_f64();
+        run.trajectory.push(u);
+        run.max_error = run.max_error.max((u - duffing_exact(t).0).abs());
+    }
+    run
+}
+
+#[test]
+fn duffing_exact_solution_derivatives_are_right() {
+    // The calculus behind the load: central differences of u and u' against u', u''
+    // (truncation d²/6·|u'''| < 2e-9, rounding 1e-16/d = 1e-12).
+    let d = 1e-4;
+    for i in 0..50 {
+        let t = 0.37 * i as f64;
+        let (um, vm, _) = duffing_exact(t - d);
+        let (_, v, a) = duffing_exact(t);
+        let (up, vp, _) = duffing_exact(t + d);
+        assert!(((up - um) / (2.0 * d) - v).abs() < 1e-8);
+        assert!(((vp - vm) / (2.0 * d) - a).abs() < 1e-8);
+    }
+    // and the closed form the paper prints: p = −0.01 e^{−0.1t} sin t + e^{−0.3t} sin³ t
+    for i in 0..50 {
+        let t = 0.41 * i as f64;
+        let closed = -0.01 * (-0.1 * t).exp() * t.sin() + (-0.3 * t).exp() * t.sin().powi(3);
+        assert!((duffing_load(t) - closed).abs() < 1e-15);
+    }
+}
+
+#[test]
+fn duffing_example5_error_and_order() {
+    let e1 = duffing_run::<f64>(0.01, 25.0, true, NewtonSettings::default());
+    let e2 = duffing_run::<f64>(0.005, 25.0, true, NewtonSettings::default());
+    let order = (e1.max_error / e2.max_error).log2();
+    println!(
+        "Example 5 (f64, T = 25): max error h=0.01: {:.3e}, h=0.005: {:.3e}, order {order:.3}, max Newton iterations {}",
+        e1.max_error, e2.max_error, e1.max_iterations
+    );
+    // Measured: 1.588e-5 and 3.970e-6, order 2.000, i.e. error = C h² with C = 0.159 at
+    // both steps (asymptotic regime). The bounds: the order of a second-order scheme within
+    // ±0.05, and C h² with C 10 % above the measured constant.
+    assert!((order - 2.0).abs() < 0.05, "order {order}");
+    assert!(e1.max_error < 0.175 * 0.01 * 0.01, "{}", e1.max_error);
+    assert!(e2.max_error < 0.175 * 0.005 * 0.005, "{}", e2.max_error);
+}
+
+#[test]
+fn duffing_f32() {
+    let exact = NewtonSettings::<f32>::exactly(2, NewtonSettings::<f32>::default_tolerance());
+    let f = duffing_run::<f32>(0.01, 25.0, true, exact);
+    let g = duffing_run::<f32>(0.01, 25.0, true, NewtonSettings::default());
+    let d = duffing_run::<f64>(0.01, 25.0, true, NewtonSettings::default());
+    let dev = f
+        .trajectory
+        .iter()
+        .zip(&d.trajectory)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    println!(
+        "Example 5 (f32, h = 0.01): max error fixed-2 {:.3e}, adaptive {:.3e} (max it {}); f64 {:.3e}; max |u32 − u64| {dev:.3e}",
+        f.max_error, g.max_error, g.max_iterations, d.max_error
+    );
+    // Measured: 1.622e-5 (fixed 2 iterations), 1.624e-5 (adaptive), f64 1.588e-5, and
+    // max |u_f32 − u_f64| = 1.14e-6. Rounding: ≈ ε_f32 |u| ≈ 1e-7 per step, a random walk
+    // over n = 2500 steps gives √n·ε ≈ 6e-6; that is the bound on the f32 − f64 gap, and
+    // the f32 error bound is the f64 one (0.175 h²) plus it.
+    assert!(dev < 6e-6, "{dev}");
+    for e in [f.max_error, g.max_error] {
+        assert!(e < 0.175 * 0.01 * 0.01 + 6e-6, "{e}");
+    }
+}
+
+#[test]
+fn analytic_and_finite_difference_jacobians_agree() {
+    let a = duffing_run::<f64>(0.01, 25.0, true, NewtonSettings::default());
+    let f = duffing_run::<f64>(0.01, 25.0, false, NewtonSettings::default());
+    let dev = a
+        .trajectory
+        .iter()
+        .zip(&f.trajectory)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    println!(
+        "Duffing analytic vs FD Jacobian: max |Δu| {dev:.3e}, iterations {} vs {}",
+        a.max_iterations, f.max_iterations
+    );
+    // Measured 1.3e-13 (both converge in one iteration far below the tolerance). Both
+    // solutions satisfy the same discrete equations to the Newton tolerance (1e-10
+    // relative, with O(1) forces), so any gap above 1e-10 means one path stopped early or
+    // converged elsewhere.
+    assert!(dev < 1e-10, "{dev}");
+}
+
+// ---------------------------------------------------------------- F linear = Linear
+
+/// `F = C v + K u` of the benchmark building, with its (constant) tangent.
+struct LinearModel {
+    m: SMatrix<f64, 5, 5>,
+    c: SMatrix<f64, 5, 5>,
+    k: SMatrix<f64, 5, 5>,
+}
+
+impl Model<f64, 5> for LinearModel {
+    fn mass(&self) -> SMatrix<f64, 5, 5> {
+        self.m
+    }
+    fn force(&self, u: &SVector<f64, 5>, v: &SVector<f64, 5>) -> SVector<f64, 5> {
+        self.c * v + self.k * u
+    }
+    fn tangent(&self, _u: &SVector<f64, 5>, _v: &SVector<f64, 5>) -> Option<Tangent<f64, 5>> {
+        Some(Tangent {
+            stiffness: self.k,
+            damping: self.c,
+        })
+    }
+}
+
+fn rows<const N: usize>(a: &models::Rows<N>) -> SMatrix<f64, N, N> {
+    SMatrix::from_fn(|i, j| a[i][j])
+}
+
+#[test]
+fn linear_force_reproduces_linear() {
+    let (m, c, k) = models::five_storey_building();
+    let model = LinearModel {
+        m: rows(&m),
+        c: rows(&c),
+        k: rows(&k),
+    };
+    let h = 0.01;
+    let lin = Linear::new(&model.m, &model.c, &model.k, h).unwrap();
+    let nl = Nonlinear::<f64, 5>::new(h, NewtonSettings::default()).unwrap();
+    // Storey loads 1e6·sin(3t + i) N, from rest displaced 1 cm at the roof.
+    let p = |t: f64| SVector::<f64, 5>::from_fn(|i, _| 1e6 * (3.0 * t + i as f64).sin());
+    let u0 = vector![0.002, 0.004, 0.006, 0.008, 0.01];
+    let v0 = SVector::<f64, 5>::zeros();
+    let mut a = lin.start(&u0, &v0, &p(0.0)).unwrap();
+    let mut b = nl.start(&model, &u0, &v0, &p(0.0)).unwrap();
+    let (mut dev, mut umax) = (0.0f64, 0.0f64);
+    for n in 1..=2000 {
+        let pn = p(n as f64 * h);
+        lin.step(&mut a, &pn);
+        let rep = nl.step(&model, &mut b, &pn).unwrap();
+        assert!(rep.converged && rep.iterations <= 1, "{rep:?}");
+        dev = dev.max((a.u() - b.u()).amax());
+        umax = umax.max(a.u().amax());
+    }
+    println!(
+        "F linear vs Linear, 5 storeys, 2000 steps: max |Δu| / max |u| = {:.3e}",
+        dev / umax
+    );
+    // Same recurrence, different rounding (precomputed inverse vs an LU solve per step).
+    assert!(dev <= 1e-12 * umax, "{dev} vs {umax}");
+    assert_eq!(a.steps(), b.steps());
+}
+
+// ---------------------------------------------------------------- failure paths
+
+/// A scalar model with switches for each failure.
+#[derive(Clone, Copy)]
+struct Faulty {
+    mass: f64,
+    /// stiffness k in F = k u + cubic u³
+    k: f64,
+    cubic: f64,
+    nan_force_above: f64,
+    nan_tangent: bool,
+    analytic: bool,
+}
+
+impl Default for Faulty {
+    fn default() -> Self {
+        Self {
+            mass: 1.0,
+            k: 1.0,
+            cubic: 0.0,
+            nan_force_above: f64::INFINITY,
+            nan_tangent: false,
+            analytic: true,
+        }
+    }
+}
+
+impl Model<f64, 1> for Faulty {
+    fn mass(&self) -> SMatrix<f64, 1, 1> {
+        matrix![self.mass]
+    }
+    fn force(&self, u: &SVector<f64, 1>, _v: &SVector<f64, 1>) -> SVector<f64, 1> {
+        if u[0].abs() > self.nan_force_above {
+            return vector![f64::NAN];
+        }
+        vector![self.k * u[0] + self.cubic * u[0].powi(3)]
+    }
+    fn tangent(&self, u: &SVector<f64, 1>, _v: &SVector<f64, 1>) -> Option<Tangent<f64, 1>> {
+        let kt = if self.nan_tangent {
+            f64::NAN
+        } else {
+            self.k + 3.0 * self.cubic * u[0] * u[0]
+        };
+        self.analytic.then(|| Tangent {
+            stiffness: matrix![kt],
+            damping: matrix![0.0],
+        })
+    }
+}
+
+fn assert_step_fails<Mo: Model<f64, N>, const N: usize>(
+    st: &Nonlinear<f64, N>,
+    model: &Mo,
+    s: &mut State<f64, N>,
+    p: &SVector<f64, N>,
+    want: Error,
+) {
+    let before = bits(s);
+    assert_eq!(st.step(model, s, p), Err(want));
+    assert_eq!(bits(s), before, "state changed by a failed step");
+}
+
+#[test]
+fn non_convergence_leaves_state_unchanged() {
+    // A hard cubic spring (u'' + u + 100 u³ = 0) from u0 = 1, v0 = 0 with h = 0.5: one
+    // Newton iteration cannot reach 1e-12.
+    let model = Faulty {
+        cubic: 100.0,
+        ..Faulty::default()
+    };
+    let st = Nonlinear::<f64, 1>::new(0.5, NewtonSettings::up_to(1, 1e-12)).unwrap();
+    let mut s = st
+        .start(&model, &vector![1.0], &vector![0.0], &vector![0.0])
+        .unwrap();
+    assert_step_fails(&st, &model, &mut s, &vector![0.0], Error::NotConverged);
+    // The same in fixed-iteration mode.
+    let fixed = Nonlinear::<f64, 1>::new(0.5, NewtonSettings::exactly(1, 1e-12)).unwrap();
+    assert_step_fails(&fixed, &model, &mut s, &vector![0.0], Error::NotConverged);
+    // trial_step hands over the unconverged candidate and its report, state untouched.
+    let before = bits(&s);
+    let (cand, rep) = st.trial_step(&model, &s, &vector![0.0]).unwrap();
+    assert!(
+        !rep.converged && rep.iterations == 1 && rep.residual > 1e-12,
+        "{rep:?}"
+    );
+    assert_eq!(cand.steps(), 1);
+    assert_eq!(bits(&s), before);
+    // With a budget of 50 the same step converges, and the report says in how many.
+    let more = Nonlinear::<f64, 1>::new(0.5, NewtonSettings::up_to(50, 1e-12)).unwrap();
+    let rep = more.step(&model, &mut s, &vector![0.0]).unwrap();
+    assert!(
+        rep.converged && rep.iterations > 1 && rep.residual <= 1e-12,
+        "{rep:?}"
+    );
+}
+
+#[test]
+fn singular_jacobian_leaves_state_unchanged() {
+    let h = 0.1;
+    // J = M + (h²/4) k = 0 for k = −4M/h² (analytic tangent: exact cancellation).
+    let model = Faulty {
+        k: -4.0 / (h * h),
+        ..Faulty::default()
+    };
+    let st = Nonlinear::<f64, 1>::new(h, NewtonSettings::default()).unwrap();
+    let mut s = st
+        .start(&model, &vector![1.0], &vector![0.0], &vector![0.0])
+        .unwrap();
+    assert_step_fails(&st, &model, &mut s, &vector![0.0], Error::SingularJacobian);
+    // Singular mass and no stiffness: J = M exactly singular (state set by hand). This
+    // model has no tangent, so the finite-difference path is the one tested here.
+    struct Massless;
+    impl Model<f64, 2> for Massless {
+        fn mass(&self) -> SMatrix<f64, 2, 2> {
+            matrix![1.0, 0.0; 0.0, 0.0]
+        }
+        fn force(&self, _u: &SVector<f64, 2>, _v: &SVector<f64, 2>) -> SVector<f64, 2> {
+            vector![0.0, 0.0]
+        }
+    }
+    let st = Nonlinear::<f64, 2>::new(h, NewtonSettings::default()).unwrap();
+    assert_eq!(
+        st.start(
+            &Massless,
+            &vector![0.0, 0.0],
+            &vector![0.0, 0.0],
+            &vector![1.0, 1.0]
+        ),
+        Err(Error::SingularMass)
+    );
+    let mut s = st
+        .start_with_acceleration(&vector![0.0, 0.0], &vector![0.0, 0.0], &vector![0.5, 0.5])
+        .unwrap();
+    assert_step_fails(
+        &st,
+        &Massless,
+        &mut s,
+        &vector![1.0, 1.0],
+        Error::SingularJacobian,
+    );
+}
+
+#[test]
+fn non_finite_force_or_load_leaves_state_unchanged() {
+    let st = Nonlinear::<f64, 1>::new(0.1, NewtonSettings::default()).unwrap();
+    // F is NaN once |u| > 0.5; starting at 0.45 moving at 10 m/s the first iterate crosses it.
+    let nan_force = Faulty {
+        nan_force_above: 0.5,
+        ..Faulty::default()
+    };
+    let mut s = st
+        .start(&nan_force, &vector![0.45], &vector![10.0], &vector![0.0])
+        .unwrap();
+    assert_step_fails(
+        &st,
+        &nan_force,
+        &mut s,
+        &vector![0.0],
+        Error::NonFiniteForce,
+    );
+    // NaN tangent.
+    let nan_tangent = Faulty {
+        nan_tangent: true,
+        ..Faulty::default()
+    };
+    let mut s = st
+        .start(&nan_tangent, &vector![0.1], &vector![1.0], &vector![0.0])
+        .unwrap();
+    assert_step_fails(
+        &st,
+        &nan_tangent,
+        &mut s,
+        &vector![0.0],
+        Error::NonFiniteForce,
+    );
+    // NaN during the finite-difference columns only (the iterate itself is finite).
+    let fd = Faulty {
+        nan_force_above: 0.45,
+        analytic: false,
+        ..Faulty::default()
+    };
+    let mut s = st
+        .start_with_acceleration(&vector![0.45], &vector![0.0], &vector![0.0])
+        .unwrap();
+    assert_step_fails(&st, &fd, &mut s, &vector![0.0], Error::NonFiniteForce);
+    // NaN or infinite load.
+    let ok = Faulty::default();
+    let mut s = st
+        .start(&ok, &vector![0.1], &vector![0.0], &vector![0.0])
+        .unwrap();
+    for bad in [f64::NAN, f64::INFINITY] {
+        assert_step_fails(&st, &ok, &mut s, &vector![bad], Error::NonFiniteInput);
+    }
+    // NaN mass.
+    let bad_mass = Faulty {
+        mass: f64::NAN,
+        ..Faulty::default()
+    };
+    assert_step_fails(&st, &bad_mass, &mut s, &vector![0.0], Error::NonFiniteInput);
+    // The good model still steps from the untouched state.
+    st.step(&ok, &mut s, &vector![0.0]).unwrap();
+    assert_eq!(s.steps(), 1);
+}
+
+#[test]
+fn start_and_construction_errors() {
+    let ok = Faulty::default();
+    assert_eq!(
+        Nonlinear::<f64, 1>::new(0.0, NewtonSettings::default()),
+        Err(Error::InvalidTimeStep)
+    );
+    assert_eq!(
+        Nonlinear::<f64, 1>::new(f64::NAN, NewtonSettings::default()),
+        Err(Error::InvalidTimeStep)
+    );
+    assert_eq!(
+        Nonlinear::<f64, 1>::new(0.1, NewtonSettings::up_to(0, 1e-10)),
+        Err(Error::InvalidNewtonSettings)
+    );
+    assert_eq!(
+        Nonlinear::<f64, 1>::new(0.1, NewtonSettings::exactly(0, 1e-10)),
+        Err(Error::InvalidNewtonSettings)
+    );
+    assert_eq!(
+        Nonlinear::<f64, 1>::new(0.1, NewtonSettings::up_to(3, -1.0)),
+        Err(Error::InvalidNewtonSettings)
+    );
+    assert_eq!(
+        Nonlinear::<f64, 1>::new(0.1, NewtonSettings::up_to(3, f64::NAN)),
+        Err(Error::InvalidNewtonSettings)
+    );
+    let st = Nonlinear::<f64, 1>::new(0.1, NewtonSettings::default()).unwrap();
+    let z = vector![0.0];
+    assert_eq!(
+        st.start(&ok, &vector![f64::NAN], &z, &z),
+        Err(Error::NonFiniteInput)
+    );
+    assert_eq!(
+        st.start(&ok, &z, &z, &vector![f64::INFINITY]),
+        Err(Error::NonFiniteInput)
+    );
+    assert_eq!(
+        st.start(&Faulty { mass: 0.0, ..ok }, &z, &z, &z),
+        Err(Error::SingularMass)
+    );
+    assert_eq!(
+        st.start(
+            &Faulty {
+                mass: f64::NAN,
+                ..ok
+            },
+            &z,
+            &z,
+            &z
+        ),
+        Err(Error::NonFiniteInput)
+    );
+    assert_eq!(
+        st.start(
+            &Faulty {
+                nan_force_above: 0.0,
+                ..ok
+            },
+            &vector![1.0],
+            &z,
+            &z
+        ),
+        Err(Error::NonFiniteForce)
+    );
+    assert_eq!(
+        st.start_with_acceleration(&z, &z, &vector![f64::NAN]),
+        Err(Error::NonFiniteInput)
+    );
+    // q0 = M⁻¹ (p0 − F(u0, v0)) = (3 − 2·0.5) / 2 = 1 for M = 2, k = 2, u0 = 0.5, p0 = 3.
+    let s = st
+        .start(
+            &Faulty {
+                mass: 2.0,
+                k: 2.0,
+                ..ok
+            },
+            &vector![0.5],
+            &z,
+            &vector![3.0],
+        )
+        .unwrap();
+    assert_eq!(s.a()[0], 1.0);
+}
