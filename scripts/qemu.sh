@@ -13,9 +13,9 @@ cd "$(dirname "$0")/.."
 TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
-EXAMPLES=(qemu_timer qemu_cost)
+EXAMPLES=(qemu_timer qemu_cost qemu_modal)
 # Broken on purpose: "example feature" pairs that must exit with failure (status 1).
-BROKEN=("qemu_timer qemu-inject-nan" "qemu_timer qemu-tight-bound")
+BROKEN=("qemu_timer qemu-inject-nan" "qemu_timer qemu-tight-bound" "qemu_modal qemu-modal-tight-bound")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
 OUT=target/qemu
 COST_DOC=docs/cortex-m4-cost.md
@@ -63,6 +63,8 @@ ex_flags=()
 for ex in "${EXAMPLES[@]}"; do ex_flags+=(--example "$ex"); done
 cargo clippy --release --target "$TARGET" --features qemu "${ex_flags[@]}" -- -D warnings ||
     fail "clippy (firmware examples)"
+cargo clippy --release --target "$TARGET" --features qemu-footprint-all --example qemu_footprint \
+    -- -D warnings || fail "clippy (qemu_footprint, all capabilities)"
 
 step "qemu: run every example (must exit 0)"
 for ex in "${EXAMPLES[@]}"; do
@@ -102,6 +104,35 @@ target_bits=$(sed -n 's/^target u(25 s) f32 bits = //p' "$OUT/qemu_timer-qemu.lo
     fail "u(25 s): host '$host_bits', target '$target_bits'"
 echo "ok: both $host_bits"
 
+step "qemu: host and Cortex-M4F f32 runs are bit-identical (modal building, roof drift at 80 s)"
+host_bits=$(cargo test -q --release --test firmware_modal -- --nocapture --exact \
+    reference_is_current_and_host_f32_run_is_within_bound 2>&1 |
+    sed -n 's/^host roof drift f32 bits = //p')
+target_bits=$(sed -n 's/^target roof drift f32 bits = //p' "$OUT/qemu_modal-qemu.log")
+[[ -n $host_bits && $host_bits == "$target_bits" ]] ||
+    fail "roof drift: host '$host_bits', target '$target_bits'"
+echo "ok: both $host_bits"
+
+step "qemu: footprint: a firmware pays only for the capabilities it uses"
+# qemu_footprint uses only Linear<f32, 5>; with qemu-footprint-all it also uses the nonlinear
+# and the modal stepper. The full build is the control: the symbol check must find them there.
+UNUSED='modal|nonlinear|varying|jacobi|LinearInput|input[:.]|cholesky|Cholesky'
+for feat in qemu qemu-footprint-all; do
+    build qemu_footprint "$feat"
+    run qemu_footprint "$feat"
+    [[ $RC -eq 0 ]] || fail "qemu_footprint ($feat) exited with $RC"
+done
+"$NM" -C "$OUT/qemu_footprint-qemu-footprint-all" | grep -E "$UNUSED" >/dev/null ||
+    fail "control: no nonlinear/modal symbol found in the build that uses them"
+if "$NM" -C "$OUT/qemu_footprint-qemu" | grep -E "$UNUSED"; then
+    fail "the Linear-only firmware links code of capabilities it does not use (symbols above)"
+fi
+flash_of() { "$SIZE" -B "$1" | awk 'NR == 2 { print $1 + $2 }'; }
+FP_LEAN=$(flash_of "$OUT/qemu_footprint-qemu")
+FP_ALL=$(flash_of "$OUT/qemu_footprint-qemu-footprint-all")
+echo "ok: flash Linear only $FP_LEAN bytes; + Nonlinear + Modal $FP_ALL bytes; no symbol" \
+    "matching /$UNUSED/ in the Linear-only build"
+
 step "qemu: cost and memory tables -> $COST_DOC"
 sym_size() { # <elf> <symbol>: code bytes of a symbol, or "-"
     local hex
@@ -133,6 +164,29 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
         name=$([[ $form == fast ]] && echo "fast (\`Linear\`)" || echo "A-form (\`AForm\`)")
         echo "| $name | $ty | $n | $instr | $madds | $ratio | $(sym_size "$OUT/qemu_cost-qemu" "$sym") | $stack |"
     done
+    echo
+    echo "## Only what the scene needs (\`examples/qemu_modal.rs\`)"
+    echo
+    echo "The benchmark 5-storey building under El Centro, one step plus reading the roof drift, \`f32\`:"
+    echo "\`Modal<f32, 5, R>\` (R of 5 modes), the full model with the input through \`B = −Mι\`"
+    echo "(\`LinearInput<f32, 5, 1>\`), and the full \`Linear<f32, 5>\` fed \`p = B a_g\`."
+    echo
+    echo "| stepper | instructions / step | multiply-adds |"
+    echo "|---|---:|---:|"
+    grep '^COST ' "$OUT/qemu_modal-qemu.log" | while read -r _ what instr madds; do
+        echo "| \`$what\` | $instr | $madds |"
+    done
+    echo
+    echo "## Footprint (\`examples/qemu_footprint.rs\`)"
+    echo
+    echo "Flash (\`.text\` + \`.rodata\` + vector table + \`.data\`) of the same firmware using only"
+    echo "\`Linear<f32, 5>\`, and also using \`Nonlinear<f32, 5>\` and \`Modal<f32, 5, 2>\` (feature"
+    echo "\`qemu-footprint-all\`). The Linear-only build links no symbol of the others (checked)."
+    echo
+    echo "| firmware | flash (bytes) |"
+    echo "|---|---:|"
+    echo "| \`Linear<f32, 5>\` only | $FP_LEAN |"
+    echo "| + \`Nonlinear<f32, 5>\` + \`Modal<f32, 5, 2>\` | $FP_ALL |"
     echo
     echo "## Memory of each example"
     echo

@@ -1,0 +1,143 @@
+//! Firmware: flash footprint — a scene pays only for the capabilities it uses.
+//!
+//! Default build: only `Linear<f32, 5>` (operators a compiler-built `static`), stepping the
+//! benchmark building under a synthetic ground motion. With feature `qemu-footprint-all`
+//! the same firmware also steps the nonlinear stepper (`Nonlinear<f32, 5>`, the building
+//! with hardening storey springs, Newton) and a modal model (`Modal<f32, 5, 2>`, modes
+//! solved at start-up). `scripts/qemu.sh` builds both, runs both, compares their flash
+//! (`llvm-size`) and checks that the lean build links no symbol of the unused
+//! capabilities (while the full build, the control, does).
+//!
+//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_footprint`
+#![no_std]
+#![no_main]
+
+#[macro_use]
+#[path = "fw/mod.rs"]
+mod fw;
+
+use aemstep::models::{self, Rows};
+use aemstep::{Linear, Stepper};
+use cortex_m_rt::entry;
+use cortex_m_semihosting::hprintln;
+use nalgebra::SVector;
+
+const H: f64 = 0.02;
+const STEPS: u32 = 1000;
+const BUILDING: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();
+
+static FULL: Linear<f32, 5> =
+    match Linear::<f32, 5>::from_rows(BUILDING.0, BUILDING.1, BUILDING.2, H) {
+        Ok(s) => s,
+        Err(e) => panic!("{}", e.as_str()),
+    };
+
+/// A deterministic synthetic ground acceleration (m/s²), |a_g| ≤ 1.
+fn ground(n: u32) -> f32 {
+    ((n.wrapping_mul(37) % 101) as f32) / 50.0 - 1.0
+}
+
+/// `p = −M ι a_g` (storey mass 1e5 kg).
+fn load(n: u32) -> SVector<f32, 5> {
+    SVector::from_element(-1.0e5 * ground(n))
+}
+
+#[cfg(feature = "qemu-footprint-all")]
+mod extra {
+    //! The capabilities only the full build uses.
+    use super::*;
+    use aemstep::modal::base_excitation;
+    use aemstep::{Damping, Modal, Model, NewtonSettings, Nonlinear, State};
+    use nalgebra::SMatrix;
+
+    /// The building with hardening storey springs: storey force `k d (1 + d²/d0²)`.
+    struct Hardening;
+    impl Model<f32, 5> for Hardening {
+        fn mass(&self) -> SMatrix<f32, 5, 5> {
+            SMatrix::from_fn(|i, j| BUILDING.0[i][j] as f32)
+        }
+        fn force(&self, u: &SVector<f32, 5>, v: &SVector<f32, 5>) -> SVector<f32, 5> {
+            let c = SMatrix::<f32, 5, 5>::from_fn(|i, j| BUILDING.1[i][j] as f32);
+            let mut f = c * v;
+            let k = models::FIVE_STOREY_STIFFNESS as f32;
+            for i in 0..5 {
+                let d = u[i] - if i > 0 { u[i - 1] } else { 0.0 };
+                let s = k * d * (1.0 + d * d / 1.0e-4);
+                f[i] += s;
+                if i > 0 {
+                    f[i - 1] -= s;
+                }
+            }
+            f
+        }
+    }
+
+    /// Steps the nonlinear and the modal model; returns their roof displacements.
+    pub fn run() -> (f32, f32) {
+        let nl = match Nonlinear::<f32, 5>::new(H as f32, NewtonSettings::default()) {
+            Ok(s) => s,
+            Err(e) => fail!("nonlinear: {}", e.as_str()),
+        };
+        let z = SVector::zeros();
+        let mut s: State<f32, 5> = match nl.start(&Hardening, &z, &z, &load(0)) {
+            Ok(s) => s,
+            Err(e) => fail!("nonlinear start: {}", e.as_str()),
+        };
+        for n in 1..=STEPS {
+            if let Err(e) = nl.step(&Hardening, &mut s, &load(n)) {
+                fail!("nonlinear step {}: {}", n, e.as_str());
+            }
+        }
+        let (m, c, k) = BUILDING;
+        let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
+        let modal = match Modal::<f32, 5, 2>::new(
+            &m,
+            &k,
+            &Damping::Matrix(c),
+            &base_excitation(&m),
+            &roof,
+            H,
+        ) {
+            Ok(s) => s,
+            Err(e) => fail!("modal: {}", e.as_str()),
+        };
+        let mut ms = match modal.start_at_rest(&SVector::from([ground(0)])) {
+            Ok(s) => s,
+            Err(e) => fail!("modal start: {}", e.as_str()),
+        };
+        for n in 1..=STEPS {
+            modal.step(&mut ms, &SVector::from([ground(n)]));
+        }
+        (s.u()[4], modal.output(&ms)[0])
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let z = SVector::zeros();
+    let mut s = match FULL.start(&z, &z, &load(0)) {
+        Ok(s) => s,
+        Err(e) => fail!("start: {}", e.as_str()),
+    };
+    for n in 1..=STEPS {
+        FULL.step(&mut s, &load(n));
+    }
+    if !s.is_finite() {
+        fail!("linear state not finite");
+    }
+    hprintln!("qemu_footprint: Linear<f32, 5> roof {:e} m", s.u()[4]);
+    #[cfg(feature = "qemu-footprint-all")]
+    {
+        let (nl, modal) = extra::run();
+        if !(nl.is_finite() && modal.is_finite()) {
+            fail!("nonlinear or modal result not finite");
+        }
+        hprintln!(
+            "qemu_footprint: Nonlinear roof {:e} m, Modal(R = 2) roof {:e} m",
+            nl,
+            modal
+        );
+    }
+    fw::report_stack("qemu_footprint");
+    fw::exit_success()
+}
