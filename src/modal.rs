@@ -16,13 +16,15 @@
 //! `y = Y u` (any `O×N` selection: DOFs, inter-storey drifts, …) cost `O·R` each time
 //! they are read; the full state (`3N·R`) only when asked for.
 //!
-//! The eigenproblem `K φ = ω² M φ` is solved once, in `f64`, `no_std`: Cholesky
-//! `M = L Lᵀ` (`nalgebra`), symmetric eigen-decomposition `L⁻¹ K L⁻ᵀ = Q Λ Qᵀ` (cyclic
-//! Jacobi), `Φ = L⁻ᵀ Q`.
+//! The eigenproblem `K φ = ω² M φ` is solved once, in `f64`, by `const fn` code: Cholesky
+//! `M = L Lᵀ`, symmetric eigen-decomposition `L⁻¹ K L⁻ᵀ = Q Λ Qᵀ` (cyclic Jacobi),
+//! `Φ = L⁻ᵀ Q`. At run time ([`Modal::new`]) or by the compiler into flash
+//! (`Modal::from_rows` in a `static`), with bit-identical results.
 
-use nalgebra::{Cholesky, ComplexField, SMatrix, SVector};
+use nalgebra::{SMatrix, SVector};
 
 use crate::models::Rows;
+use crate::ops;
 use crate::{Error, Real, State};
 
 /// Relative tolerance below which `M`, `K` count as symmetric: `|a_ij − a_ji| ≤
@@ -191,174 +193,543 @@ pub struct Modal<T, const N: usize, const R: usize, const I: usize = 1, const O:
     modes: [usize; R],
 }
 
-fn max_abs<const N: usize>(a: &Rows<N>) -> f64 {
-    a.iter().flatten().fold(0.0, |s, x| s.max(x.abs()))
+// ---------------------------------------------------------------------------------------
+// Construction, all in `const fn` `f64`: the same code serves `Modal::new` at run time and
+// `Modal::from_rows` evaluated by the compiler, so both give bit-identical operators.
+
+/// Largest `|a_ij|` (finite input: checked before every use).
+const fn max_abs<const R: usize, const C: usize>(a: &[[f64; C]; R]) -> f64 {
+    let mut s = 0.0f64;
+    let mut i = 0;
+    while i < R {
+        let mut j = 0;
+        while j < C {
+            if a[i][j].abs() > s {
+                s = a[i][j].abs();
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    s
 }
 
-fn is_symmetric<const N: usize>(a: &Rows<N>) -> bool {
+const fn is_symmetric<const N: usize>(a: &Rows<N>) -> bool {
     let tol = SYMMETRY_TOL * max_abs(a);
-    (0..N).all(|i| (0..i).all(|j| (a[i][j] - a[j][i]).abs() <= tol))
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < i {
+            if (a[i][j] - a[j][i]).abs() > tol {
+                return false;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    true
 }
 
-fn finite<const R: usize, const C: usize>(a: &[[f64; C]; R]) -> bool {
-    a.iter().flatten().all(|x| x.is_finite())
+/// `√x` for finite `x ≥ 0`, in `const`: Newton's iteration from a bit-level first guess
+/// (relative error ≤ 6 %), iterated until it stops changing (≤ 1 ulp from the correctly
+/// rounded root; at most 64 iterations, 6 for normal numbers). `NaN` for `x < 0`.
+const fn sqrt(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    if x < 0.0 {
+        return f64::NAN;
+    }
+    let mut y = f64::from_bits((x.to_bits() >> 1) + 0x1FF8_0000_0000_0000);
+    let mut i = 0;
+    while i < 64 {
+        let z = 0.5 * (y + x / y);
+        if z == y {
+            break;
+        }
+        y = z;
+        i += 1;
+    }
+    y
 }
 
 /// Eigen-decomposition of a symmetric `a` by cyclic Jacobi rotations: `(λ, V)` with
-/// `a V = V diag(λ)`, `V` orthogonal, unsorted.
+/// `a V = V diag(λ)`, `V` orthogonal (row-major), unsorted.
 ///
-/// Jacobi is used rather than `nalgebra::SymmetricEigen` because the latter needs
-/// `Const<N>: DimSub<U1>` bounds that a const-generic `N` cannot satisfy without leaking
-/// type-level-integer bounds into every caller. Jacobi is backward stable and accurate
-/// to `O(ε‖a‖)`; it converges quadratically (≲ 10 sweeps for `N ≤ 50`). Cost
-/// `≈ 4N³` flops per sweep.
-fn jacobi_eigen<const N: usize>(
-    mut a: SMatrix<f64, N, N>,
-) -> Result<([f64; N], SMatrix<f64, N, N>), Error> {
-    let mut v = SMatrix::<f64, N, N>::identity();
-    let fro = ComplexField::sqrt(a.iter().map(|x| x * x).sum::<f64>());
+/// Jacobi rather than `nalgebra::SymmetricEigen`: the latter needs `Const<N>: DimSub<U1>`
+/// bounds that a const-generic `N` cannot meet without leaking type-level integers into
+/// every caller, and it is not `const`. Jacobi is backward stable, accurate to `O(ε‖a‖)`
+/// and converges quadratically (≲ 10 sweeps for `N ≤ 50`); `≈ 4N³` flops a sweep.
+const fn jacobi_eigen<const N: usize>(mut a: Rows<N>) -> Result<([f64; N], Rows<N>), Error> {
+    let mut v = [[0.0; N]; N];
+    let mut fro2 = 0.0;
+    let mut i = 0;
+    while i < N {
+        v[i][i] = 1.0;
+        let mut j = 0;
+        while j < N {
+            fro2 += a[i][j] * a[i][j];
+            j += 1;
+        }
+        i += 1;
+    }
+    let fro = sqrt(fro2);
     // 64 sweeps: far beyond what quadratic convergence needs; a guard, not a tuning knob.
-    for _ in 0..64 {
+    let mut sweep = 0;
+    while sweep < 64 {
         let mut off = 0.0;
-        for p in 0..N {
-            for q in 0..N {
+        let mut p = 0;
+        while p < N {
+            let mut q = 0;
+            while q < N {
                 if p != q {
-                    off += a[(p, q)] * a[(p, q)];
+                    off += a[p][q] * a[p][q];
                 }
+                q += 1;
             }
+            p += 1;
         }
-        if ComplexField::sqrt(off) <= f64::EPSILON * fro {
-            return Ok((core::array::from_fn(|i| a[(i, i)]), v));
+        if sqrt(off) <= f64::EPSILON * fro {
+            let mut lam = [0.0; N];
+            let mut i = 0;
+            while i < N {
+                lam[i] = a[i][i];
+                i += 1;
+            }
+            return Ok((lam, v));
         }
-        for p in 0..N {
-            for q in p + 1..N {
-                let apq = a[(p, q)];
+        let mut p = 0;
+        while p < N {
+            let mut q = p + 1;
+            while q < N {
+                let apq = a[p][q];
                 // Below rounding of the diagonal pair: already decoupled.
-                if apq.abs()
-                    <= 0.25 * f64::EPSILON * ComplexField::sqrt((a[(p, p)] * a[(q, q)]).abs())
-                {
-                    a[(p, q)] = 0.0;
-                    a[(q, p)] = 0.0;
+                if apq.abs() <= 0.25 * f64::EPSILON * sqrt((a[p][p] * a[q][q]).abs()) {
+                    a[p][q] = 0.0;
+                    a[q][p] = 0.0;
+                    q += 1;
                     continue;
                 }
                 // Rotation zeroing a_pq: cot 2φ = θ, t = tan φ (the smaller root).
-                let theta = (a[(q, q)] - a[(p, p)]) / (2.0 * apq);
+                let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
                 let t = if theta.abs() > 1e150 {
                     0.5 / theta
                 } else {
-                    let t = 1.0 / (theta.abs() + ComplexField::sqrt(theta * theta + 1.0));
+                    let t = 1.0 / (theta.abs() + sqrt(theta * theta + 1.0));
                     if theta < 0.0 { -t } else { t }
                 };
-                let c = 1.0 / ComplexField::sqrt(t * t + 1.0);
+                let c = 1.0 / sqrt(t * t + 1.0);
                 let s = t * c;
-                for k in 0..N {
-                    let (akp, akq) = (a[(k, p)], a[(k, q)]);
-                    a[(k, p)] = c * akp - s * akq;
-                    a[(k, q)] = s * akp + c * akq;
+                let mut k = 0;
+                while k < N {
+                    let (akp, akq) = (a[k][p], a[k][q]);
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                    k += 1;
                 }
-                for k in 0..N {
-                    let (apk, aqk) = (a[(p, k)], a[(q, k)]);
-                    a[(p, k)] = c * apk - s * aqk;
-                    a[(q, k)] = s * apk + c * aqk;
+                k = 0;
+                while k < N {
+                    let (apk, aqk) = (a[p][k], a[q][k]);
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                    k += 1;
+                }
+                k = 0;
+                while k < N {
+                    let (vkp, vkq) = (v[k][p], v[k][q]);
+                    v[k][p] = c * vkp - s * vkq;
+                    v[k][q] = s * vkp + c * vkq;
+                    k += 1;
                 }
                 // Zeroed by construction; store the exact zero, not its rounding.
-                a[(p, q)] = 0.0;
-                a[(q, p)] = 0.0;
-                for k in 0..N {
-                    let (vkp, vkq) = (v[(k, p)], v[(k, q)]);
-                    v[(k, p)] = c * vkp - s * vkq;
-                    v[(k, q)] = s * vkp + c * vkq;
-                }
+                a[p][q] = 0.0;
+                a[q][p] = 0.0;
+                q += 1;
             }
+            p += 1;
         }
+        sweep += 1;
     }
     Err(Error::EigenNotConverged)
 }
 
-/// `(ω², Φ)` of `K φ = ω² M φ`, ascending, `Φᵀ M Φ = I`.
-fn modes_of<const N: usize>(
-    m: &Rows<N>,
-    k: &Rows<N>,
-) -> Result<([f64; N], SMatrix<f64, N, N>), Error> {
+/// Cholesky factor `L` (lower, row-major) of a symmetric `m`; `None` unless every pivot
+/// exceeds `N ε max|m|` (positive definite and not singular to working precision).
+const fn cholesky<const N: usize>(m: &Rows<N>) -> Option<Rows<N>> {
+    let tiny = N as f64 * f64::EPSILON * max_abs(m);
+    let mut l = [[0.0; N]; N];
+    let mut j = 0;
+    while j < N {
+        let mut s = m[j][j];
+        let mut k = 0;
+        while k < j {
+            s -= l[j][k] * l[j][k];
+            k += 1;
+        }
+        if s.is_nan() || s <= tiny {
+            return None;
+        }
+        let d = sqrt(s);
+        l[j][j] = d;
+        let mut i = j + 1;
+        while i < N {
+            let mut s = m[i][j];
+            let mut k = 0;
+            while k < j {
+                s -= l[i][k] * l[j][k];
+                k += 1;
+            }
+            l[i][j] = s / d;
+            i += 1;
+        }
+        j += 1;
+    }
+    Some(l)
+}
+
+/// `L⁻¹ B` for lower-triangular `L` with a nonzero diagonal (forward substitution).
+const fn lower_solve<const N: usize>(l: &Rows<N>, b: &Rows<N>) -> Rows<N> {
+    let mut x = [[0.0; N]; N];
+    let mut c = 0;
+    while c < N {
+        let mut i = 0;
+        while i < N {
+            let mut s = b[i][c];
+            let mut k = 0;
+            while k < i {
+                s -= l[i][k] * x[k][c];
+                k += 1;
+            }
+            x[i][c] = s / l[i][i];
+            i += 1;
+        }
+        c += 1;
+    }
+    x
+}
+
+/// `L⁻ᵀ B` for lower-triangular `L` with a nonzero diagonal (back substitution).
+const fn lower_transpose_solve<const N: usize>(l: &Rows<N>, b: &Rows<N>) -> Rows<N> {
+    let mut x = [[0.0; N]; N];
+    let mut c = 0;
+    while c < N {
+        let mut i = N;
+        while i > 0 {
+            i -= 1;
+            let mut s = b[i][c];
+            let mut k = i + 1;
+            while k < N {
+                s -= l[k][i] * x[k][c];
+                k += 1;
+            }
+            x[i][c] = s / l[i][i];
+        }
+        c += 1;
+    }
+    x
+}
+
+const fn transpose<const N: usize>(a: &Rows<N>) -> Rows<N> {
+    let mut t = [[0.0; N]; N];
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < N {
+            t[j][i] = a[i][j];
+            j += 1;
+        }
+        i += 1;
+    }
+    t
+}
+
+/// `(ω², Φ)` of `K φ = ω² M φ`, ascending, `Φᵀ M Φ = I` (`Φ` row-major, column `r` is
+/// mode `r`): Cholesky `M = L Lᵀ`, Jacobi on `L⁻¹ K L⁻ᵀ = Q Λ Qᵀ`, `Φ = L⁻ᵀ Q`.
+const fn modes_of<const N: usize>(m: &Rows<N>, k: &Rows<N>) -> Result<([f64; N], Rows<N>), Error> {
     if !is_symmetric(m) {
         return Err(Error::MassNotSpd);
     }
     if !is_symmetric(k) {
         return Err(Error::StiffnessNotSymmetric);
     }
-    let mm = SMatrix::<f64, N, N>::from_fn(|i, j| 0.5 * (m[i][j] + m[j][i]));
-    let kk = SMatrix::<f64, N, N>::from_fn(|i, j| 0.5 * (k[i][j] + k[j][i]));
-    let l = Cholesky::new(mm).ok_or(Error::MassNotSpd)?.unpack();
-    // Pivots at rounding level mean M is singular to working precision.
-    let tiny = N as f64 * f64::EPSILON * max_abs(m);
-    if (0..N).any(|i| l[(i, i)] * l[(i, i)] <= tiny) {
-        return Err(Error::MassNotSpd);
+    let l = match cholesky(m) {
+        Some(l) => l,
+        None => return Err(Error::MassNotSpd),
+    };
+    // A = L⁻¹ K L⁻ᵀ = L⁻¹ (L⁻¹ K)ᵀ for symmetric K; symmetrized against rounding.
+    let x = lower_solve(&l, k);
+    let mut a = lower_solve(&l, &transpose(&x));
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < i {
+            let s = 0.5 * (a[i][j] + a[j][i]);
+            a[i][j] = s;
+            a[j][i] = s;
+            j += 1;
+        }
+        i += 1;
     }
-    // A = L⁻¹ K L⁻ᵀ = L⁻¹ (L⁻¹ K)ᵀ for symmetric K.
-    let x = l
-        .solve_lower_triangular(&kk)
-        .ok_or(Error::MassNotSpd)?
-        .transpose();
-    let a = l.solve_lower_triangular(&x).ok_or(Error::MassNotSpd)?;
-    let (lam, q) = jacobi_eigen((a + a.transpose()) * 0.5)?;
-    // Ascending order (insertion sort of the indices, no allocation).
+    let (lam, q) = match jacobi_eigen(a) {
+        Ok(e) => e,
+        Err(e) => return Err(e),
+    };
+    // Ascending order (insertion sort of the indices).
     let mut idx: [usize; N] = lowest_modes();
-    for i in 1..N {
+    let mut i = 1;
+    while i < N {
         let mut j = i;
         while j > 0 && lam[idx[j - 1]] > lam[idx[j]] {
-            idx.swap(j - 1, j);
+            let t = idx[j - 1];
+            idx[j - 1] = idx[j];
+            idx[j] = t;
             j -= 1;
         }
+        i += 1;
     }
-    let q = SMatrix::<f64, N, N>::from_fn(|i, j| q[(i, idx[j])]);
-    let phi = l.tr_solve_lower_triangular(&q).ok_or(Error::MassNotSpd)?;
-    Ok((core::array::from_fn(|r| lam[idx[r]]), phi))
+    let mut qs = [[0.0; N]; N];
+    let mut ls = [0.0; N];
+    let mut j = 0;
+    while j < N {
+        ls[j] = lam[idx[j]];
+        let mut i = 0;
+        while i < N {
+            qs[i][j] = q[i][idx[j]];
+            i += 1;
+        }
+        j += 1;
+    }
+    Ok((ls, lower_transpose_solve(&l, &qs)))
 }
 
 /// `2ξ_r ω_r` of every mode for the given damping.
-fn modal_damping<const N: usize>(
+const fn modal_damping<const N: usize>(
     damping: &Damping<N>,
     lam: &[f64; N],
-    phi: &SMatrix<f64, N, N>,
+    phi: &Rows<N>,
 ) -> Result<[f64; N], Error> {
-    match damping {
-        Damping::None => Ok([0.0; N]),
+    let mut out = [0.0; N];
+    match *damping {
+        Damping::None => {}
         Damping::Rayleigh { a0, a1 } => {
             if !(a0.is_finite() && a1.is_finite()) {
                 return Err(Error::NonFiniteInput);
             }
-            Ok(core::array::from_fn(|r| a0 + a1 * lam[r]))
+            let mut r = 0;
+            while r < N {
+                out[r] = a0 + a1 * lam[r];
+                r += 1;
+            }
         }
         Damping::Ratios(xi) => {
-            if !xi.iter().all(|x| x.is_finite()) {
-                return Err(Error::NonFiniteInput);
-            }
             // ω = √|λ|: for a (physically unstable) negative ω² the ratio scales √|ω²|.
-            Ok(core::array::from_fn(|r| {
-                2.0 * xi[r] * ComplexField::sqrt(lam[r].abs())
-            }))
+            let mut r = 0;
+            while r < N {
+                if !xi[r].is_finite() {
+                    return Err(Error::NonFiniteInput);
+                }
+                out[r] = 2.0 * xi[r] * sqrt(lam[r].abs());
+                r += 1;
+            }
         }
         Damping::Matrix(c) => {
-            if !finite(c) {
+            if !ops::all_finite(&c) {
                 return Err(Error::NonFiniteInput);
             }
-            let cc = SMatrix::<f64, N, N>::from_fn(|i, j| c[i][j]);
-            let d = phi.transpose() * cc * phi;
-            let scale = (0..N).fold(0.0f64, |s, r| s.max(d[(r, r)].abs()));
+            // D = Φᵀ C Φ
+            let mut cp = [[0.0; N]; N];
+            let mut i = 0;
+            while i < N {
+                let mut s = 0;
+                while s < N {
+                    let mut acc = 0.0;
+                    let mut l = 0;
+                    while l < N {
+                        acc += c[i][l] * phi[l][s];
+                        l += 1;
+                    }
+                    cp[i][s] = acc;
+                    s += 1;
+                }
+                i += 1;
+            }
+            let mut d = [[0.0; N]; N];
+            let mut r = 0;
+            while r < N {
+                let mut s = 0;
+                while s < N {
+                    let mut acc = 0.0;
+                    let mut l = 0;
+                    while l < N {
+                        acc += phi[l][r] * cp[l][s];
+                        l += 1;
+                    }
+                    d[r][s] = acc;
+                    s += 1;
+                }
+                r += 1;
+            }
+            let mut scale = 0.0f64;
+            let mut r = 0;
+            while r < N {
+                if d[r][r].abs() > scale {
+                    scale = d[r][r].abs();
+                }
+                r += 1;
+            }
             let floor = SYMMETRY_TOL * scale;
-            for r in 0..N {
-                for s in 0..N {
-                    let allowed = CLASSICAL_COUPLING_TOL
-                        * ComplexField::sqrt((d[(r, r)] * d[(s, s)]).abs())
-                        + floor;
-                    if r != s && d[(r, s)].abs() > allowed {
+            let mut r = 0;
+            while r < N {
+                let mut s = 0;
+                while s < N {
+                    let allowed = CLASSICAL_COUPLING_TOL * sqrt((d[r][r] * d[s][s]).abs()) + floor;
+                    if r != s && d[r][s].abs() > allowed {
                         return Err(Error::NonClassicalDamping);
                     }
+                    s += 1;
                 }
+                out[r] = d[r][r];
+                r += 1;
             }
-            Ok(core::array::from_fn(|r| d[(r, r)]))
         }
     }
+    Ok(out)
+}
+
+/// Every operator of a [`Modal`], in `f64`.
+struct ModalOps<const N: usize, const R: usize, const I: usize, const O: usize> {
+    half_h: f64,
+    quarter_h2: f64,
+    g_gamma: [[f64; I]; R],
+    g_c: [f64; R],
+    g_k: [f64; R],
+    gamma: [[f64; I]; R],
+    c: [f64; R],
+    k: [f64; R],
+    out: [[f64; R]; O],
+    phi: [[f64; R]; N],
+    proj: [[f64; N]; R],
+}
+
+/// Check the data and build every operator (shared by `with_modes` and the `const`
+/// constructors).
+const fn modal_operators<const N: usize, const R: usize, const I: usize, const O: usize>(
+    m: &Rows<N>,
+    k: &Rows<N>,
+    damping: &Damping<N>,
+    b: &[[f64; I]; N],
+    y: &[[f64; N]; O],
+    modes: &[usize; R],
+    h: f64,
+) -> Result<ModalOps<N, R, I, O>, Error> {
+    if R == 0 || R > N {
+        return Err(Error::InvalidModeSelection);
+    }
+    let mut i = 0;
+    while i < R {
+        if modes[i] >= N {
+            return Err(Error::InvalidModeSelection);
+        }
+        let mut j = 0;
+        while j < i {
+            if modes[i] == modes[j] {
+                return Err(Error::InvalidModeSelection);
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    if !(ops::all_finite(m)
+        && ops::all_finite(k)
+        && ops::all_finite_rect(b)
+        && ops::all_finite_rect(y))
+    {
+        return Err(Error::NonFiniteInput);
+    }
+    if !(h.is_finite() && h > 0.0) {
+        return Err(Error::InvalidTimeStep);
+    }
+    let (lam, phi) = match modes_of(m, k) {
+        Ok(x) => x,
+        Err(e) => return Err(e),
+    };
+    let c_all = match modal_damping(damping, &lam, &phi) {
+        Ok(x) => x,
+        Err(e) => return Err(e),
+    };
+    let (half_h, quarter_h2) = (0.5 * h, 0.25 * h * h);
+    let mut op = ModalOps {
+        half_h,
+        quarter_h2,
+        g_gamma: [[0.0; I]; R],
+        g_c: [0.0; R],
+        g_k: [0.0; R],
+        gamma: [[0.0; I]; R],
+        c: [0.0; R],
+        k: [0.0; R],
+        out: [[0.0; R]; O],
+        phi: [[0.0; R]; N],
+        proj: [[0.0; N]; R],
+    };
+    let mut r = 0;
+    while r < R {
+        let mode = modes[r];
+        let (c, lam) = (c_all[mode], lam[mode]);
+        let meff = 1.0 + half_h * c + quarter_h2 * lam;
+        if !(meff.is_finite() && meff > f64::EPSILON) {
+            return Err(Error::SingularEffectiveMatrix);
+        }
+        let g = 1.0 / meff;
+        op.g_c[r] = g * c;
+        op.g_k[r] = g * lam;
+        op.c[r] = c;
+        op.k[r] = lam;
+        let mut j = 0;
+        while j < I {
+            let mut gam = 0.0;
+            let mut i = 0;
+            while i < N {
+                gam += phi[i][mode] * b[i][j];
+                i += 1;
+            }
+            op.gamma[r][j] = gam;
+            op.g_gamma[r][j] = g * gam;
+            j += 1;
+        }
+        let mut o = 0;
+        while o < O {
+            let mut yo = 0.0;
+            let mut i = 0;
+            while i < N {
+                yo += y[o][i] * phi[i][mode];
+                i += 1;
+            }
+            op.out[o][r] = yo;
+            o += 1;
+        }
+        let mut i = 0;
+        while i < N {
+            op.phi[i][r] = phi[i][mode];
+            let mut pm = 0.0;
+            let mut l = 0;
+            while l < N {
+                pm += phi[l][mode] * m[l][i];
+                l += 1;
+            }
+            op.proj[r][i] = pm;
+            i += 1;
+        }
+        r += 1;
+    }
+    Ok(op)
+}
+
+fn round1<T: Real, const A: usize>(a: &[f64; A]) -> [T; A] {
+    a.map(T::from_f64_rounded)
+}
+
+fn round2<T: Real, const A: usize, const B: usize>(a: &[[f64; B]; A]) -> [[T; B]; A] {
+    a.map(|r| r.map(T::from_f64_rounded))
 }
 
 impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Modal<T, N, R, I, O> {
@@ -371,13 +742,17 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
     /// - `y`: output matrix, `O×N` (e.g. a row selecting the roof, or [`storey_drifts`]).
     /// - `h`: time step (s).
     ///
+    /// Computed in `f64` by the same `const` code as `Modal::from_rows` (bit-identical
+    /// results), rounded once to `T`.
+    ///
     /// Errors: [`Error::InvalidModeSelection`] (`R = 0` or `R > N`),
     /// [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`], [`Error::MassNotSpd`],
     /// [`Error::StiffnessNotSymmetric`], [`Error::NonClassicalDamping`],
     /// [`Error::EigenNotConverged`], [`Error::SingularEffectiveMatrix`] (a mode with
     /// `1 + (h/2)·2ξω + (h²/4)·ω² ≤ 0`, possible only for negative `ω²` or `ξ`).
     ///
-    /// Cost: `O(N³)` `f64` flops and a few `N×N` `f64` temporaries on the stack; once.
+    /// Cost: `O(N³)` `f64` flops (Jacobi: `≈ 4N³` a sweep, a few sweeps) and a few `N×N`
+    /// `f64` temporaries on the stack; once.
     pub fn new(
         m: &Rows<N>,
         k: &Rows<N>,
@@ -403,64 +778,106 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
         modes: [usize; R],
         h: f64,
     ) -> Result<Self, Error> {
-        let distinct = (0..R).all(|i| (0..i).all(|j| modes[i] != modes[j]));
-        if R == 0 || R > N || !distinct || modes.iter().any(|&r| r >= N) {
-            return Err(Error::InvalidModeSelection);
-        }
-        if !(finite(m) && finite(k) && finite(b) && finite(y)) {
-            return Err(Error::NonFiniteInput);
-        }
-        if !(h.is_finite() && h > 0.0) {
-            return Err(Error::InvalidTimeStep);
-        }
-        let (lam, phi) = modes_of(m, k)?;
-        let c_all = modal_damping(damping, &lam, &phi)?;
-        let (half_h, quarter_h2) = (0.5 * h, 0.25 * h * h);
-
-        let mut me = Self {
+        let op = modal_operators(m, k, damping, b, y, &modes, h)?;
+        Ok(Self {
             h: T::from_f64_rounded(h),
-            half_h: T::from_f64_rounded(half_h),
-            quarter_h2: T::from_f64_rounded(quarter_h2),
-            g_gamma: [[T::zero(); I]; R],
-            g_c: [T::zero(); R],
-            g_k: [T::zero(); R],
-            gamma: [[T::zero(); I]; R],
-            c: [T::zero(); R],
-            k: [T::zero(); R],
-            out: [[T::zero(); R]; O],
-            phi: [[T::zero(); R]; N],
-            proj: [[T::zero(); N]; R],
+            half_h: T::from_f64_rounded(op.half_h),
+            quarter_h2: T::from_f64_rounded(op.quarter_h2),
+            g_gamma: round2(&op.g_gamma),
+            g_c: round1(&op.g_c),
+            g_k: round1(&op.g_k),
+            gamma: round2(&op.gamma),
+            c: round1(&op.c),
+            k: round1(&op.k),
+            out: round2(&op.out),
+            phi: round2(&op.phi),
+            proj: round2(&op.proj),
             modes,
-        };
-        for (r, &mode) in modes.iter().enumerate() {
-            let (c, lam) = (c_all[mode], lam[mode]);
-            let meff = 1.0 + half_h * c + quarter_h2 * lam;
-            if !(meff.is_finite() && meff > f64::EPSILON) {
-                return Err(Error::SingularEffectiveMatrix);
-            }
-            let g = 1.0 / meff;
-            me.g_c[r] = T::from_f64_rounded(g * c);
-            me.g_k[r] = T::from_f64_rounded(g * lam);
-            me.c[r] = T::from_f64_rounded(c);
-            me.k[r] = T::from_f64_rounded(lam);
-            for j in 0..I {
-                let gam: f64 = (0..N).map(|i| phi[(i, mode)] * b[i][j]).sum();
-                me.gamma[r][j] = T::from_f64_rounded(gam);
-                me.g_gamma[r][j] = T::from_f64_rounded(g * gam);
-            }
-            for o in 0..O {
-                let yo: f64 = (0..N).map(|i| y[o][i] * phi[(i, mode)]).sum();
-                me.out[o][r] = T::from_f64_rounded(yo);
-            }
-            for i in 0..N {
-                me.phi[i][r] = T::from_f64_rounded(phi[(i, mode)]);
-                let pm: f64 = (0..N).map(|l| phi[(l, mode)] * m[l][i]).sum();
-                me.proj[r][i] = T::from_f64_rounded(pm);
-            }
-        }
-        Ok(me)
+        })
     }
 }
+
+/// Const-fn construction, for modal operators computed at compile time into flash.
+macro_rules! const_ctor {
+    ($t:ty) => {
+        impl<const N: usize, const R: usize, const I: usize, const O: usize> Modal<$t, N, R, I, O> {
+            /// `const fn` twin of [`Modal::new`] (the `R` lowest modes), bit-identical to
+            /// it. In a `static`, the compiler solves the eigenproblem and no eigen-solver
+            /// code is linked into the firmware.
+            ///
+            /// Errors: as [`Modal::new`].
+            pub const fn from_rows(
+                m: Rows<N>,
+                k: Rows<N>,
+                damping: Damping<N>,
+                b: [[f64; I]; N],
+                y: [[f64; N]; O],
+                h: f64,
+            ) -> Result<Self, Error> {
+                Self::from_rows_with_modes(m, k, damping, b, y, lowest_modes(), h)
+            }
+
+            /// `const fn` twin of [`Modal::with_modes`], bit-identical to it.
+            ///
+            /// Errors: as [`Modal::with_modes`].
+            pub const fn from_rows_with_modes(
+                m: Rows<N>,
+                k: Rows<N>,
+                damping: Damping<N>,
+                b: [[f64; I]; N],
+                y: [[f64; N]; O],
+                modes: [usize; R],
+                h: f64,
+            ) -> Result<Self, Error> {
+                let op = match modal_operators(&m, &k, &damping, &b, &y, &modes, h) {
+                    Ok(op) => op,
+                    Err(e) => return Err(e),
+                };
+                Ok(Self {
+                    h: h as $t,
+                    half_h: op.half_h as $t,
+                    quarter_h2: op.quarter_h2 as $t,
+                    g_gamma: const_ctor!(@r2 $t, op.g_gamma, R, I),
+                    g_c: const_ctor!(@r1 $t, op.g_c, R),
+                    g_k: const_ctor!(@r1 $t, op.g_k, R),
+                    gamma: const_ctor!(@r2 $t, op.gamma, R, I),
+                    c: const_ctor!(@r1 $t, op.c, R),
+                    k: const_ctor!(@r1 $t, op.k, R),
+                    out: const_ctor!(@r2 $t, op.out, O, R),
+                    phi: const_ctor!(@r2 $t, op.phi, N, R),
+                    proj: const_ctor!(@r2 $t, op.proj, R, N),
+                    modes,
+                })
+            }
+        }
+    };
+    (@r1 $t:ty, $a:expr, $n:expr) => {{
+        let a = $a;
+        let mut r = [0.0 as $t; $n];
+        let mut i = 0;
+        while i < $n {
+            r[i] = a[i] as $t;
+            i += 1;
+        }
+        r
+    }};
+    (@r2 $t:ty, $a:expr, $rows:expr, $cols:expr) => {{
+        let a = $a;
+        let mut r = [[0.0 as $t; $cols]; $rows];
+        let mut i = 0;
+        while i < $rows {
+            let mut j = 0;
+            while j < $cols {
+                r[i][j] = a[i][j] as $t;
+                j += 1;
+            }
+            i += 1;
+        }
+        r
+    }};
+}
+const_ctor!(f32);
+const_ctor!(f64);
 
 impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Modal<T, N, R, I, O> {
     /// The time step `h` (s).
@@ -624,5 +1041,34 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
             })
         };
         State::from_parts(map(&s.eta), map(&s.deta), map(&s.ddeta), s.n)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The `const` square root is within 1 ulp of the correctly rounded one (libm's
+    /// `sqrt` is correctly rounded) over 40 decades and at the edges.
+    #[test]
+    fn const_sqrt_within_one_ulp() {
+        let mut x = 1e-300f64;
+        let mut worst = 0u64;
+        while x < 1e300 {
+            for f in [1.0, 1.37, 2.0, 3.99, 7.3] {
+                let v = x * f;
+                let (a, b) = (sqrt(v).to_bits(), nalgebra::ComplexField::sqrt(v).to_bits());
+                worst = worst.max(a.abs_diff(b));
+            }
+            x *= 1.0e10;
+        }
+        assert!(worst <= 1, "{worst} ulp");
+        assert_eq!(sqrt(0.0), 0.0);
+        assert_eq!(sqrt(4.0), 2.0);
+        assert!(sqrt(-1.0).is_nan());
+        assert_eq!(sqrt(f64::INFINITY), f64::INFINITY);
+        // Subnormal input still converges.
+        let t = 4.9e-324f64;
+        assert!((sqrt(t) - 2.2227587494850775e-162).abs() <= 1e-177);
     }
 }

@@ -412,6 +412,53 @@ fn f32_modal_tracks_f64_modal() {
     assert!(d / p <= bound, "{} > {bound}", d / p);
 }
 
+/// `Modal::from_rows` in a `static` (evaluated by the compiler) is bit-identical to
+/// `Modal::new` at run time, in f32 and f64, and for a chosen mode set.
+#[test]
+fn const_and_runtime_constructors_agree_bit_for_bit() {
+    const B: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();
+    const ROOF: [[f64; 5]; 1] = [[0.0, 0.0, 0.0, 0.0, 1.0]];
+    static S32: Modal<f32, 5, 2> = match Modal::<f32, 5, 2>::from_rows(
+        B.0,
+        B.2,
+        Damping::Matrix(B.1),
+        base_excitation(&B.0),
+        ROOF,
+        0.02,
+    ) {
+        Ok(s) => s,
+        Err(e) => panic!("{}", e.as_str()),
+    };
+    static S64: Modal<f64, 5, 3, 1, 5> = match Modal::<f64, 5, 3, 1, 5>::from_rows_with_modes(
+        B.0,
+        B.2,
+        Damping::Matrix(B.1),
+        base_excitation(&B.0),
+        storey_drifts(),
+        [4, 0, 2],
+        0.02,
+    ) {
+        Ok(s) => s,
+        Err(e) => panic!("{}", e.as_str()),
+    };
+    let (m, c, k) = B;
+    let b = base_excitation(&m);
+    let d = Damping::Matrix(c);
+    assert_eq!(
+        S32,
+        Modal::<f32, 5, 2>::new(&m, &k, &d, &b, &ROOF, 0.02).unwrap()
+    );
+    assert_eq!(
+        S64,
+        Modal::<f64, 5, 3, 1, 5>::with_modes(&m, &k, &d, &b, &storey_drifts(), [4, 0, 2], 0.02)
+            .unwrap()
+    );
+    assert_eq!(
+        Modal::<f64, 5, 2>::from_rows(m, k, d, b, [[1.0; 5]], -1.0).err(),
+        Some(Error::InvalidTimeStep)
+    );
+}
+
 #[test]
 fn typed_errors() {
     let (m, c, k) = models::five_storey_building();
@@ -477,7 +524,32 @@ fn typed_errors() {
         Modal::<f64, 5, 2>::new(&m, &k, &Damping::Matrix(cp), &b, &y, h).err(),
         Some(Error::NonClassicalDamping)
     );
-    // Non-finite data and bad h.
+    // Non-finite data and bad h (NaN in every input).
+    for which in 0..3 {
+        let (mut mm, mut kk, mut cc) = (m, k, c);
+        match which {
+            0 => mm[3][3] = f64::NAN,
+            1 => kk[2][1] = f64::NAN,
+            _ => cc[0][4] = f64::NAN,
+        }
+        assert_eq!(
+            Modal::<f64, 5, 2>::new(&mm, &kk, &Damping::Matrix(cc), &b, &y, h).err(),
+            Some(Error::NonFiniteInput),
+            "NaN in input #{which}"
+        );
+    }
+    let mut yn = y;
+    yn[0][2] = f64::NAN;
+    assert_eq!(
+        Modal::<f64, 5, 2>::new(&m, &k, &d, &b, &yn, h).err(),
+        Some(Error::NonFiniteInput)
+    );
+    let mut xi = [0.05; 5];
+    xi[3] = f64::NAN;
+    assert_eq!(
+        Modal::<f64, 5, 2>::new(&m, &k, &Damping::Ratios(xi), &b, &y, h).err(),
+        Some(Error::NonFiniteInput)
+    );
     let mut bn = b;
     bn[0][0] = f64::NAN;
     assert_eq!(
