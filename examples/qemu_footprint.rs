@@ -1,12 +1,14 @@
 //! Firmware: flash footprint — a scene pays only for the capabilities it uses.
 //!
 //! Default build: only `Linear<f32, 5>` (operators a compiler-built `static`), stepping the
-//! benchmark building under a synthetic ground motion. With feature `qemu-footprint-all`
-//! the same firmware also steps the nonlinear stepper (`Nonlinear<f32, 5>`, the building
-//! with hardening storey springs, Newton) and a modal model (`Modal<f32, 5, 2>`, modes
-//! solved at start-up). `scripts/qemu.sh` builds both, runs both, compares their flash
-//! (`llvm-size`) and checks that the lean build links no symbol of the unused
-//! capabilities (while the full build, the control, does).
+//! benchmark building under a synthetic ground motion. With feature `qemu-footprint-modal`
+//! it also steps `Modal<f32, 5, 2>` whose modes the compiler solved (`static`,
+//! `Modal::from_rows`). With feature `qemu-footprint-all` it also steps the nonlinear
+//! stepper (`Nonlinear<f32, 5>`, the building with hardening storey springs, Newton) and a
+//! `Modal<f32, 5, 2>` built at start-up (`Modal::new`: the eigen-solver runs on target).
+//! `scripts/qemu.sh` builds and runs all three, compares their flash (`llvm-size`) and
+//! checks that the lean build links no symbol of the unused capabilities and the
+//! `static`-modal build no eigen-solver (the full build, which has both, is the control).
 //!
 //! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_footprint`
 #![no_std]
@@ -40,6 +42,38 @@ fn ground(n: u32) -> f32 {
 /// `p = −M ι a_g` (storey mass 1e5 kg).
 fn load(n: u32) -> SVector<f32, 5> {
     SVector::from_element(-1.0e5 * ground(n))
+}
+
+#[cfg(feature = "qemu-footprint-modal")]
+mod flash_modal {
+    //! A modal model whose operators the compiler computed.
+    use super::*;
+    use aemstep::modal::base_excitation;
+    use aemstep::{Damping, Modal};
+
+    static MODAL: Modal<f32, 5, 2> = match Modal::<f32, 5, 2>::from_rows(
+        BUILDING.0,
+        BUILDING.2,
+        Damping::Matrix(BUILDING.1),
+        base_excitation(&BUILDING.0),
+        [[0.0, 0.0, 0.0, 0.0, 1.0]],
+        H,
+    ) {
+        Ok(s) => s,
+        Err(e) => panic!("{}", e.as_str()),
+    };
+
+    /// Steps it; returns the roof displacement.
+    pub fn run() -> f32 {
+        let mut ms = match MODAL.start_at_rest(&SVector::from([ground(0)])) {
+            Ok(s) => s,
+            Err(e) => fail!("modal start: {}", e.as_str()),
+        };
+        for n in 1..=STEPS {
+            MODAL.step(&mut ms, &SVector::from([ground(n)]));
+        }
+        MODAL.output(&ms)[0]
+    }
 }
 
 #[cfg(feature = "qemu-footprint-all")]
@@ -126,6 +160,14 @@ fn main() -> ! {
         fail!("linear state not finite");
     }
     hprintln!("qemu_footprint: Linear<f32, 5> roof {:e} m", s.u()[4]);
+    #[cfg(feature = "qemu-footprint-modal")]
+    {
+        let modal = flash_modal::run();
+        if !modal.is_finite() {
+            fail!("modal result not finite");
+        }
+        hprintln!("qemu_footprint: Modal(R = 2, static) roof {:e} m", modal);
+    }
     #[cfg(feature = "qemu-footprint-all")]
     {
         let (nl, modal) = extra::run();

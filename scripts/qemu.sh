@@ -63,8 +63,10 @@ ex_flags=()
 for ex in "${EXAMPLES[@]}"; do ex_flags+=(--example "$ex"); done
 cargo clippy --release --target "$TARGET" --features qemu "${ex_flags[@]}" -- -D warnings ||
     fail "clippy (firmware examples)"
-cargo clippy --release --target "$TARGET" --features qemu-footprint-all --example qemu_footprint \
-    -- -D warnings || fail "clippy (qemu_footprint, all capabilities)"
+for feat in qemu-footprint-modal qemu-footprint-all; do
+    cargo clippy --release --target "$TARGET" --features "$feat" --example qemu_footprint \
+        -- -D warnings || fail "clippy (qemu_footprint, $feat)"
+done
 
 step "qemu: run every example (must exit 0)"
 for ex in "${EXAMPLES[@]}"; do
@@ -114,24 +116,35 @@ target_bits=$(sed -n 's/^target roof drift f32 bits = //p' "$OUT/qemu_modal-qemu
 echo "ok: both $host_bits"
 
 step "qemu: footprint: a firmware pays only for the capabilities it uses"
-# qemu_footprint uses only Linear<f32, 5>; with qemu-footprint-all it also uses the nonlinear
-# and the modal stepper. The full build is the control: the symbol check must find them there.
+# qemu_footprint uses only Linear<f32, 5>; with qemu-footprint-modal also a compile-time
+# Modal<f32, 5, 2>; with qemu-footprint-all also the nonlinear stepper and a Modal built at
+# run time. The last is the control: the symbol checks must find the code there.
 UNUSED='modal|nonlinear|varying|jacobi|LinearInput|input[:.]|cholesky|Cholesky'
-for feat in qemu qemu-footprint-all; do
+EIGEN='jacobi|cholesky|modes_of|modal_operators'
+for feat in qemu qemu-footprint-modal qemu-footprint-all; do
     build qemu_footprint "$feat"
     run qemu_footprint "$feat"
     [[ $RC -eq 0 ]] || fail "qemu_footprint ($feat) exited with $RC"
 done
 "$NM" -C "$OUT/qemu_footprint-qemu-footprint-all" | grep -E "$UNUSED" >/dev/null ||
     fail "control: no nonlinear/modal symbol found in the build that uses them"
+"$NM" -C "$OUT/qemu_footprint-qemu-footprint-all" | grep -E "$EIGEN" >/dev/null ||
+    fail "control: no eigen-solver symbol found in the build that runs Modal::new"
 if "$NM" -C "$OUT/qemu_footprint-qemu" | grep -E "$UNUSED"; then
     fail "the Linear-only firmware links code of capabilities it does not use (symbols above)"
 fi
+for elf in "$OUT/qemu_footprint-qemu-footprint-modal" "$OUT/qemu_modal-qemu"; do
+    if "$NM" -C "$elf" | grep -E "$EIGEN"; then
+        fail "$elf links eigen-solver code although its modes were solved at compile time"
+    fi
+done
 flash_of() { "$SIZE" -B "$1" | awk 'NR == 2 { print $1 + $2 }'; }
 FP_LEAN=$(flash_of "$OUT/qemu_footprint-qemu")
+FP_MODAL=$(flash_of "$OUT/qemu_footprint-qemu-footprint-modal")
 FP_ALL=$(flash_of "$OUT/qemu_footprint-qemu-footprint-all")
-echo "ok: flash Linear only $FP_LEAN bytes; + Nonlinear + Modal $FP_ALL bytes; no symbol" \
-    "matching /$UNUSED/ in the Linear-only build"
+echo "ok: flash: Linear only $FP_LEAN bytes; + static Modal $FP_MODAL; + Nonlinear + run-time" \
+    "Modal $FP_ALL. No /$UNUSED/ symbol in the Linear-only build, no /$EIGEN/ symbol in the" \
+    "static-Modal builds"
 
 step "qemu: cost and memory tables -> $COST_DOC"
 sym_size() { # <elf> <symbol>: code bytes of a symbol, or "-"
@@ -180,13 +193,16 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "## Footprint (\`examples/qemu_footprint.rs\`)"
     echo
     echo "Flash (\`.text\` + \`.rodata\` + vector table + \`.data\`) of the same firmware using only"
-    echo "\`Linear<f32, 5>\`, and also using \`Nonlinear<f32, 5>\` and \`Modal<f32, 5, 2>\` (feature"
-    echo "\`qemu-footprint-all\`). The Linear-only build links no symbol of the others (checked)."
+    echo "\`Linear<f32, 5>\`; also a \`Modal<f32, 5, 2>\` solved by the compiler (feature"
+    echo "\`qemu-footprint-modal\`); also \`Nonlinear<f32, 5>\` and a \`Modal<f32, 5, 2>\` built at run time"
+    echo "(feature \`qemu-footprint-all\`). Checked: the Linear-only build links no symbol of the others,"
+    echo "the compile-time-modal builds no eigen-solver."
     echo
     echo "| firmware | flash (bytes) |"
     echo "|---|---:|"
     echo "| \`Linear<f32, 5>\` only | $FP_LEAN |"
-    echo "| + \`Nonlinear<f32, 5>\` + \`Modal<f32, 5, 2>\` | $FP_ALL |"
+    echo "| + \`Modal<f32, 5, 2>\` (\`static\`, \`from_rows\`) | $FP_MODAL |"
+    echo "| + \`Nonlinear<f32, 5>\` + \`Modal<f32, 5, 2>\` (\`Modal::new\` on target) | $FP_ALL |"
     echo
     echo "## Memory of each example"
     echo

@@ -145,8 +145,10 @@ pub const fn base_excitation<const N: usize>(m: &Rows<N>) -> [[f64; 1]; N] {
 /// ([`Modal::output`]). With `R = N` it reproduces [`Linear`](crate::Linear) to rounding;
 /// with `R < N` the error is the truncation of the dropped modes (see the README table).
 ///
-/// Size: `R·(I + O + 2N + 6) + 3` values of `T`. Build with [`Modal::new`] (the `R`
-/// lowest modes) or [`Modal::with_modes`], in `f64`, rounded once to `T`.
+/// Size: `R·(2I + O + 2N + 4) + 3` values of `T` and `R` indices. Build with
+/// [`Modal::new`] (the `R` lowest modes) or [`Modal::with_modes`] at run time, or with
+/// `Modal::from_rows` / `Modal::from_rows_with_modes` (`const fn`: in a `static`, computed
+/// by the compiler into flash); in `f64`, rounded once to `T`.
 ///
 /// ```
 /// use aemstep::{models, Damping, Modal};
