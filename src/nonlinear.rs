@@ -458,25 +458,28 @@ fn finite_difference_jacobian<T: Real, const N: usize, Mo: Model<T, N> + ?Sized>
     let one = T::one();
     let mut j = *m;
     let mut scale = T::zero();
+    // Column-major arrays: plain array indexing with loop-bounded indices, which the
+    // compiler proves in bounds (no panic path in the binary).
+    let (u_a, v_a, f_a) = (&u.data.0[0], &v.data.0[0], &f.data.0[0]);
     for col in 0..N {
-        let (uj, vj) = (u[col], v[col]);
+        let (uj, vj) = (u_a[col], v_a[col]);
         // u_j moves by √ε·max(|u_j|, 1), rounded so the step is exact in floating point;
         // v_j moves along the same q_j direction, by (b/c) times that.
         let shifted = uj + sqrt_eps * uj.abs().max(one);
-        let du = shifted - uj;
-        let delta = du / c;
+        let delta = (shifted - uj) / c;
         let (mut up, mut vp) = (*u, *v);
-        up[col] = shifted;
-        vp[col] = vj + b * delta;
+        up.data.0[0][col] = shifted;
+        vp.data.0[0][col] = vj + b * delta;
         let fp = model.force(&up, &vp);
         if !all_finite(&fp) {
             return Err(Error::NonFiniteForce);
         }
+        let fp_a = &fp.data.0[0];
+        let j_col = &mut j.data.0[col];
         for row in 0..N {
-            let d = (fp[row] - f[row]) / delta;
-            let mij = j[(row, col)];
-            scale = scale.max(mij.abs() + d.abs());
-            j[(row, col)] = mij + d;
+            let d = (fp_a[row] - f_a[row]) / delta;
+            scale = scale.max(j_col[row].abs() + d.abs());
+            j_col[row] += d;
         }
     }
     Ok((j, scale))
@@ -492,13 +495,17 @@ pub(crate) fn solve_in_place<T: Real, const N: usize>(
     scale: T,
 ) -> bool {
     let tiny = T::from_f64_rounded(N as f64) * T::default_epsilon() * scale;
+    // Column-major storage, `a[c][r]` = A(r, c); plain array indexing with loop-bounded
+    // indices, which the compiler proves in bounds (no panic path in the binary).
+    let a = &mut a.data.0;
+    let x = &mut b.data.0[0];
     for col in 0..N {
         let mut piv = col;
-        let mut best = a[(col, col)].abs();
+        let mut best = a[col][col].abs();
         for r in col + 1..N {
-            let x = a[(r, col)].abs();
-            if x > best {
-                best = x;
+            let e = a[col][r].abs();
+            if e > best {
+                best = e;
                 piv = r;
             }
         }
@@ -507,28 +514,34 @@ pub(crate) fn solve_in_place<T: Real, const N: usize>(
             return false;
         }
         if piv != col {
-            a.swap_rows(piv, col);
-            b.swap_rows(piv, col);
+            for c in 0..N {
+                let t = a[c][piv];
+                a[c][piv] = a[c][col];
+                a[c][col] = t;
+            }
+            let t = x[piv];
+            x[piv] = x[col];
+            x[col] = t;
         }
-        let d = a[(col, col)];
+        let d = a[col][col];
         for r in col + 1..N {
-            let f = a[(r, col)] / d;
+            let f = a[col][r] / d;
             if f != T::zero() {
                 for k in col + 1..N {
-                    let x = a[(col, k)];
-                    a[(r, k)] -= f * x;
+                    let p = a[k][col];
+                    a[k][r] -= f * p;
                 }
-                let bc = b[col];
-                b[r] -= f * bc;
+                let xc = x[col];
+                x[r] -= f * xc;
             }
         }
     }
     for col in (0..N).rev() {
-        let mut s = b[col];
+        let mut s = x[col];
         for k in col + 1..N {
-            s -= a[(col, k)] * b[k];
+            s -= a[k][col] * x[k];
         }
-        b[col] = s / a[(col, col)];
+        x[col] = s / a[col][col];
     }
     true
 }
