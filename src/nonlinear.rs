@@ -514,14 +514,10 @@ pub(crate) fn solve_in_place<T: Real, const N: usize>(
             return false;
         }
         if piv != col {
-            for c in 0..N {
-                let t = a[c][piv];
-                a[c][piv] = a[c][col];
-                a[c][col] = t;
+            for column in a.iter_mut() {
+                column.swap(piv, col);
             }
-            let t = x[piv];
-            x[piv] = x[col];
-            x[col] = t;
+            x.swap(piv, col);
         }
         let d = a[col][col];
         for r in col + 1..N {
