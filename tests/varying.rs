@@ -306,3 +306,13 @@ fn start_and_construction_errors() {
         .unwrap();
     assert!((s.a()[0] - example3_exact(0.0).2).abs() < 1e-15);
 }
+
+#[test]
+fn singular_step_error_names_the_step_when_displayed() {
+    let e = aemstep::Error::SingularEffectiveMatrixAtStep { step: 5 };
+    let text = e.to_string();
+    assert!(
+        text.starts_with(e.as_str()) && text.ends_with("(step 5)"),
+        "{text}"
+    );
+}
