@@ -100,7 +100,11 @@ impl Error {
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
+        f.write_str(self.as_str())?;
+        match self {
+            Error::SingularEffectiveMatrixAtStep { step } => write!(f, " (step {step})"),
+            _ => Ok(()),
+        }
     }
 }
 

@@ -63,8 +63,8 @@ pub trait Model<T: Real, const N: usize> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Iterations {
-    /// Stop as soon as the relative residual is at most the tolerance, after at most this
-    /// many iterations (`≥ 1`).
+    /// Stop as soon as the step has converged (see [`NewtonSettings::tolerance`]), after
+    /// at most this many iterations (`≥ 1`).
     UpTo(u32),
     /// Always exactly this many iterations (`≥ 1`): the same work every step, for hard
     /// real-time loops. Convergence is still judged (and reported) by the tolerance.
@@ -77,13 +77,23 @@ pub enum Iterations {
 pub struct NewtonSettings<T> {
     /// Iteration budget and mode.
     pub iterations: Iterations,
-    /// Tolerance on the relative residual `‖R‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)`
-    /// (dimensionless, finite, `≥ 0`).
+    /// Convergence tolerance (dimensionless, finite, `≥ 0`). A step has converged when
+    /// either
+    /// - the relative residual `‖M q + F − p‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` is `≤ tolerance`,
+    ///   or
+    /// - the last Newton correction `δq` was small against the accelerations the state
+    ///   represents: `‖δq‖∞ ≤ tolerance · max(‖q‖∞, ‖u‖∞/(h²/4), ‖v‖∞/(h/2))`, i.e. it
+    ///   moved `u_n` or `v_n` by at most `tolerance` relative to their size.
+    ///
+    /// The second test catches convergence at the rounding floor, where the forces nearly
+    /// cancel (e.g. a spring passing its natural length) and the residual cannot fall
+    /// below `ε` times the terms inside `F`.
     pub tolerance: T,
 }
 
 impl<T: Real> NewtonSettings<T> {
-    /// Iterate until the relative residual is `≤ tolerance`, at most `max_iterations` times.
+    /// Iterate until converged (see [`NewtonSettings::tolerance`]), at most
+    /// `max_iterations` times.
     pub fn up_to(max_iterations: u32, tolerance: T) -> Self {
         Self {
             iterations: Iterations::UpTo(max_iterations),
@@ -124,7 +134,10 @@ pub struct NewtonReport<T> {
     /// Final relative residual `‖M q + F − p‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` at the returned
     /// state (dimensionless; `0` if all three are zero).
     pub residual: T,
-    /// `residual ≤ tolerance`.
+    /// Size of the last Newton correction, `‖δq‖∞ / max(‖q‖∞, ‖u‖∞/(h²/4), ‖v‖∞/(h/2))`
+    /// at the returned state (dimensionless; `0` if no iteration was made).
+    pub correction: T,
+    /// `residual ≤ tolerance` or (`iterations ≥ 1` and `correction ≤ tolerance`).
     pub converged: bool,
 }
 
@@ -289,8 +302,8 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
     ///
     /// Errors (each leaves `state` bit-identical): [`Error::NonFiniteInput`] (`p_n` or
     /// `M`), [`Error::NonFiniteForce`] (the model returned NaN/∞ at some iterate),
-    /// [`Error::SingularJacobian`], [`Error::NotConverged`] (residual above tolerance after
-    /// the iteration budget), [`Error::NonFiniteState`].
+    /// [`Error::SingularJacobian`], [`Error::NotConverged`] (not converged after the
+    /// iteration budget, see [`NewtonSettings::tolerance`]), [`Error::NonFiniteState`].
     ///
     /// Cost: see [`Nonlinear`]; no allocation, no panic.
     pub fn step<Mo: Model<T, N> + ?Sized>(
@@ -335,6 +348,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         let tol = self.settings.tolerance;
         let mut q = state.a;
         let mut iterations = 0u32;
+        let mut last_delta = T::zero();
         loop {
             let u = uh + q * c;
             let v = vh + q * b;
@@ -345,7 +359,19 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
             let mq = m * q;
             let r = mq + f - p;
             let residual = relative_residual(&r, &mq, &f, p);
-            let converged = residual <= tol;
+            let correction = if iterations == 0 {
+                T::zero()
+            } else {
+                let reference = norm_inf(&q).max(norm_inf(&u) / c).max(norm_inf(&v) / b);
+                if last_delta <= T::zero() {
+                    T::zero()
+                } else if reference > T::zero() {
+                    last_delta / reference
+                } else {
+                    T::one()
+                }
+            };
+            let converged = residual <= tol || (iterations > 0 && correction <= tol);
             let done = iterations >= budget || (!fixed && converged);
             if done {
                 let next = State::from_parts(u, v, q, state.n.wrapping_add(1));
@@ -355,6 +381,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
                 let report = NewtonReport {
                     iterations,
                     residual,
+                    correction,
                     converged,
                 };
                 return Ok((next, report));
@@ -387,6 +414,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
                 return Err(Error::SingularJacobian);
             }
             q -= delta;
+            last_delta = norm_inf(&delta);
             iterations += 1;
         }
     }
@@ -430,25 +458,28 @@ fn finite_difference_jacobian<T: Real, const N: usize, Mo: Model<T, N> + ?Sized>
     let one = T::one();
     let mut j = *m;
     let mut scale = T::zero();
+    // Column-major arrays: plain array indexing with loop-bounded indices, which the
+    // compiler proves in bounds (no panic path in the binary).
+    let (u_a, v_a, f_a) = (&u.data.0[0], &v.data.0[0], &f.data.0[0]);
     for col in 0..N {
-        let (uj, vj) = (u[col], v[col]);
+        let (uj, vj) = (u_a[col], v_a[col]);
         // u_j moves by √ε·max(|u_j|, 1), rounded so the step is exact in floating point;
         // v_j moves along the same q_j direction, by (b/c) times that.
         let shifted = uj + sqrt_eps * uj.abs().max(one);
-        let du = shifted - uj;
-        let delta = du / c;
+        let delta = (shifted - uj) / c;
         let (mut up, mut vp) = (*u, *v);
-        up[col] = shifted;
-        vp[col] = vj + b * delta;
+        up.data.0[0][col] = shifted;
+        vp.data.0[0][col] = vj + b * delta;
         let fp = model.force(&up, &vp);
         if !all_finite(&fp) {
             return Err(Error::NonFiniteForce);
         }
+        let fp_a = &fp.data.0[0];
+        let j_col = &mut j.data.0[col];
         for row in 0..N {
-            let d = (fp[row] - f[row]) / delta;
-            let mij = j[(row, col)];
-            scale = scale.max(mij.abs() + d.abs());
-            j[(row, col)] = mij + d;
+            let d = (fp_a[row] - f_a[row]) / delta;
+            scale = scale.max(j_col[row].abs() + d.abs());
+            j_col[row] += d;
         }
     }
     Ok((j, scale))
@@ -464,13 +495,17 @@ pub(crate) fn solve_in_place<T: Real, const N: usize>(
     scale: T,
 ) -> bool {
     let tiny = T::from_f64_rounded(N as f64) * T::default_epsilon() * scale;
+    // Column-major storage, `a[c][r]` = A(r, c); plain array indexing with loop-bounded
+    // indices, which the compiler proves in bounds (no panic path in the binary).
+    let a = &mut a.data.0;
+    let x = &mut b.data.0[0];
     for col in 0..N {
         let mut piv = col;
-        let mut best = a[(col, col)].abs();
+        let mut best = a[col][col].abs();
         for r in col + 1..N {
-            let x = a[(r, col)].abs();
-            if x > best {
-                best = x;
+            let e = a[col][r].abs();
+            if e > best {
+                best = e;
                 piv = r;
             }
         }
@@ -479,28 +514,30 @@ pub(crate) fn solve_in_place<T: Real, const N: usize>(
             return false;
         }
         if piv != col {
-            a.swap_rows(piv, col);
-            b.swap_rows(piv, col);
+            for column in a.iter_mut() {
+                column.swap(piv, col);
+            }
+            x.swap(piv, col);
         }
-        let d = a[(col, col)];
+        let d = a[col][col];
         for r in col + 1..N {
-            let f = a[(r, col)] / d;
+            let f = a[col][r] / d;
             if f != T::zero() {
                 for k in col + 1..N {
-                    let x = a[(col, k)];
-                    a[(r, k)] -= f * x;
+                    let p = a[k][col];
+                    a[k][r] -= f * p;
                 }
-                let bc = b[col];
-                b[r] -= f * bc;
+                let xc = x[col];
+                x[r] -= f * xc;
             }
         }
     }
     for col in (0..N).rev() {
-        let mut s = b[col];
+        let mut s = x[col];
         for k in col + 1..N {
-            s -= a[(col, k)] * b[k];
+            s -= a[k][col] * x[k];
         }
-        b[col] = s / a[(col, col)];
+        x[col] = s / a[col][col];
     }
     true
 }
