@@ -277,14 +277,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Linear<T, N> {
         }
         // q = G p − GC v̂ − GK û, written to `a`. Rows go in blocks of `BLOCK`, so each
         // value of `x` loaded feeds `BLOCK` multiply-adds.
-        let (blocks, rest) = self.ops.as_chunks::<BLOCK>();
-        let (a_blocks, a_rest) = s.a.as_mut_slice().as_chunks_mut::<BLOCK>();
-        for (rows, a) in blocks.iter().zip(a_blocks) {
-            *a = dots(rows, &x);
-        }
-        for (row, a) in rest.iter().zip(a_rest) {
-            [*a] = dots(core::array::from_ref(row), &x);
-        }
+        mat_vec_blocked(&self.ops, &x, s.a.as_mut_slice());
         // v = v̂ + (h/2) q, u = û + (h²/4) q. A separate pass with constant indices (once
         // unrolled), so v̂, û are used straight from registers.
         for j in 0..N {
@@ -296,25 +289,27 @@ impl<T: Real, const N: usize> Stepper<T, N> for Linear<T, N> {
     }
 }
 
-/// Rows of the operator processed together in [`Linear`]'s step.
+/// Operator rows processed together by the steps (two accumulators: on the Cortex-M4F
+/// this is what keeps the f32 fast form at or below 3 instructions a multiply-add for
+/// N = 6 and 12; 3 or 4 rows spill registers at one size or the other).
 const BLOCK: usize = 2;
 
-/// `R` dot products of interleaved operator rows with `x`: `R` accumulators, so each `x`
-/// value is loaded once for `R` multiply-adds. Each sum starts from its first product (no
-/// `0 +`), then accumulates in order: `G[i]·p`, then `−GC[i]·v̂`, then `−GK[i]·û`.
+/// `R` dot products of interleaved operator rows (each `K` blocks of `N`) with `x`: `R`
+/// accumulators, so each `x` value is loaded once for `R` multiply-adds. Each sum starts
+/// from its first product (no `0 +`), then accumulates block by block, in order.
 #[inline(always)]
-fn dots<T: Real, const N: usize, const R: usize>(
-    rows: &[[[T; N]; 3]; R],
-    x: &[[T; N]; 3],
+pub(crate) fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
+    rows: &[[[T; N]; K]; R],
+    x: &[[T; N]; K],
 ) -> [T; R] {
     let mut q = [T::zero(); R];
-    if N == 0 {
+    if N == 0 || K == 0 {
         return q;
     }
     for r in 0..R {
         q[r] = rows[r][0][0] * x[0][0];
     }
-    for b in 0..3 {
+    for b in 0..K {
         let first = if b == 0 { 1 } else { 0 };
         for j in first..N {
             let xj = x[b][j];
@@ -324,6 +319,23 @@ fn dots<T: Real, const N: usize, const R: usize>(
         }
     }
     q
+}
+
+/// `out = rows · x` for `N` interleaved rows, in blocks of [`BLOCK`] rows.
+#[inline(always)]
+pub(crate) fn mat_vec_blocked<T: Real, const N: usize, const K: usize>(
+    rows: &[[[T; N]; K]; N],
+    x: &[[T; N]; K],
+    out: &mut [T],
+) {
+    let (blocks, rest) = rows.as_chunks::<BLOCK>();
+    let (out_blocks, out_rest) = out.as_chunks_mut::<BLOCK>();
+    for (rows, o) in blocks.iter().zip(out_blocks) {
+        *o = dots(rows, x);
+    }
+    for (row, o) in rest.iter().zip(out_rest) {
+        [*o] = dots(core::array::from_ref(row), x);
+    }
 }
 
 /// `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0` and the state at step 0.
