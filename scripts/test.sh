@@ -6,6 +6,10 @@ cd "$(dirname "$0")/.."
 
 step() { printf '\n==> %s\n' "$*"; }
 fail() { printf '\nFAILED: %s\n' "$*" >&2; exit 1; }
+# Test runner output is also collected here, to print one total at the end.
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+tests() { "$@" 2>&1 | tee -a "$log"; }
 
 step "toolchain: thumb targets (idempotent)"
 rustup target add thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi
@@ -16,11 +20,11 @@ cargo clippy --all-targets -- -D warnings || fail "clippy"
 cargo clippy --all-targets --features std -- -D warnings || fail "clippy (std)"
 
 step "host tests (debug: overflow checks on)"
-cargo test --all-targets || fail "host tests"
-cargo test --doc || fail "doctests"
+tests cargo test --all-targets || fail "host tests"
+tests cargo test --doc || fail "doctests"
 
 step "long host tests (release)"
-cargo test --release --all-targets -- --ignored || fail "long tests"
+tests cargo test --release --all-targets -- --ignored || fail "long tests"
 
 step "no_std builds for thumb targets"
 for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi; do
@@ -34,4 +38,9 @@ bash scripts/qemu.sh || fail "firmware (scripts/qemu.sh)"
 step "docs build without warnings"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps || fail "rustdoc"
 
+read -r passed failed < <(awk '/^test result:/ { for (i = 1; i < NF; i++) {
+    if ($(i + 1) ~ /^passed;/) p += $i; if ($(i + 1) ~ /^failed;/) f += $i } }
+    END { print p + 0, f + 0 }' "$log")
 printf '\nall test stages passed\n'
+echo "total: ${passed} passed, ${failed} failed"
+

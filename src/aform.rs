@@ -104,8 +104,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for AForm<T, N> {
         v0: &SVector<T, N>,
         p0: &SVector<T, N>,
     ) -> Result<State<T, N>, Error> {
-        let ops = self.start.as_ref().ok_or(Error::SingularMass)?;
-        initial_state(ops, u0, v0, p0)
+        initial_state(self.start.as_ref(), u0, v0, p0)
     }
 
     /// Cost: `12N²` multiply-adds.

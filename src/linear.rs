@@ -256,8 +256,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Linear<T, N> {
         v0: &SVector<T, N>,
         p0: &SVector<T, N>,
     ) -> Result<State<T, N>, Error> {
-        let ops = self.start.as_ref().ok_or(Error::SingularMass)?;
-        initial_state(ops, u0, v0, p0)
+        initial_state(self.start.as_ref(), u0, v0, p0)
     }
 
     /// Cost: `3N²` multiply-adds + `7N` (see the module docs for the recurrence).
@@ -338,13 +337,15 @@ pub(crate) fn mat_vec_blocked<T: Real, const N: usize, const K: usize>(
     }
 }
 
-/// `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0` and the state at step 0.
+/// `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0` and the state at step 0; `ops` is `None` when
+/// `M` is singular ([`Error::SingularMass`]).
 pub(crate) fn initial_state<T: Real, const N: usize>(
-    ops: &StartOps<T, N>,
+    ops: Option<&StartOps<T, N>>,
     u0: &SVector<T, N>,
     v0: &SVector<T, N>,
     p0: &SVector<T, N>,
 ) -> Result<State<T, N>, Error> {
+    let ops = ops.ok_or(Error::SingularMass)?;
     let inputs_finite = u0
         .iter()
         .chain(v0.iter())
