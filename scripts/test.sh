@@ -26,6 +26,9 @@ tests cargo test --doc || fail "doctests"
 step "long host tests (release)"
 tests cargo test --release --all-targets -- --ignored || fail "long tests"
 
+step "energy behaviour of the nonlinear stepper (numbers quoted in README.md)"
+cargo run --release --example energy || fail "energy example"
+
 step "no_std builds for thumb targets"
 for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi; do
     cargo build --lib --release --target "$t" || fail "no_std build for $t"

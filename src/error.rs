@@ -23,6 +23,24 @@ pub enum Error {
     /// The step would produce a NaN or infinite state (e.g. a NaN load sample);
     /// the state was left unchanged.
     NonFiniteState,
+    /// The nonlinear step's Newton iteration did not bring the relative residual down to
+    /// its tolerance within the iteration budget; the state was left unchanged
+    /// (`Nonlinear::trial_step` still returns the unconverged candidate).
+    NotConverged,
+    /// The Newton matrix `J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u` of a nonlinear step is
+    /// singular to working precision; the state was left unchanged.
+    SingularJacobian,
+    /// A nonlinear model's force `F(u, v)` or its tangent returned a NaN or infinite
+    /// entry; the state was left unchanged.
+    NonFiniteForce,
+    /// Newton settings with zero iterations, or a tolerance that is negative or not finite.
+    InvalidNewtonSettings,
+    /// The effective matrix `M(t) + (h/2) C(t) + (h²/4) K(t)` of a time-varying system is
+    /// singular to working precision at `t = step·h`; the state was left unchanged.
+    SingularEffectiveMatrixAtStep {
+        /// The index `n` of the step that could not be taken (the state is still at `n − 1`).
+        step: u64,
+    },
 }
 
 impl Error {
@@ -40,6 +58,19 @@ impl Error {
             }
             Error::NonFiniteState => {
                 "the step would make the state NaN or infinite; state unchanged"
+            }
+            Error::NotConverged => "Newton did not converge within its budget; state unchanged",
+            Error::SingularJacobian => {
+                "the Newton matrix M + (h/2)dF/dv + (h^2/4)dF/du is singular; state unchanged"
+            }
+            Error::NonFiniteForce => {
+                "the model's force or tangent is NaN or infinite; state unchanged"
+            }
+            Error::InvalidNewtonSettings => {
+                "Newton settings need >= 1 iteration and a finite tolerance >= 0"
+            }
+            Error::SingularEffectiveMatrixAtStep { .. } => {
+                "the time-varying effective matrix is singular at this step; state unchanged"
             }
         }
     }

@@ -17,6 +17,8 @@
 //! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference and
 //!   inspection.
 //! - [`State`], [`Stepper`]: the state and the interface every scheme shares.
+//! - [`Nonlinear`], [`Model`]: `M u'' + F(u, u') = p(t)` by Newton on the acceleration,
+//!   with a per-step [`NewtonReport`]; [`Varying`]: `M(t), C(t), K(t)` ([`TimeVarying`]).
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
 //!
@@ -34,15 +36,19 @@ mod aform;
 mod error;
 mod linear;
 pub mod models;
+mod nonlinear;
 mod ops;
 mod scalar;
 mod state;
+mod varying;
 
 pub use aform::AForm;
 pub use error::Error;
 pub use linear::Linear;
+pub use nonlinear::{Iterations, Model, NewtonReport, NewtonSettings, Nonlinear, Tangent};
 pub use scalar::Real;
 pub use state::{State, Stepper};
+pub use varying::{Coefficients, TimeVarying, Varying};
 
 /// The README's code blocks, compiled and run as doctests.
 #[cfg(doctest)]

@@ -1,0 +1,543 @@
+//! Nonlinear equations of motion `M u'' + F(u, u') = p(t)` (paper §5, Algorithm 2).
+//!
+//! The kinematics are those of the linear step (`q = u''` constant on the step at the mean
+//! of its end values); the equation of motion is enforced at `t_n`:
+//!
+//! ```text
+//! v̂ = v_{n−1} + (h/2) q_{n−1},   û = u_{n−1} + h v_{n−1} + (h²/4) q_{n−1}
+//! find q_n:  R(q_n) = M q_n + F(û + (h²/4) q_n, v̂ + (h/2) q_n) − p_n = 0
+//! v_n = v̂ + (h/2) q_n,            u_n = û + (h²/4) q_n
+//! ```
+//!
+//! `R = 0` is solved by Newton's method from the predictor `q_{n−1}`, with the matrix
+//! `J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u`, factorized by LU with partial pivoting at every
+//! iteration.
+//!
+//! **Cost per step**: `k · (N³/3 + 4N² multiply-adds + one tangent evaluation) + (k + 1)`
+//! force evaluations, where `k` is the number of Newton iterations (at most the budget). Without
+//! an analytic tangent the tangent evaluation is `N` extra force evaluations (a directional
+//! finite difference per column of `J`). Stack: about three `N×N` matrices of `T`.
+
+use core::marker::PhantomData;
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::{Error, Real, State};
+
+/// The derivatives of the internal force `F(u, v)` at one point (the tangent operator).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tangent<T, const N: usize> {
+    /// Tangent stiffness `∂F/∂u` (force per displacement), `N×N`.
+    pub stiffness: SMatrix<T, N, N>,
+    /// Tangent damping `∂F/∂v` (force per velocity), `N×N`.
+    pub damping: SMatrix<T, N, N>,
+}
+
+/// A nonlinear structural model `M u'' + F(u, u') = p(t)`, implemented by the user.
+///
+/// `F` gathers every internal force (damping and restoring, linear or not). A model whose
+/// `F` also depends on time can be passed to each step evaluated at that step's end time
+/// `t_n` (the equation is enforced there): models are taken by reference per call.
+///
+/// Methods must not panic; a NaN or infinite result is reported as
+/// [`Error::NonFiniteForce`] and the step is not taken.
+pub trait Model<T: Real, const N: usize> {
+    /// The constant mass matrix `M` (`N×N`). Called once per step and once per start.
+    fn mass(&self) -> SMatrix<T, N, N>;
+
+    /// The internal force `F(u, v)` at displacement `u` and velocity `v`.
+    fn force(&self, u: &SVector<T, N>, v: &SVector<T, N>) -> SVector<T, N>;
+
+    /// The tangent `∂F/∂u`, `∂F/∂v` at `(u, v)`, or `None` (the default) to let the
+    /// stepper form `J` by finite differences: `N` extra force evaluations per Newton
+    /// iteration, one forward difference per column along `q_j`, which moves `u_j` by
+    /// `s = √ε·max(|u_j|, 1)` and `v_j` by `(2/h)·s`. Exact for `F` linear in `v`; give
+    /// the tangent when `F` is strongly nonlinear in `v` or a fixed, small iteration count
+    /// must converge.
+    fn tangent(&self, _u: &SVector<T, N>, _v: &SVector<T, N>) -> Option<Tangent<T, N>> {
+        None
+    }
+}
+
+/// How many Newton iterations a step may use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Iterations {
+    /// Stop as soon as the step has converged (see [`NewtonSettings::tolerance`]), after
+    /// at most this many iterations (`≥ 1`).
+    UpTo(u32),
+    /// Always exactly this many iterations (`≥ 1`): the same work every step, for hard
+    /// real-time loops. Convergence is still judged (and reported) by the tolerance.
+    Exactly(u32),
+}
+
+/// Newton settings of a [`Nonlinear`] stepper.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct NewtonSettings<T> {
+    /// Iteration budget and mode.
+    pub iterations: Iterations,
+    /// Convergence tolerance (dimensionless, finite, `≥ 0`). A step has converged when
+    /// either
+    /// - the relative residual `‖M q + F − p‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` is `≤ tolerance`,
+    ///   or
+    /// - the last Newton correction `δq` was small against the accelerations the state
+    ///   represents: `‖δq‖∞ ≤ tolerance · max(‖q‖∞, ‖u‖∞/(h²/4), ‖v‖∞/(h/2))`, i.e. it
+    ///   moved `u_n` or `v_n` by at most `tolerance` relative to their size.
+    ///
+    /// The second test catches convergence at the rounding floor, where the forces nearly
+    /// cancel (e.g. a spring passing its natural length) and the residual cannot fall
+    /// below `ε` times the terms inside `F`.
+    pub tolerance: T,
+}
+
+impl<T: Real> NewtonSettings<T> {
+    /// Iterate until converged (see [`NewtonSettings::tolerance`]), at most
+    /// `max_iterations` times.
+    pub fn up_to(max_iterations: u32, tolerance: T) -> Self {
+        Self {
+            iterations: Iterations::UpTo(max_iterations),
+            tolerance,
+        }
+    }
+
+    /// Always `iterations` Newton iterations (constant work per step), convergence judged
+    /// by `tolerance` afterwards.
+    pub fn exactly(iterations: u32, tolerance: T) -> Self {
+        Self {
+            iterations: Iterations::Exactly(iterations),
+            tolerance,
+        }
+    }
+
+    /// The default tolerance, `max(1e-10, 128 ε)`: `1e-10` in `f64`, `1.5e-5` in `f32`.
+    pub fn default_tolerance() -> T {
+        let eps = T::default_epsilon().as_f64();
+        T::from_f64_rounded(f64::max(1e-10, 128.0 * eps))
+    }
+}
+
+impl<T: Real> Default for NewtonSettings<T> {
+    /// Up to 20 iterations, [`NewtonSettings::default_tolerance`].
+    fn default() -> Self {
+        Self::up_to(20, Self::default_tolerance())
+    }
+}
+
+/// What one nonlinear step's Newton iteration did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct NewtonReport<T> {
+    /// Newton iterations used (factorizations of `J`); `0` if the predictor already met
+    /// the tolerance.
+    pub iterations: u32,
+    /// Final relative residual `‖M q + F − p‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` at the returned
+    /// state (dimensionless; `0` if all three are zero).
+    pub residual: T,
+    /// Size of the last Newton correction, `‖δq‖∞ / max(‖q‖∞, ‖u‖∞/(h²/4), ‖v‖∞/(h/2))`
+    /// at the returned state (dimensionless; `0` if no iteration was made).
+    pub correction: T,
+    /// `residual ≤ tolerance` or (`iterations ≥ 1` and `correction ≤ tolerance`).
+    pub converged: bool,
+}
+
+/// The nonlinear AEM stepper for `M u'' + F(u, u') = p(t)` (paper Algorithm 2) with `N`
+/// degrees of freedom, in `f32` or `f64`.
+///
+/// It holds only `h` and the Newton settings; the [`Model`] is passed to every call. A
+/// step that fails (no convergence, singular `J`, non-finite force or load) returns an
+/// [`Error`] and leaves the caller's [`State`] bit-identical; [`Nonlinear::trial_step`]
+/// gives the unconverged candidate when the caller wants to decide itself.
+///
+/// Each step solves, by Newton's method from the predictor `q_{n−1}`,
+///
+/// ```text
+/// v̂ = v_{n−1} + (h/2) q_{n−1},   û = u_{n−1} + h v_{n−1} + (h²/4) q_{n−1}
+/// R(q_n) = M q_n + F(û + (h²/4) q_n, v̂ + (h/2) q_n) − p_n = 0
+/// J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u          (LU with partial pivoting, every iteration)
+/// v_n = v̂ + (h/2) q_n,            u_n = û + (h²/4) q_n
+/// ```
+///
+/// **Cost per step**, for `k` Newton iterations: `k × (N³/3 + 4N² multiply-adds + one
+/// tangent evaluation) + (k + 1)` force evaluations. Without an analytic tangent, a
+/// tangent evaluation is `N` force evaluations. Stack: about three `N×N` matrices of `T`.
+///
+/// A Duffing oscillator `u'' + 0.2 u' + u + u³ = p(t)` (paper Example 5), with two Newton
+/// iterations every step:
+///
+/// ```
+/// use aemstep::{Model, NewtonSettings, Nonlinear, Tangent};
+/// use nalgebra::{matrix, vector, SMatrix, SVector};
+///
+/// struct Duffing;
+/// impl Model<f32, 1> for Duffing {
+///     fn mass(&self) -> SMatrix<f32, 1, 1> {
+///         matrix![1.0]
+///     }
+///     fn force(&self, u: &SVector<f32, 1>, v: &SVector<f32, 1>) -> SVector<f32, 1> {
+///         vector![0.2 * v[0] + u[0] + u[0] * u[0] * u[0]]
+///     }
+///     fn tangent(&self, u: &SVector<f32, 1>, _v: &SVector<f32, 1>) -> Option<Tangent<f32, 1>> {
+///         Some(Tangent { stiffness: matrix![1.0 + 3.0 * u[0] * u[0]], damping: matrix![0.2] })
+///     }
+/// }
+///
+/// // exact solution u = e^{-0.1t} sin t, so p(t) = -0.01 e^{-0.1t} sin t + e^{-0.3t} sin³t
+/// let p = |t: f32| vector![-0.01 * (-0.1 * t).exp() * t.sin() + (-0.3 * t).exp() * t.sin().powi(3)];
+/// let h = 0.01;
+/// let stepper = Nonlinear::<f32, 1>::new(h, NewtonSettings::exactly(2, 1e-5))?;
+/// let mut s = stepper.start(&Duffing, &vector![0.0], &vector![1.0], &p(0.0))?;
+/// for n in 1..=300 {
+///     let report = stepper.step(&Duffing, &mut s, &p(n as f32 * h))?;
+///     assert!(report.converged && report.iterations == 2);
+/// }
+/// let t = 3.0f32;
+/// assert!((s.u()[0] - (-0.1 * t).exp() * t.sin()).abs() < 1e-4);
+/// # Ok::<(), aemstep::Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Nonlinear<T, const N: usize> {
+    h: T,
+    half_h: T,
+    quarter_h2: T,
+    settings: NewtonSettings<T>,
+    _n: PhantomData<[T; N]>,
+}
+
+impl<T: Real, const N: usize> Nonlinear<T, N> {
+    /// A stepper with time step `h` (s) and the given Newton settings.
+    ///
+    /// Errors: [`Error::InvalidTimeStep`] (`h` not finite or `≤ 0`),
+    /// [`Error::InvalidNewtonSettings`] (zero iterations, or a tolerance that is negative
+    /// or not finite). Cost: O(1).
+    pub fn new(h: T, settings: NewtonSettings<T>) -> Result<Self, Error> {
+        if !(h.is_finite() && h > T::zero()) {
+            return Err(Error::InvalidTimeStep);
+        }
+        let budget = match settings.iterations {
+            Iterations::UpTo(k) | Iterations::Exactly(k) => k,
+        };
+        if budget == 0 || !settings.tolerance.is_finite() || settings.tolerance < T::zero() {
+            return Err(Error::InvalidNewtonSettings);
+        }
+        let hf = h.as_f64();
+        Ok(Self {
+            h,
+            half_h: T::from_f64_rounded(0.5 * hf),
+            quarter_h2: T::from_f64_rounded(0.25 * hf * hf),
+            settings,
+            _n: PhantomData,
+        })
+    }
+
+    /// The time step `h` (s).
+    pub fn time_step(&self) -> T {
+        self.h
+    }
+
+    /// The Newton settings.
+    pub fn settings(&self) -> NewtonSettings<T> {
+        self.settings
+    }
+
+    /// The state at `t = 0`, with `q0 = M⁻¹ (p0 − F(u0, v0))` (paper eq. 45).
+    ///
+    /// Errors: [`Error::NonFiniteInput`] (`u0`, `v0`, `p0` or `M`),
+    /// [`Error::NonFiniteForce`], [`Error::SingularMass`] (then use
+    /// [`Nonlinear::start_with_acceleration`]), [`Error::NonFiniteState`].
+    /// Cost: one force evaluation and one `N×N` LU solve.
+    pub fn start<Mo: Model<T, N> + ?Sized>(
+        &self,
+        model: &Mo,
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        p0: &SVector<T, N>,
+    ) -> Result<State<T, N>, Error> {
+        if !(all_finite(u0) && all_finite(v0) && all_finite(p0)) {
+            return Err(Error::NonFiniteInput);
+        }
+        let m = model.mass();
+        if !m.iter().all(|x| x.is_finite()) {
+            return Err(Error::NonFiniteInput);
+        }
+        let f = model.force(u0, v0);
+        if !all_finite(&f) {
+            return Err(Error::NonFiniteForce);
+        }
+        let scale = m.iter().fold(T::zero(), |s, x| s.max(x.abs()));
+        let mut a0 = p0 - f;
+        let mut lu = m;
+        if !solve_in_place(&mut lu, &mut a0, scale) {
+            return Err(Error::SingularMass);
+        }
+        let s = State::from_parts(*u0, *v0, a0, 0);
+        if s.is_finite() {
+            Ok(s)
+        } else {
+            Err(Error::NonFiniteState)
+        }
+    }
+
+    /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M`).
+    ///
+    /// Errors: [`Error::NonFiniteInput`]. Cost: O(N).
+    pub fn start_with_acceleration(
+        &self,
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        a0: &SVector<T, N>,
+    ) -> Result<State<T, N>, Error> {
+        let s = State::from_parts(*u0, *v0, *a0, 0);
+        if s.is_finite() {
+            Ok(s)
+        } else {
+            Err(Error::NonFiniteInput)
+        }
+    }
+
+    /// Advance `state` from `t_{n−1}` to `t_n` under the load `p_n = p(t_n)`, committing
+    /// only a converged, finite result.
+    ///
+    /// Returns the Newton report (its `converged` is always `true` on `Ok`).
+    ///
+    /// Errors (each leaves `state` bit-identical): [`Error::NonFiniteInput`] (`p_n` or
+    /// `M`), [`Error::NonFiniteForce`] (the model returned NaN/∞ at some iterate),
+    /// [`Error::SingularJacobian`], [`Error::NotConverged`] (not converged after the
+    /// iteration budget, see [`NewtonSettings::tolerance`]), [`Error::NonFiniteState`].
+    ///
+    /// Cost: see [`Nonlinear`]; no allocation, no panic.
+    pub fn step<Mo: Model<T, N> + ?Sized>(
+        &self,
+        model: &Mo,
+        state: &mut State<T, N>,
+        p: &SVector<T, N>,
+    ) -> Result<NewtonReport<T>, Error> {
+        let (next, report) = self.trial_step(model, state, p)?;
+        if !report.converged {
+            return Err(Error::NotConverged);
+        }
+        *state = next;
+        Ok(report)
+    }
+
+    /// The candidate next state and its Newton report, without touching `state` — even
+    /// when Newton did not converge (then `report.converged` is `false` and the caller
+    /// decides: accept it, retry with a smaller step, or stop).
+    ///
+    /// Errors: as [`Nonlinear::step`] except [`Error::NotConverged`]. Cost: as a step.
+    pub fn trial_step<Mo: Model<T, N> + ?Sized>(
+        &self,
+        model: &Mo,
+        state: &State<T, N>,
+        p: &SVector<T, N>,
+    ) -> Result<(State<T, N>, NewtonReport<T>), Error> {
+        if !all_finite(p) {
+            return Err(Error::NonFiniteInput);
+        }
+        let m = model.mass();
+        if !m.iter().all(|x| x.is_finite()) {
+            return Err(Error::NonFiniteInput);
+        }
+        let (b, c) = (self.half_h, self.quarter_h2);
+        let vh = state.v + state.a * b;
+        let uh = state.u + state.v * self.h + state.a * c;
+        let (budget, fixed) = match self.settings.iterations {
+            Iterations::UpTo(k) => (k, false),
+            Iterations::Exactly(k) => (k, true),
+        };
+        let tol = self.settings.tolerance;
+        let mut q = state.a;
+        let mut iterations = 0u32;
+        let mut last_delta = T::zero();
+        loop {
+            let u = uh + q * c;
+            let v = vh + q * b;
+            let f = model.force(&u, &v);
+            if !all_finite(&f) {
+                return Err(Error::NonFiniteForce);
+            }
+            let mq = m * q;
+            let r = mq + f - p;
+            let residual = relative_residual(&r, &mq, &f, p);
+            let correction = if iterations == 0 {
+                T::zero()
+            } else {
+                let reference = norm_inf(&q).max(norm_inf(&u) / c).max(norm_inf(&v) / b);
+                if last_delta <= T::zero() {
+                    T::zero()
+                } else if reference > T::zero() {
+                    last_delta / reference
+                } else {
+                    T::one()
+                }
+            };
+            let converged = residual <= tol || (iterations > 0 && correction <= tol);
+            let done = iterations >= budget || (!fixed && converged);
+            if done {
+                let next = State::from_parts(u, v, q, state.n.wrapping_add(1));
+                if !next.is_finite() {
+                    return Err(Error::NonFiniteState);
+                }
+                let report = NewtonReport {
+                    iterations,
+                    residual,
+                    correction,
+                    converged,
+                };
+                return Ok((next, report));
+            }
+            // J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u, with an entry scale for the pivot test.
+            let (mut j, scale) = match model.tangent(&u, &v) {
+                Some(t) => {
+                    if !t
+                        .stiffness
+                        .iter()
+                        .chain(t.damping.iter())
+                        .all(|x| x.is_finite())
+                    {
+                        return Err(Error::NonFiniteForce);
+                    }
+                    let j = m + t.damping * b + t.stiffness * c;
+                    let scale = m
+                        .iter()
+                        .zip(t.damping.iter())
+                        .zip(t.stiffness.iter())
+                        .fold(T::zero(), |s, ((x, d), k)| {
+                            s.max(x.abs() + b * d.abs() + c * k.abs())
+                        });
+                    (j, scale)
+                }
+                None => finite_difference_jacobian(model, &m, &u, &v, &f, b, c)?,
+            };
+            let mut delta = r;
+            if !solve_in_place(&mut j, &mut delta, scale) {
+                return Err(Error::SingularJacobian);
+            }
+            q -= delta;
+            last_delta = norm_inf(&delta);
+            iterations += 1;
+        }
+    }
+}
+
+fn all_finite<T: Real, const N: usize>(x: &SVector<T, N>) -> bool {
+    x.iter().all(|e| e.is_finite())
+}
+
+fn norm_inf<T: Real, const N: usize>(x: &SVector<T, N>) -> T {
+    x.iter().fold(T::zero(), |s, e| s.max(e.abs()))
+}
+
+/// `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)`, `0` when the denominator is zero (then `r = 0` too).
+fn relative_residual<T: Real, const N: usize>(
+    r: &SVector<T, N>,
+    mq: &SVector<T, N>,
+    f: &SVector<T, N>,
+    p: &SVector<T, N>,
+) -> T {
+    let scale = norm_inf(mq).max(norm_inf(f)).max(norm_inf(p));
+    if scale > T::zero() {
+        norm_inf(r) / scale
+    } else {
+        T::zero()
+    }
+}
+
+/// `J = M + ∂F(û + c q, v̂ + b q)/∂q` by one forward difference per column (`N` force
+/// evaluations), and the entry scale `max |M_ij| + |(J − M)_ij|` for the pivot test.
+fn finite_difference_jacobian<T: Real, const N: usize, Mo: Model<T, N> + ?Sized>(
+    model: &Mo,
+    m: &SMatrix<T, N, N>,
+    u: &SVector<T, N>,
+    v: &SVector<T, N>,
+    f: &SVector<T, N>,
+    b: T,
+    c: T,
+) -> Result<(SMatrix<T, N, N>, T), Error> {
+    let sqrt_eps = T::default_epsilon().sqrt();
+    let one = T::one();
+    let mut j = *m;
+    let mut scale = T::zero();
+    // Column-major arrays: plain array indexing with loop-bounded indices, which the
+    // compiler proves in bounds (no panic path in the binary).
+    let (u_a, v_a, f_a) = (&u.data.0[0], &v.data.0[0], &f.data.0[0]);
+    for col in 0..N {
+        let (uj, vj) = (u_a[col], v_a[col]);
+        // u_j moves by √ε·max(|u_j|, 1), rounded so the step is exact in floating point;
+        // v_j moves along the same q_j direction, by (b/c) times that.
+        let shifted = uj + sqrt_eps * uj.abs().max(one);
+        let delta = (shifted - uj) / c;
+        let (mut up, mut vp) = (*u, *v);
+        up.data.0[0][col] = shifted;
+        vp.data.0[0][col] = vj + b * delta;
+        let fp = model.force(&up, &vp);
+        if !all_finite(&fp) {
+            return Err(Error::NonFiniteForce);
+        }
+        let fp_a = &fp.data.0[0];
+        let j_col = &mut j.data.0[col];
+        for row in 0..N {
+            let d = (fp_a[row] - f_a[row]) / delta;
+            scale = scale.max(j_col[row].abs() + d.abs());
+            j_col[row] += d;
+        }
+    }
+    Ok((j, scale))
+}
+
+/// Solve `A x = b` in place (`b` becomes `x`) by Gaussian elimination with partial
+/// pivoting; `a` is overwritten. Returns `false` — with `b` unspecified — when a pivot is
+/// at most `N·ε·scale` (`scale`: the magnitude of `A`'s entries), i.e. `A` is singular to
+/// working precision. Cost: `N³/3 + N²` multiply-adds; no allocation, no panic.
+pub(crate) fn solve_in_place<T: Real, const N: usize>(
+    a: &mut SMatrix<T, N, N>,
+    b: &mut SVector<T, N>,
+    scale: T,
+) -> bool {
+    let tiny = T::from_f64_rounded(N as f64) * T::default_epsilon() * scale;
+    // Column-major storage, `a[c][r]` = A(r, c); plain array indexing with loop-bounded
+    // indices, which the compiler proves in bounds (no panic path in the binary).
+    let a = &mut a.data.0;
+    let x = &mut b.data.0[0];
+    for col in 0..N {
+        let mut piv = col;
+        let mut best = a[col][col].abs();
+        for r in col + 1..N {
+            let e = a[col][r].abs();
+            if e > best {
+                best = e;
+                piv = r;
+            }
+        }
+        // A NaN or infinite pivot is rejected too.
+        if !best.is_finite() || best <= tiny {
+            return false;
+        }
+        if piv != col {
+            for column in a.iter_mut() {
+                column.swap(piv, col);
+            }
+            x.swap(piv, col);
+        }
+        let d = a[col][col];
+        for r in col + 1..N {
+            let f = a[col][r] / d;
+            if f != T::zero() {
+                for k in col + 1..N {
+                    let p = a[k][col];
+                    a[k][r] -= f * p;
+                }
+                let xc = x[col];
+                x[r] -= f * xc;
+            }
+        }
+    }
+    for col in (0..N).rev() {
+        let mut s = x[col];
+        for k in col + 1..N {
+            s -= a[k][col] * x[k];
+        }
+        x[col] = s / a[col][col];
+    }
+    true
+}
