@@ -1,7 +1,8 @@
 //! Firmware: instructions per step on a Cortex-M4F (QEMU `mps2-an386`, `-icount shift=0`),
 //! for the fast form (`Linear`, 3N² multiply-adds) and the paper's A-form (`AForm`, 12N²),
 //! `f32` (hardware FPU) and `f64` (software floating point on this core), N = 1, 2, 3, 5
-//! (the benchmark building), 6, 12.
+//! (the benchmark building), 6, 12; and the nonlinear stepper on the Duffing oscillator
+//! `u'' + 0.2 u' + u + u³ = p` with exactly 2 Newton iterations a step (analytic tangent).
 //!
 //! Each step function is a separate `#[no_mangle]` symbol `cost_step_<form>_<T>_<N>`, so
 //! `scripts/qemu.sh` can read its code size from the ELF. The firmware prints one `ROW`
@@ -26,12 +27,12 @@
 mod fw;
 
 use aemstep::models::{Rows, rayleigh, shear_building};
-use aemstep::{Linear, Real, State, Stepper};
+use aemstep::{Linear, Model, NewtonSettings, Nonlinear, Real, State, Stepper, Tangent};
 use core::hint::black_box;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector, matrix, vector};
 
 /// Step (s) of every case; the cost does not depend on it.
 const H: f64 = 0.01;
@@ -110,6 +111,59 @@ fn row(form: &str, ty: &str, n: usize, tenths: u32, madds: usize, stack: usize, 
     );
 }
 
+/// The Duffing oscillator of paper Example 5, `u'' + 0.2 u' + u + u³ = p`.
+struct Duffing;
+
+impl<T: Real> Model<T, 1> for Duffing {
+    fn mass(&self) -> SMatrix<T, 1, 1> {
+        matrix![T::one()]
+    }
+    fn force(&self, u: &SVector<T, 1>, v: &SVector<T, 1>) -> SVector<T, 1> {
+        let (u, v) = (u[0], v[0]);
+        vector![T::from_f64_rounded(0.2) * v + u + u * u * u]
+    }
+    fn tangent(&self, u: &SVector<T, 1>, _v: &SVector<T, 1>) -> Option<Tangent<T, 1>> {
+        let u = u[0];
+        Some(Tangent {
+            stiffness: matrix![T::one() + T::from_f64_rounded(3.0) * u * u],
+            damping: matrix![T::from_f64_rounded(0.2)],
+        })
+    }
+}
+
+/// Instructions per Duffing step (in tenths), 2 Newton iterations, over `reps` steps
+/// under a constant load from u0 = 0, v0 = 1, and the stack bytes one step uses.
+fn measure_duffing<T: Real>(
+    syst: &mut SYST,
+    step: fn(&Nonlinear<T, 1>, &mut State<T, 1>, &SVector<T, 1>),
+    reps: u32,
+) -> (u32, usize) {
+    let r = T::from_f64_rounded;
+    let Ok(stepper) = Nonlinear::<T, 1>::new(r(0.01), NewtonSettings::exactly(2, r(1e-5))) else {
+        fail!("Newton settings");
+    };
+    let p = vector![r(0.5)];
+    let mut s = match stepper.start(&Duffing, &vector![r(0.0)], &vector![r(1.0)], &p) {
+        Ok(s) => s,
+        Err(e) => fail!("start: {}", e.as_str()),
+    };
+    let full = fw::instructions(syst, || {
+        for _ in 0..reps {
+            step(black_box(&stepper), black_box(&mut s), black_box(&p));
+        }
+    });
+    let base = fw::instructions(syst, || {
+        for _ in 0..reps {
+            empty_step(black_box(&stepper), black_box(&mut s), black_box(&p));
+        }
+    });
+    if s.steps() != reps as u64 || !s.is_finite() {
+        fail!("Duffing: {} of {} steps taken", s.steps(), reps);
+    }
+    let stack = fw::stack_used_by(|| step(black_box(&stepper), black_box(&mut s), black_box(&p)));
+    (((full - base) as u64 * 10 / reps as u64) as u32, stack)
+}
+
 /// One case: an out-of-line `#[no_mangle]` step function named `$sym`, measured.
 macro_rules! case {
     ($syst:expr, fast, $t:ident, $n:literal, $reps:expr, $sym:ident) => {{
@@ -147,6 +201,16 @@ macro_rules! case {
             stringify!($sym),
         );
     }};
+    ($syst:expr, duffing, $t:ident, $reps:expr, $sym:ident) => {{
+        /// A Duffing step; a failed step (none is expected) is caught by the step count.
+        #[unsafe(no_mangle)]
+        #[inline(never)]
+        fn $sym(sys: &Nonlinear<$t, 1>, s: &mut State<$t, 1>, p: &SVector<$t, 1>) {
+            let _ = sys.step(&Duffing, s, p);
+        }
+        let (c, st) = measure_duffing::<$t>($syst, $sym, $reps);
+        row("duffing", stringify!($t), 1, c, 0, st, stringify!($sym));
+    }};
 }
 
 #[entry]
@@ -183,6 +247,9 @@ fn main() -> ! {
     case!(syst, aform, f64, 5, 200, cost_step_aform_f64_5);
     case!(syst, aform, f64, 6, 200, cost_step_aform_f64_6);
     case!(syst, aform, f64, 12, 200, cost_step_aform_f64_12);
+
+    case!(syst, duffing, f32, 1000, cost_step_duffing_f32_1);
+    case!(syst, duffing, f64, 200, cost_step_duffing_f64_1);
 
     fw::report_stack("qemu_cost");
     fw::exit_success()

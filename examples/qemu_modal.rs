@@ -158,14 +158,14 @@ macro_rules! modal_cost {
 
 #[unsafe(no_mangle)]
 #[inline(never)]
-fn modal_cost_full_input(sys: &LinearInput<f32, 5, 1>, s: &mut State<f32, 5>, ag: f32) -> f32 {
+fn cost_step_linear_input_5(sys: &LinearInput<f32, 5, 1>, s: &mut State<f32, 5>, ag: f32) -> f32 {
     sys.step(s, &SVector::from([ag]));
     s.u()[4]
 }
 
 #[unsafe(no_mangle)]
 #[inline(never)]
-fn modal_cost_full_linear(
+fn cost_step_linear_5_b(
     sys: &Linear<f32, 5>,
     s: &mut State<f32, 5>,
     b: &SVector<f32, 5>,
@@ -220,18 +220,18 @@ fn main() -> ! {
     hprintln!("calibration: 100 x 1000 nops = {} instructions", cal);
 
     // Instructions per step, one output (roof drift) read each step.
-    modal_cost!(syst, 1, modal_cost_r1);
-    modal_cost!(syst, 2, modal_cost_r2);
-    modal_cost!(syst, 3, modal_cost_r3);
-    modal_cost!(syst, 4, modal_cost_r4);
-    modal_cost!(syst, 5, modal_cost_r5);
+    modal_cost!(syst, 1, cost_step_modal_r1);
+    modal_cost!(syst, 2, cost_step_modal_r2);
+    modal_cost!(syst, 3, cost_step_modal_r3);
+    modal_cost!(syst, 4, cost_step_modal_r4);
+    modal_cost!(syst, 5, cost_step_modal_r5);
     let z = SVector::<f32, 5>::zeros();
     let mut s = match FULL_INPUT.start(&z, &z, &SVector::from([0.0])) {
         Ok(s) => s,
         Err(e) => fail!("start: {}", e.as_str()),
     };
     let c = per_step(syst, 1000, |a| {
-        modal_cost_full_input(black_box(&FULL_INPUT), &mut s, a)
+        cost_step_linear_input_5(black_box(&FULL_INPUT), &mut s, a)
     });
     cost("LinearInput<f32,5,1>", c, 2 * 25 + 5 + 5 * 5);
     let b = SVector::<f32, 5>::from_fn(|i, _| base_excitation(&BUILDING.0)[i][0] as f32);
@@ -240,7 +240,7 @@ fn main() -> ! {
         Err(e) => fail!("start: {}", e.as_str()),
     };
     let c = per_step(syst, 1000, |a| {
-        modal_cost_full_linear(black_box(&FULL), &mut s, black_box(&b), a)
+        cost_step_linear_5_b(black_box(&FULL), &mut s, black_box(&b), a)
     });
     cost("Linear<f32,5>", c, 3 * 25 + 5 * 5 + 5);
 

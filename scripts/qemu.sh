@@ -13,9 +13,10 @@ cd "$(dirname "$0")/.."
 TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
-EXAMPLES=(qemu_timer qemu_cost qemu_modal)
+EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal)
 # Broken on purpose: "example feature" pairs that must exit with failure (status 1).
-BROKEN=("qemu_timer qemu-inject-nan" "qemu_timer qemu-tight-bound" "qemu_modal qemu-modal-tight-bound")
+BROKEN=("qemu_timer qemu-inject-nan" "qemu_timer qemu-tight-bound" "qemu_nonlinear qemu-inject-nan"
+    "qemu_modal qemu-modal-tight-bound")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
 OUT=target/qemu
 COST_DOC=docs/cortex-m4-cost.md
@@ -29,7 +30,8 @@ rustup component add llvm-tools
 LLVM_BIN="$(rustc --print sysroot)/lib/rustlib/$(rustc -vV | sed -n 's/^host: //p')/bin"
 NM="$LLVM_BIN/llvm-nm"
 SIZE="$LLVM_BIN/llvm-size"
-[[ -x $NM && -x $SIZE ]] || fail "llvm-nm/llvm-size not found in $LLVM_BIN"
+OBJDUMP="$LLVM_BIN/llvm-objdump"
+[[ -x $NM && -x $SIZE && -x $OBJDUMP ]] || fail "llvm-nm/llvm-size/llvm-objdump not found in $LLVM_BIN"
 if ! command -v qemu-system-arm >/dev/null; then
     SUDO=""
     [[ $(id -u) -eq 0 ]] || SUDO=sudo
@@ -98,6 +100,44 @@ fi
 echo "ok: qemu_timer has no symbol matching /$INVERSION/ (the run-time build has: $("$NM" -C \
     "$OUT/qemu_timer-qemu-runtime-ops" | grep -E "$INVERSION" | awk '{print $3}' | tr '\n' ' '))"
 
+step "qemu: no panic reachable from any step function (call graph of the ELFs)"
+# Roots: every `#[no_mangle]` step symbol (`<example>_step`, `cost_step_*`). Edges: direct
+# calls and tail branches between functions in the disassembly. A panic path in a step
+# (an index or unwrap the compiler could not prove) would reach `core::panicking::*`.
+step_roots() { # <elf>: the step symbols (`<example>_step`, `cost_step_*`)
+    "$NM" "$1" | awk '$3 ~ /^cost_step_|_step$/ { print $3 }'
+}
+reachable() { # <elf> <root>...: every function reachable from the roots, one per line
+    local elf=$1
+    shift
+    "$OBJDUMP" -d --no-show-raw-insn "$elf" | awk -v roots="$*" '
+        /^[0-9a-f]+ <[^>]+>:$/ { fn = $2; gsub(/[<>:]/, "", fn); next }
+        /\t(bl|blx|b|b\.w)\t+0x[0-9a-f]+ </ {
+            if (match($0, /<[^>+]+/)) { t = substr($0, RSTART + 1, RLENGTH - 1); if (t != fn) edge[fn] = edge[fn] " " t }
+        }
+        END {
+            n = split(roots, queue, " "); for (i = 1; i <= n; i++) seen[queue[i]] = 1
+            for (i = 1; i <= n; i++) {
+                m = split(edge[queue[i]], next_, " ")
+                for (j = 1; j <= m; j++) if (!(next_[j] in seen)) { seen[next_[j]] = 1; queue[++n] = next_[j] }
+            }
+            for (f in seen) print f
+        }'
+}
+# Control: the same walk must find the panic machinery behind the firmware's own formatted
+# failure path (core::fmt indexes slices), or the check proves nothing.
+reachable "$OUT/qemu_timer-qemu" "$("$NM" "$OUT/qemu_timer-qemu" | awk '$3 ~ /exit_failure/ { print $3; exit }')" |
+    grep -qi panic || fail "control: the call-graph walk found no panic behind exit_failure"
+for ex in "${EXAMPLES[@]}"; do
+    mapfile -t roots < <(step_roots "$OUT/$ex-qemu")
+    [[ ${#roots[@]} -gt 0 ]] || fail "$ex: no step symbol found"
+    fns=$(reachable "$OUT/$ex-qemu" "${roots[@]}")
+    if grep -i 'panic' <<<"$fns"; then
+        fail "$ex: a panic is reachable from a step function (above)"
+    fi
+    echo "ok: $ex: ${#roots[@]} step function(s), $(wc -l <<<"$fns") functions reachable, none panics"
+done
+
 step "qemu: host and Cortex-M4F f32 runs are bit-identical (Example 2, u at 25 s)"
 host_bits=$(cargo test -q --release --test firmware_example2 -- --nocapture --exact \
     f32_error_within_the_firmware_bound 2>&1 | sed -n 's/^host u(25 s) f32 bits = //p')
@@ -147,10 +187,12 @@ echo "ok: flash: Linear only $FP_LEAN bytes; + static Modal $FP_MODAL; + Nonline
     "static-Modal builds"
 
 step "qemu: cost and memory tables -> $COST_DOC"
-sym_size() { # <elf> <symbol>: code bytes of a symbol, or "-"
-    local hex
-    hex=$("$NM" -S "$1" | awk -v s="$2" '$4 == s { print $2; exit }')
-    if [[ -n $hex ]]; then echo $((16#$hex)); else echo -; fi
+sym_size() { # <elf> <symbol>: code bytes of the symbol and of every function it calls, or "-"
+    "$NM" -S "$1" | grep -q " $2\$" || { echo -; return; }
+    reachable "$1" "$2" | sort -u >"$OUT/fns"
+    "$NM" -S "$1" | awk 'NR == FNR { want[$1] = 1; next } NF == 4 && ($4 in want) && !done[$4]++ { s += strtonum_hex($2) }
+        function strtonum_hex(h,   i, v, c) { v = 0; h = tolower(h); for (i = 1; i <= length(h); i++) { c = index("0123456789abcdef", substr(h, i, 1)) - 1; v = v * 16 + c } return v }
+        END { print s + 0 }' "$OUT/fns" -
 }
 mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     awk -v e="$1" -v k="$2" '$1 == "MEM" && $2 == e && $3 == k { v = $4 } END { printf "%s", v == "" ? "-" : v }' \
@@ -170,11 +212,23 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "uniform shear building (N = 5 is the benchmark building's size), dense operators. \`f64\` is software"
     echo "floating point on this core (its FPU is single precision)."
     echo
+    echo "Step code: the step's own symbol and every function it calls, in bytes; step stack: what one call"
+    echo "uses, measured on target by painting (see below)."
+    echo
     echo "| form | type | N | instructions / step | multiply-adds | instructions / multiply-add | step code (bytes) | step stack (bytes) |"
     echo "|---|---|---:|---:|---:|---:|---:|---:|"
     grep '^ROW ' "$OUT/qemu_cost-qemu.log" | while read -r _ form ty n instr madds stack sym; do
-        ratio=$(awk -v a="$instr" -v b="$madds" 'BEGIN { printf "%.2f", a / b }')
-        name=$([[ $form == fast ]] && echo "fast (\`Linear\`)" || echo "A-form (\`AForm\`)")
+        case $form in
+        fast) name="fast (\`Linear\`)" ;;
+        aform) name="A-form (\`AForm\`)" ;;
+        duffing) name="Duffing (\`Nonlinear\`, exactly 2 Newton iterations)" ;;
+        *) fail "unknown cost row '$form'" ;;
+        esac
+        if [[ $madds -gt 0 ]]; then
+            ratio=$(awk -v a="$instr" -v b="$madds" 'BEGIN { printf "%.2f", a / b }')
+        else
+            ratio="—" madds="—"
+        fi
         echo "| $name | $ty | $n | $instr | $madds | $ratio | $(sym_size "$OUT/qemu_cost-qemu" "$sym") | $stack |"
     done
     echo
@@ -209,7 +263,8 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "Flash = \`.text\` + \`.rodata\` + vector table + \`.data\` initialisers; static RAM = \`.data\` + \`.bss\`"
     echo "(\`llvm-size\`); stack high-water = deepest stack use since reset, measured on target by scanning"
     echo "the paint (\`0xCCCCCCCC\`) cortex-m-rt lays at reset. Step function: its own symbol's code bytes and the"
-    echo "stack one call uses (painted and scanned around the call)."
+    echo "stack one call uses (painted and scanned around the call). Step code counts the step's symbol and every"
+    echo "function it calls (for \`f64\`, the soft-float routines: shared by all \`f64\` code)."
     echo
     echo "| example | flash (bytes) | static RAM (bytes) | stack high-water (bytes) | step function code (bytes) | step function stack (bytes) |"
     echo "|---|---:|---:|---:|---:|---:|"

@@ -18,7 +18,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::linear::{StartOps, initial_state};
+use crate::linear::{StartOps, initial_state, mat_vec_blocked};
 use crate::{Error, Real, State, Stepper};
 
 /// The amplification operator `A` and load operator `b` of the linear AEM step, as
@@ -26,12 +26,14 @@ use crate::{Error, Real, State, Stepper};
 ///
 /// Size: `12N² + 3N² + 1` values of `T` (the `3N²` are the start-up operators).
 #[derive(Clone, Copy, Debug, PartialEq)]
+// `repr(C)` with the operator first: every operator load is a small immediate offset.
+#[repr(C)]
 pub struct AForm<T, const N: usize> {
+    /// `rows[r][i] = [A_r0[i], A_r1[i], A_r2[i], b_r[i]]`: row `i` of block row `r`
+    /// (0 = q, 1 = v, 2 = u) of `[A | b]`, one contiguous run of `4N` values that
+    /// multiplies `(q, v, u, p)`.
+    rows: [[[[T; N]; 4]; N]; 3],
     h: T,
-    /// `a[r][c]`: block row `r`, block column `c` (0 = q, 1 = v, 2 = u); row-major blocks.
-    a: [[[[T; N]; N]; 3]; 3],
-    /// `b[r]`: block row `r`.
-    b: [[[T; N]; N]; 3],
     start: Option<StartOps<T, N>>,
 }
 
@@ -69,19 +71,25 @@ impl<T: Real, const N: usize> AForm<T, N> {
                 b[2][i][j] = beta * g[i][j];
             }
         }
-        Self { h, a, b, start }
+        let rows = core::array::from_fn(|r| {
+            core::array::from_fn(|i| [a[r][0][i], a[r][1][i], a[r][2][i], b[r][i]])
+        });
+        Self { rows, h, start }
     }
 
     /// Block `A_{rc}` (`r, c` in `0..3`: 0 = q, 1 = v, 2 = u), or `None` if out of range.
     pub fn a_block(&self, r: usize, c: usize) -> Option<SMatrix<T, N, N>> {
-        let blk = self.a.get(r)?.get(c)?;
-        Some(SMatrix::from_fn(|i, j| blk[i][j]))
+        if c >= 3 {
+            return None; // the 4th column block of `rows` is b
+        }
+        let blk = self.rows.get(r)?;
+        Some(SMatrix::from_fn(|i, j| blk[i][c][j]))
     }
 
     /// Block `b_r` (`r` in `0..3`), or `None` if out of range.
     pub fn b_block(&self, r: usize) -> Option<SMatrix<T, N, N>> {
-        let blk = self.b.get(r)?;
-        Some(SMatrix::from_fn(|i, j| blk[i][j]))
+        let blk = self.rows.get(r)?;
+        Some(SMatrix::from_fn(|i, j| blk[i][3][j]))
     }
 }
 
@@ -100,29 +108,17 @@ impl<T: Real, const N: usize> Stepper<T, N> for AForm<T, N> {
     }
 
     /// Cost: `12N²` multiply-adds.
+    #[inline]
     fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
-        let old = [s.a, s.v, s.u];
-        let mut new = [SVector::<T, N>::zeros(); 3];
-        for (r, out) in new.iter_mut().enumerate() {
-            for i in 0..N {
-                let mut acc = T::zero();
-                for (c, x) in old.iter().enumerate() {
-                    let row = &self.a[r][c][i];
-                    for j in 0..N {
-                        acc += row[j] * x[j];
-                    }
-                }
-                let row = &self.b[r][i];
-                for j in 0..N {
-                    acc += row[j] * p[j];
-                }
-                out[i] = acc;
-            }
+        let x = [s.a.into(), s.v.into(), s.u.into(), (*p).into()];
+        let mut new = [[T::zero(); N]; 3];
+        for (rows, out) in self.rows.iter().zip(new.iter_mut()) {
+            mat_vec_blocked(rows, &x, out);
         }
         let [a, v, u] = new;
-        s.a = a;
-        s.v = v;
-        s.u = u;
+        s.a = a.into();
+        s.v = v.into();
+        s.u = u.into();
         s.n = s.n.wrapping_add(1);
     }
 }

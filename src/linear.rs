@@ -49,16 +49,18 @@ pub(crate) struct StartOps<T, const N: usize> {
 /// # Ok::<(), aemstep::Error>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
+// `repr(C)` with `ops` first: the step addresses every operator value as a small
+// immediate offset from `self` (Thumb-2 `vldr` reaches ±1020 bytes).
+#[repr(C)]
 pub struct Linear<T, const N: usize> {
+    /// The step operators, interleaved by row so that row `i` of all three is one
+    /// contiguous run of `3N` values: `ops[i] = [G[i], −(GC)[i], −(GK)[i]]`
+    /// (`G = M_eff⁻¹`). `q_i` is then a single multiply-accumulate chain over that run
+    /// (negation is exact, so the values are those of `G`, `GC`, `GK`).
+    ops: [[[T; N]; 3]; N],
     h: T,
     half_h: T,
     quarter_h2: T,
-    /// `G = M_eff⁻¹`, row-major.
-    g: [[T; N]; N],
-    /// `G·C`, row-major.
-    gc: [[T; N]; N],
-    /// `G·K`, row-major.
-    gk: [[T; N]; N],
     start: Option<StartOps<T, N>>,
 }
 
@@ -75,6 +77,15 @@ fn rows_f64<T: Real, const N: usize>(a: &SMatrix<T, N, N>) -> Mat<N> {
 
 fn round_rows<T: Real, const N: usize>(a: &Mat<N>) -> [[T; N]; N] {
     a.map(|row| row.map(T::from_f64_rounded))
+}
+
+/// `[G[i], −GC[i], −GK[i]]` for every row `i` (the storage of [`Linear`]).
+fn interleave<T: Real, const N: usize>(
+    g: &[[T; N]; N],
+    gc: &[[T; N]; N],
+    gk: &[[T; N]; N],
+) -> [[[T; N]; 3]; N] {
+    core::array::from_fn(|i| [g[i], gc[i].map(|x| -x), gk[i].map(|x| -x)])
 }
 
 /// `y = A x` for a row-major `A`.
@@ -115,9 +126,7 @@ impl<T: Real, const N: usize> Linear<T, N> {
             h,
             half_h: T::from_f64_rounded(0.5 * hf),
             quarter_h2: T::from_f64_rounded(0.25 * hf * hf),
-            g: round_rows(&op.g),
-            gc: round_rows(&op.gc),
-            gk: round_rows(&op.gk),
+            ops: interleave(&round_rows(&op.g), &round_rows(&op.gc), &round_rows(&op.gk)),
             start: match op.start {
                 Some((mi, mc, mk)) => Some(StartOps {
                     minv: round_rows(&mi),
@@ -131,14 +140,17 @@ impl<T: Real, const N: usize> Linear<T, N> {
 
     /// `G = (M + (h/2) C + (h²/4) K)⁻¹`.
     pub fn effective_inverse(&self) -> SMatrix<T, N, N> {
-        SMatrix::from_fn(|i, j| self.g[i][j])
+        SMatrix::from_fn(|i, j| self.ops[i][0][j])
     }
 
     /// The paper's literal form `U_n = A U_{n−1} + b p_n` of this stepper (`12N²`
     /// multiply-adds a step): the reference the fast form is tested against, and a way to
     /// inspect the amplification operator. Cost to build: about `6N³` flops in `T`.
     pub fn a_form(&self) -> AForm<T, N> {
-        AForm::from_operators(self.h, &self.g, &self.gc, &self.gk, self.start)
+        let block = |b: usize, sign: T| self.ops.map(|row| row[b].map(|x| sign * x));
+        let one = T::one();
+        let (g, gc, gk) = (block(0, one), block(1, -one), block(2, -one));
+        AForm::from_operators(self.h, &g, &gc, &gk, self.start)
     }
 }
 
@@ -180,9 +192,7 @@ macro_rules! const_ctor {
                     h: h as $t,
                     half_h: (0.5 * h) as $t,
                     quarter_h2: (0.25 * h * h) as $t,
-                    g: const_ctor!(@round $t, op.g),
-                    gc: const_ctor!(@round $t, op.gc),
-                    gk: const_ctor!(@round $t, op.gk),
+                    ops: const_ctor!(@interleave $t, op.g, op.gc, op.gk),
                     start: match op.start {
                         Some((mi, mc, mk)) => Some(StartOps {
                             minv: const_ctor!(@round $t, mi),
@@ -200,6 +210,22 @@ macro_rules! const_ctor {
             }
         }
     };
+    (@interleave $t:ty, $g:expr, $gc:expr, $gk:expr) => {{
+        let (g, gc, gk) = ($g, $gc, $gk);
+        let mut r = [[[0.0 as $t; N]; 3]; N];
+        let mut i = 0;
+        while i < N {
+            let mut j = 0;
+            while j < N {
+                r[i][0][j] = g[i][j] as $t;
+                r[i][1][j] = -(gc[i][j] as $t);
+                r[i][2][j] = -(gk[i][j] as $t);
+                j += 1;
+            }
+            i += 1;
+        }
+        r
+    }};
     (@round $t:ty, $a:expr) => {{
         let a = $a;
         let mut r = [[0.0 as $t; N]; N];
@@ -237,23 +263,77 @@ impl<T: Real, const N: usize> Stepper<T, N> for Linear<T, N> {
     #[inline]
     fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
         let (half_h, h, quarter_h2) = (self.half_h, self.h, self.quarter_h2);
-        let mut vh = [T::zero(); N];
-        let mut uh = [T::zero(); N];
+        // x = (p, v̂, û): the vector every interleaved operator row multiplies.
+        let mut x = [[T::zero(); N]; 3];
         for j in 0..N {
-            vh[j] = s.v[j] + half_h * s.a[j];
-            uh[j] = s.u[j] + h * s.v[j] + quarter_h2 * s.a[j];
+            let (u, v, a) = (s.u[j], s.v[j], s.a[j]);
+            x[0][j] = p[j];
+            // v̂ = v + (h/2) a;  û = u + h v + (h²/4) a, written as u + h v̂ − (h²/4) a
+            // (the same value up to rounding, one operation fewer).
+            let vh = v + half_h * a;
+            x[1][j] = vh;
+            x[2][j] = u + h * vh - quarter_h2 * a;
         }
-        for i in 0..N {
-            let (g, gc, gk) = (&self.g[i], &self.gc[i], &self.gk[i]);
-            let mut q = T::zero();
-            for j in 0..N {
-                q += g[j] * p[j] - gc[j] * vh[j] - gk[j] * uh[j];
-            }
-            s.a[i] = q;
-            s.v[i] = vh[i] + half_h * q;
-            s.u[i] = uh[i] + quarter_h2 * q;
+        // q = G p − GC v̂ − GK û, written to `a`. Rows go in blocks of `BLOCK`, so each
+        // value of `x` loaded feeds `BLOCK` multiply-adds.
+        mat_vec_blocked(&self.ops, &x, s.a.as_mut_slice());
+        // v = v̂ + (h/2) q, u = û + (h²/4) q. A separate pass with constant indices (once
+        // unrolled), so v̂, û are used straight from registers.
+        for j in 0..N {
+            let q = s.a[j];
+            s.v[j] = x[1][j] + half_h * q;
+            s.u[j] = x[2][j] + quarter_h2 * q;
         }
         s.n = s.n.wrapping_add(1);
+    }
+}
+
+/// Operator rows processed together by the steps (two accumulators: on the Cortex-M4F
+/// this is what keeps the f32 fast form at or below 3 instructions a multiply-add for
+/// N = 6 and 12; 3 or 4 rows spill registers at one size or the other).
+const BLOCK: usize = 2;
+
+/// `R` dot products of interleaved operator rows (each `K` blocks of `N`) with `x`: `R`
+/// accumulators, so each `x` value is loaded once for `R` multiply-adds. Each sum starts
+/// from its first product (no `0 +`), then accumulates block by block, in order.
+#[inline(always)]
+pub(crate) fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
+    rows: &[[[T; N]; K]; R],
+    x: &[[T; N]; K],
+) -> [T; R] {
+    let mut q = [T::zero(); R];
+    if N == 0 || K == 0 {
+        return q;
+    }
+    for r in 0..R {
+        q[r] = rows[r][0][0] * x[0][0];
+    }
+    for b in 0..K {
+        let first = if b == 0 { 1 } else { 0 };
+        for j in first..N {
+            let xj = x[b][j];
+            for r in 0..R {
+                q[r] += rows[r][b][j] * xj;
+            }
+        }
+    }
+    q
+}
+
+/// `out = rows · x` for `N` interleaved rows, in blocks of [`BLOCK`] rows.
+#[inline(always)]
+pub(crate) fn mat_vec_blocked<T: Real, const N: usize, const K: usize>(
+    rows: &[[[T; N]; K]; N],
+    x: &[[T; N]; K],
+    out: &mut [T],
+) {
+    let (blocks, rest) = rows.as_chunks::<BLOCK>();
+    let (out_blocks, out_rest) = out.as_chunks_mut::<BLOCK>();
+    for (rows, o) in blocks.iter().zip(out_blocks) {
+        *o = dots(rows, x);
+    }
+    for (row, o) in rest.iter().zip(out_rest) {
+        [*o] = dots(core::array::from_ref(row), x);
     }
 }
 
