@@ -17,7 +17,8 @@ EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear)
 # Broken on purpose: "example feature" pairs that must exit with failure (status 1).
 BROKEN=("qemu_timer qemu-inject-nan" "qemu_timer qemu-tight-bound" "qemu_nonlinear qemu-inject-nan")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
-OUT=target/qemu
+TARGET_DIR=${CARGO_TARGET_DIR:-target}
+OUT=$TARGET_DIR/qemu
 COST_DOC=docs/cortex-m4-cost.md
 
 step() { printf '\n==> %s\n' "$*"; }
@@ -46,7 +47,7 @@ example_args() { # <example> <features>
 build() { # <example> <features>: builds and keeps a copy of the ELF as $OUT/<example>-<features>
     # shellcheck disable=SC2046
     cargo build -q $(example_args "$1" "$2") || fail "build $1 ($2)"
-    cp "target/$TARGET/release/examples/$1" "$OUT/$1-$2"
+    cp "$TARGET_DIR/$TARGET/release/examples/$1" "$OUT/$1-$2"
 }
 run() { # <example> <features>: runs it under QEMU (the runner of .cargo/config.toml); sets RC
     local log="$OUT/$1-$2.log"
