@@ -327,13 +327,13 @@ pub(crate) fn mat_vec_blocked<T: Real, const N: usize, const K: usize>(
     x: &[[T; N]; K],
     out: &mut [T],
 ) {
-    let (blocks, rest) = rows.as_chunks::<BLOCK>();
-    let (out_blocks, out_rest) = out.as_chunks_mut::<BLOCK>();
-    for (rows, o) in blocks.iter().zip(out_blocks) {
-        *o = dots(rows, x);
-    }
+    let (rest, blocks) = rows.as_rchunks::<BLOCK>();
+    let (out_rest, out_blocks) = out.as_rchunks_mut::<BLOCK>();
     for (row, o) in rest.iter().zip(out_rest) {
         [*o] = dots(core::array::from_ref(row), x);
+    }
+    for (rows, o) in blocks.iter().zip(out_blocks) {
+        *o = dots(rows, x);
     }
 }
 
