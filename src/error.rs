@@ -23,6 +23,9 @@ pub enum Error {
     /// The step would produce a NaN or infinite state (e.g. a NaN load sample);
     /// the state was left unchanged.
     NonFiniteState,
+    /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) is not finite or is
+    /// outside its documented range.
+    InvalidParameter,
 }
 
 impl Error {
@@ -41,6 +44,7 @@ impl Error {
             Error::NonFiniteState => {
                 "the step would make the state NaN or infinite; state unchanged"
             }
+            Error::InvalidParameter => "a scheme parameter is not finite or out of range",
         }
     }
 }

@@ -17,6 +17,10 @@
 //! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference and
 //!   inspection.
 //! - [`State`], [`Stepper`]: the state and the interface every scheme shares.
+//! - Comparator schemes behind the same interface: [`Newmark`] (β, γ), [`GeneralizedAlpha`]
+//!   (ρ∞, HHT-α), [`Exact`] (matrix-exponential discretization, piecewise-linear load).
+//! - [`analysis`]: amplification matrix, spectral radius, period elongation and amplitude
+//!   decay of any scheme on the 1-DOF oscillator.
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
 //!
@@ -31,16 +35,23 @@
 extern crate std;
 
 mod aform;
+pub mod analysis;
 mod error;
+mod exact;
+mod generalized_alpha;
 mod linear;
 pub mod models;
+mod newmark;
 mod ops;
 mod scalar;
 mod state;
 
 pub use aform::AForm;
 pub use error::Error;
+pub use exact::Exact;
+pub use generalized_alpha::{AlphaParameters, GeneralizedAlpha};
 pub use linear::Linear;
+pub use newmark::Newmark;
 pub use scalar::Real;
 pub use state::{State, Stepper};
 
