@@ -638,7 +638,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     print!("{}", summary(ex4.name, &rows4, 1e-3));
     print!("{}", summary(el.name, &rows_el, 1e-3));
-    print!("{}", summary(el.name, &rows_el, 1e-6));
+    print!("{}", summary(el.name, &rows_el, 1e-4));
     println!("\nFigs. 2–3 values:{figs}");
     Ok(())
 }
