@@ -18,6 +18,11 @@
 //! (`ξ̄` is the damping ratio of the continuous oscillator whose exact flow over one step
 //! has the eigenvalue `λ`; for small damping it equals the spec's `−ln r/φ`.)
 //!
+//! Accuracy: `r` and the spectral radius to a few ulps; the phase `φ` to about `16ε/s`
+//! absolute (it comes from `√(4c − b²)`, a difference of O(1) coefficients), so the period
+//! elongation is resolved to about `16ε/s²` — 4·10⁻¹² at `s = 0.01`, useless below
+//! `s ≈ 10⁻⁴`.
+//!
 //! [`sdof`] builds the `f64` stepper of a [`Scheme`] for given `s`, `ξ` and does all of
 //! this. Everything here is `no_std` and allocation-free; cost is a few hundred flops
 //! plus the construction of a 1-DOF stepper.

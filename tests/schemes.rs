@@ -115,8 +115,11 @@ fn exact_scheme_matches_the_modal_solution_at_any_step() {
     for h in [0.001, 0.01, 0.1, 0.25] {
         let sys = Exact::new(&ex.m, &ex.c, &ex.k, h).unwrap();
         let err = ex4_error(&sys, &ex);
-        // Rounding only: per step ~ε·‖u‖ (‖u‖ ≤ 10) amplified by the number of steps at
-        // worst; measured 2e-13 at h = 0.001 (5000 steps). Bound: 1e-15 · 10 · steps.
+        println!("exact scheme, Example 4, h = {h}: max error {err:.2e}");
+        // Rounding only: per step ≲ 4ε·‖u‖ with ‖u‖ ≤ 12, accumulating at worst linearly
+        // over the 5/h steps, plus the reference's own evaluation (~1e-13): bound
+        // 1e-14 · steps + 1e-13. Measured 1.0e-12 at h = 0.001 (5000 steps) down to
+        // 8e-14 at h = 0.25.
         let bound = 1e-14 * (5.0 / h) + 1e-13;
         assert!(err < bound, "h = {h}: {err:e} (bound {bound:e})");
     }
@@ -283,7 +286,9 @@ fn f32_schemes_track_f64() {
     );
     assert!(e_nm < e64 + 1e-3);
     assert!(e_ex < 1e-3);
-    assert!(e_ga < 1e-2); // its own O(h²) error at this h is ~2e-3 (f64 measured in the order test)
+    // Its own O(h²) error at this h is 3.8e-3 (f64, measured in the order test) plus the
+    // same 1e-3 rounding allowance.
+    assert!(e_ga < 3.8e-3 + 1e-3);
 }
 
 #[test]
