@@ -54,6 +54,9 @@ pub enum Error {
     NonClassicalDamping,
     /// The symmetric eigen-solver did not converge (only with pathological input).
     EigenNotConverged,
+    /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) is not finite or is
+    /// outside its documented range.
+    InvalidParameter,
 }
 
 impl Error {
@@ -94,6 +97,7 @@ impl Error {
                 "the damping is not classical (it couples the modes): use the full stepper"
             }
             Error::EigenNotConverged => "the symmetric eigen-solver did not converge",
+            Error::InvalidParameter => "a scheme parameter is not finite or out of range",
         }
     }
 }

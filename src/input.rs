@@ -15,6 +15,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::linear::{round_rows, rows_f64};
 use crate::ops::{self, Mat};
 use crate::{Error, Real, State};
 
@@ -62,15 +63,6 @@ pub struct LinearInput<T, const N: usize, const I: usize> {
     /// `G·K`, row-major.
     gk: [[T; N]; N],
     start: Option<InputStart<T, N, I>>,
-}
-
-/// `SMatrix` (column-major) to a row-major `f64` array.
-fn rows_f64<T: Real, const R: usize, const C: usize>(a: &SMatrix<T, R, C>) -> [[f64; C]; R] {
-    core::array::from_fn(|i| core::array::from_fn(|j| a[(i, j)].as_f64()))
-}
-
-fn round<T: Real, const R: usize, const C: usize>(a: &[[f64; C]; R]) -> [[T; C]; R] {
-    a.map(|row| row.map(T::from_f64_rounded))
 }
 
 /// The `f64` operators: `(G B, G C, G K, start)`.
@@ -127,13 +119,13 @@ impl<T: Real, const N: usize, const I: usize> LinearInput<T, N, I> {
             h,
             half_h: T::from_f64_rounded(0.5 * hf),
             quarter_h2: T::from_f64_rounded(0.25 * hf * hf),
-            gb: round(&gb),
-            gc: round(&gc),
-            gk: round(&gk),
+            gb: round_rows(&gb),
+            gc: round_rows(&gc),
+            gk: round_rows(&gk),
             start: start.map(|(mb, mc, mk)| InputStart {
-                minv_b: round(&mb),
-                minv_c: round(&mc),
-                minv_k: round(&mk),
+                minv_b: round_rows(&mb),
+                minv_c: round_rows(&mc),
+                minv_k: round_rows(&mk),
             }),
         })
     }

@@ -21,6 +21,10 @@
 //! - [`State`], [`Stepper`]: the state and the interface every scheme shares.
 //! - [`Nonlinear`], [`Model`]: `M u'' + F(u, u') = p(t)` by Newton on the acceleration,
 //!   with a per-step [`NewtonReport`]; [`Varying`]: `M(t), C(t), K(t)` ([`TimeVarying`]).
+//! - Comparator schemes behind the same interface: [`Newmark`] (β, γ), [`GeneralizedAlpha`]
+//!   (ρ∞, HHT-α), [`Exact`] (matrix-exponential discretization, piecewise-linear load).
+//! - [`analysis`]: amplification matrix, spectral radius, period elongation and amplitude
+//!   decay of any scheme on the 1-DOF oscillator.
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
 //!
@@ -35,11 +39,15 @@
 extern crate std;
 
 mod aform;
+pub mod analysis;
 mod error;
+mod exact;
+mod generalized_alpha;
 mod input;
 mod linear;
 pub mod modal;
 pub mod models;
+mod newmark;
 mod nonlinear;
 mod ops;
 mod scalar;
@@ -48,9 +56,12 @@ mod varying;
 
 pub use aform::AForm;
 pub use error::Error;
+pub use exact::Exact;
+pub use generalized_alpha::{AlphaParameters, GeneralizedAlpha};
 pub use input::LinearInput;
 pub use linear::Linear;
 pub use modal::{Damping, Modal, ModalState};
+pub use newmark::Newmark;
 pub use nonlinear::{Iterations, Model, NewtonReport, NewtonSettings, Nonlinear, Tangent};
 pub use scalar::Real;
 pub use state::{State, Stepper};

@@ -15,7 +15,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::ops::{self, Mat};
+use crate::ops;
 use crate::{AForm, Error, Real, State, Stepper};
 
 /// Operators for the start-up acceleration `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0`.
@@ -64,23 +64,22 @@ pub struct Linear<T, const N: usize> {
     start: Option<StartOps<T, N>>,
 }
 
-/// `SMatrix` (column-major) to a row-major `f64` array.
-fn rows_f64<T: Real, const N: usize>(a: &SMatrix<T, N, N>) -> Mat<N> {
-    let mut r = [[0.0; N]; N];
-    for (i, row) in r.iter_mut().enumerate() {
-        for (j, x) in row.iter_mut().enumerate() {
-            *x = a[(i, j)].as_f64();
-        }
-    }
-    r
+/// `SMatrix` (column-major) to a row-major `f64` array (exact).
+pub(crate) fn rows_f64<T: Real, const R: usize, const C: usize>(
+    a: &SMatrix<T, R, C>,
+) -> [[f64; C]; R] {
+    core::array::from_fn(|i| core::array::from_fn(|j| a[(i, j)].as_f64()))
 }
 
-fn round_rows<T: Real, const N: usize>(a: &Mat<N>) -> [[T; N]; N] {
+/// Round a row-major `f64` array once to `T`.
+pub(crate) fn round_rows<T: Real, const R: usize, const C: usize>(
+    a: &[[f64; C]; R],
+) -> [[T; C]; R] {
     a.map(|row| row.map(T::from_f64_rounded))
 }
 
 /// `[G[i], −GC[i], −GK[i]]` for every row `i` (the storage of [`Linear`]).
-fn interleave<T: Real, const N: usize>(
+pub(crate) fn interleave<T: Real, const N: usize>(
     g: &[[T; N]; N],
     gc: &[[T; N]; N],
     gk: &[[T; N]; N],
@@ -262,30 +261,52 @@ impl<T: Real, const N: usize> Stepper<T, N> for Linear<T, N> {
     /// Cost: `3N²` multiply-adds + `7N` (see the module docs for the recurrence).
     #[inline]
     fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
-        let (half_h, h, quarter_h2) = (self.half_h, self.h, self.quarter_h2);
-        // x = (p, v̂, û): the vector every interleaved operator row multiplies.
-        let mut x = [[T::zero(); N]; 3];
-        for j in 0..N {
-            let (u, v, a) = (s.u[j], s.v[j], s.a[j]);
-            x[0][j] = p[j];
-            // v̂ = v + (h/2) a;  û = u + h v + (h²/4) a, written as u + h v̂ − (h²/4) a
-            // (the same value up to rounding, one operation fewer).
-            let vh = v + half_h * a;
-            x[1][j] = vh;
-            x[2][j] = u + h * vh - quarter_h2 * a;
-        }
-        // q = G p − GC v̂ − GK û, written to `a`. Rows go in blocks of `BLOCK`, so each
-        // value of `x` loaded feeds `BLOCK` multiply-adds.
-        mat_vec_blocked(&self.ops, &x, s.a.as_mut_slice());
-        // v = v̂ + (h/2) q, u = û + (h²/4) q. A separate pass with constant indices (once
-        // unrolled), so v̂, û are used straight from registers.
-        for j in 0..N {
-            let q = s.a[j];
-            s.v[j] = x[1][j] + half_h * q;
-            s.u[j] = x[2][j] + quarter_h2 * q;
-        }
-        s.n = s.n.wrapping_add(1);
+        let (h, half_h, quarter_h2) = (self.h, self.half_h, self.quarter_h2);
+        // β = 1/4, γ = 1/2: (1 − γ) h = γ h = h/2, (β + 1/2 − γ) h² = β h² = h²/4.
+        newmark_step(&self.ops, [h, half_h, quarter_h2, half_h, quarter_h2], s, p);
     }
+}
+
+/// One step of the Newmark family in eliminated form, shared by [`Linear`]
+/// (β = 1/4, γ = 1/2: the AEM) and [`Newmark`](crate::Newmark), over interleaved operator
+/// rows `ops[i] = [G[i], −GC[i], −GK[i]]`, `G = (M + γh C + βh² K)⁻¹`.
+/// `c = [h, (1 − γ) h, (β + 1/2 − γ) h², γ h, β h²]`:
+///
+/// ```text
+/// v̂ = v + (1 − γ) h a      û = u + h v̂ − (β + 1/2 − γ) h² a   (= u + h v + (1/2 − β) h² a)
+/// a ← G p − GC v̂ − GK û    v ← v̂ + γ h a                     u ← û + β h² a
+/// ```
+///
+/// Cost: `3N²` multiply-adds + `7N`; branch-free, panic-free.
+#[inline(always)]
+pub(crate) fn newmark_step<T: Real, const N: usize>(
+    ops: &[[[T; N]; 3]; N],
+    c: [T; 5],
+    s: &mut State<T, N>,
+    p: &SVector<T, N>,
+) {
+    let [h, c_v, c_u, gamma_h, beta_h2] = c;
+    // x = (p, v̂, û): the vector every interleaved operator row multiplies.
+    let mut x = [[T::zero(); N]; 3];
+    for j in 0..N {
+        let (u, v, a) = (s.u[j], s.v[j], s.a[j]);
+        x[0][j] = p[j];
+        // û from v̂ rather than from v: the same value up to rounding, one operation fewer.
+        let vh = v + c_v * a;
+        x[1][j] = vh;
+        x[2][j] = u + h * vh - c_u * a;
+    }
+    // q = G p − GC v̂ − GK û, written to `a`. Rows go in blocks of `BLOCK`, so each value
+    // of `x` loaded feeds `BLOCK` multiply-adds.
+    mat_vec_blocked(ops, &x, s.a.as_mut_slice());
+    // v = v̂ + γh q, u = û + βh² q. A separate pass with constant indices (once unrolled),
+    // so v̂, û are used straight from registers.
+    for j in 0..N {
+        let q = s.a[j];
+        s.v[j] = x[1][j] + gamma_h * q;
+        s.u[j] = x[2][j] + beta_h2 * q;
+    }
+    s.n = s.n.wrapping_add(1);
 }
 
 /// Operator rows processed together by the steps (two accumulators: on the Cortex-M4F
