@@ -219,21 +219,6 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
         self.params
     }
 
-    /// The textbook step: advance from `t_{n−1}` to `t_n` with the load samples
-    /// `p_prev = p(t_{n−1})` and `p = p(t_n)`, the load taken as
-    /// `(1 − α_f) p + α_f p_prev`. Second order for any smooth load.
-    ///
-    /// Cost: `4N²` multiply-adds + `10N`. No allocation, no panic.
-    #[inline]
-    pub fn step_with_previous_load(
-        &self,
-        s: &mut State<T, N>,
-        p_prev: &SVector<T, N>,
-        p: &SVector<T, N>,
-    ) {
-        self.step_inner(s, p_prev, p);
-    }
-
     #[inline(always)]
     fn step_inner(&self, s: &mut State<T, N>, p_prev: &SVector<T, N>, p: &SVector<T, N>) {
         let mut pbar = [T::zero(); N];
@@ -275,10 +260,27 @@ impl<T: Real, const N: usize> Stepper<T, N> for GeneralizedAlpha<T, N> {
         initial_state(self.start.as_ref(), u0, v0, p0)
     }
 
-    /// [`GeneralizedAlpha::step_with_previous_load`] with `p_prev = p` (see the module
-    /// docs: first order for time-varying loads). Cost: `4N²` multiply-adds + `10N`.
+    /// [`Stepper::step_with_previous_load`] with `p_prev = p`: exact for free vibration and
+    /// constant loads, but FIRST order for a time-varying load (the weighted load
+    /// `(1 − α_f) p_n + α_f p_{n−1}` needs the previous sample, which the shared [`State`]
+    /// does not carry). Drive it with `step_with_previous_load` for second order.
+    /// Cost: `4N²` multiply-adds + `10N`.
     #[inline]
     fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
         self.step_inner(s, p, p);
+    }
+
+    /// The textbook step: the load taken as `(1 − α_f) p + α_f p_prev`, with
+    /// `p_prev = p(t_{n−1})`, `p = p(t_n)`. Second order for any smooth load.
+    ///
+    /// Cost: `4N²` multiply-adds + `10N`. No allocation, no panic.
+    #[inline]
+    fn step_with_previous_load(
+        &self,
+        s: &mut State<T, N>,
+        p_prev: &SVector<T, N>,
+        p: &SVector<T, N>,
+    ) {
+        self.step_inner(s, p_prev, p);
     }
 }

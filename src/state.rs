@@ -109,18 +109,63 @@ pub trait Stepper<T: Real, const N: usize> {
     /// NaN state: use [`Stepper::try_step`] where that must not happen.
     fn step(&self, state: &mut State<T, N>, p: &SVector<T, N>);
 
+    /// Advance with the load samples at both ends of the step, `p_prev = p(t_{n−1})` and
+    /// `p = p(t_n)` — what a loop over a sampled signal has anyway. Generic code that
+    /// calls this drives every scheme at its full order:
+    ///
+    /// - schemes whose step depends on `p_n` only — the AEM ([`Linear`](crate::Linear),
+    ///   [`AForm`](crate::AForm)), [`Newmark`](crate::Newmark), and
+    ///   [`Exact`](crate::Exact), which recovers `p_{n−1}` from its state — ignore
+    ///   `p_prev` (this default);
+    /// - [`GeneralizedAlpha`](crate::GeneralizedAlpha) takes the load as
+    ///   `(1 − α_f) p + α_f p_prev`, the textbook form; through [`Stepper::step`] it must
+    ///   assume `p_prev = p`, which is first order for a time-varying load.
+    ///
+    /// Cost, panics, allocation: as [`Stepper::step`].
+    #[inline]
+    fn step_with_previous_load(
+        &self,
+        state: &mut State<T, N>,
+        p_prev: &SVector<T, N>,
+        p: &SVector<T, N>,
+    ) {
+        let _ = p_prev;
+        self.step(state, p);
+    }
+
     /// [`Stepper::step`], committed only if the new state is finite.
     ///
     /// Errors: [`Error::NonFiniteState`] (e.g. a NaN load sample), leaving `state`
     /// bit-identical to what it was. Cost: one step plus a copy and a scan of `3N` values.
     fn try_step(&self, state: &mut State<T, N>, p: &SVector<T, N>) -> Result<(), Error> {
-        let mut next = *state;
-        self.step(&mut next, p);
-        if next.is_finite() {
-            *state = next;
-            Ok(())
-        } else {
-            Err(Error::NonFiniteState)
-        }
+        commit_if_finite(state, |next| self.step(next, p))
+    }
+
+    /// [`Stepper::step_with_previous_load`], committed only if the new state is finite.
+    ///
+    /// Errors: as [`Stepper::try_step`]; `state` is unchanged on error.
+    fn try_step_with_previous_load(
+        &self,
+        state: &mut State<T, N>,
+        p_prev: &SVector<T, N>,
+        p: &SVector<T, N>,
+    ) -> Result<(), Error> {
+        commit_if_finite(state, |next| self.step_with_previous_load(next, p_prev, p))
+    }
+}
+
+/// Run `step` on a copy of `state` and commit it only if the result is finite.
+#[inline]
+fn commit_if_finite<T: Real, const N: usize>(
+    state: &mut State<T, N>,
+    step: impl FnOnce(&mut State<T, N>),
+) -> Result<(), Error> {
+    let mut next = *state;
+    step(&mut next);
+    if next.is_finite() {
+        *state = next;
+        Ok(())
+    } else {
+        Err(Error::NonFiniteState)
     }
 }

@@ -253,6 +253,61 @@ fn generalized_alpha_time_varying_load_orders() {
     assert!((q1 - 1.0).abs() < 0.15, "{q1}");
 }
 
+/// Drives any scheme through the shared interface with a sampled, time-varying load:
+/// the loop a user writes once and reuses for every scheme.
+fn sampled_run(sys: &dyn Stepper<f64, 1>, t_end: f64, load: impl Fn(f64) -> f64) -> f64 {
+    let h = sys.time_step();
+    let mut p_prev = vector![load(0.0)];
+    let mut s = sys.start(&vector![0.0], &vector![0.0], &p_prev).unwrap();
+    for n in 1..=(t_end / h).round() as usize {
+        let p = vector![load(n as f64 * h)];
+        sys.try_step_with_previous_load(&mut s, &p_prev, &p)
+            .unwrap();
+        p_prev = p;
+    }
+    s.u()[0]
+}
+
+#[test]
+fn every_scheme_is_second_order_through_the_shared_interface() {
+    // u'' + 2ξω u' + ω² u = sin(2t) + 0.5 cos(3t); reference: the exact scheme at h = 1e-4
+    // (exact for a piecewise-linear load; its interpolation error there is O(h²) ≈ 1e-12
+    // relative to the coarse runs' errors).
+    let (w, xi) = (4.0f64, 0.02);
+    let (m, c, k) = (matrix![1.0], matrix![2.0 * xi * w], matrix![w * w]);
+    let load = |t: f64| (2.0 * t).sin() + 0.5 * (3.0 * t).cos();
+    let t_end = 4.0;
+    let reference = sampled_run(&Exact::new(&m, &c, &k, 1e-4).unwrap(), t_end, load);
+    type Scheme = Box<dyn Stepper<f64, 1>>;
+    let build = |name: &str, h: f64| -> Scheme {
+        match name {
+            "AEM" => Box::new(Linear::new(&m, &c, &k, h).unwrap()),
+            "AForm" => Box::new(Linear::new(&m, &c, &k, h).unwrap().a_form()),
+            "Newmark LA" => Box::new(Newmark::linear_acceleration(&m, &c, &k, h).unwrap()),
+            "gen-α 0.7" => Box::new(GeneralizedAlpha::new(&m, &c, &k, h, 0.7).unwrap()),
+            "HHT −0.1" => Box::new(GeneralizedAlpha::hht(&m, &c, &k, h, -0.1).unwrap()),
+            // Exact for the interpolated load: its whole error is the load's
+            // piecewise-linear interpolation, also O(h²).
+            _ => Box::new(Exact::new(&m, &c, &k, h).unwrap()),
+        }
+    };
+    for name in [
+        "AEM",
+        "AForm",
+        "Newmark LA",
+        "gen-α 0.7",
+        "HHT −0.1",
+        "Exact",
+    ] {
+        let err = |h| (sampled_run(build(name, h).as_ref(), t_end, load) - reference).abs();
+        let (e1, e2) = (err(0.01), err(0.005));
+        let q = order(e1, e2);
+        println!("{name}: errors {e1:.3e} {e2:.3e}, order {q:.3}");
+        // Second order up to the O(ωh) weight of the next term (ωh ≤ 0.04): ±0.15.
+        assert!((q - 2.0).abs() < 0.15, "{name}: order {q}");
+    }
+}
+
 #[test]
 fn f32_schemes_track_f64() {
     // f32 operators and arithmetic: per-step relative rounding ~6e-8; over 1250 steps at
@@ -346,4 +401,25 @@ fn constructors_reject_bad_input() {
         Err(Error::NonFiniteState)
     );
     assert_eq!(s, before);
+}
+
+#[test]
+fn checked_two_sample_step_keeps_the_state_on_a_bad_sample() {
+    let (m, c, k) = (matrix![1.0], matrix![0.1], matrix![4.0]);
+    let sys = GeneralizedAlpha::new(&m, &c, &k, 0.01, 0.7).unwrap();
+    let mut s = sys
+        .start(&vector![1.0], &vector![0.0], &vector![0.0])
+        .unwrap();
+    sys.try_step_with_previous_load(&mut s, &vector![0.0], &vector![1.0])
+        .unwrap();
+    let before = s;
+    // Generalized-α reads p_prev: a NaN there is refused, the state kept bit for bit.
+    assert_eq!(
+        sys.try_step_with_previous_load(&mut s, &vector![f64::NAN], &vector![1.0]),
+        Err(Error::NonFiniteState)
+    );
+    assert_eq!(s.u()[0].to_bits(), before.u()[0].to_bits());
+    assert_eq!(s.v()[0].to_bits(), before.v()[0].to_bits());
+    assert_eq!(s.a()[0].to_bits(), before.a()[0].to_bits());
+    assert_eq!(s.steps(), before.steps());
 }
