@@ -170,12 +170,7 @@ impl<T: Real, const N: usize, const I: usize> LinearInput<T, N, I> {
             }
             s
         });
-        let s = State::from_parts(*u0, *v0, a0, 0);
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteState)
-        }
+        State::initial_computed(u0, v0, a0)
     }
 
     /// The state at `t = 0` with a known initial acceleration `a0`.
@@ -187,12 +182,7 @@ impl<T: Real, const N: usize, const I: usize> LinearInput<T, N, I> {
         v0: &SVector<T, N>,
         a0: &SVector<T, N>,
     ) -> Result<State<T, N>, Error> {
-        let s = State::from_parts(*u0, *v0, *a0, 0);
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteInput)
-        }
+        State::initial_given(u0, v0, a0)
     }
 
     /// Advance `state` from `t_{n−1}` to `t_n` under the input `w_n = w(t_n)`.
@@ -242,7 +232,7 @@ impl<T: Real, const N: usize, const I: usize> LinearInput<T, N, I> {
 
 /// Const-fn construction, for operators computed at compile time into flash.
 macro_rules! const_ctor {
-    ($t:ty) => {
+    ($t:ident) => {
         impl<const N: usize, const I: usize> LinearInput<$t, N, I> {
             /// `const fn` twin of [`LinearInput::new`]: `M, C, K` (`N×N`) and `B` (`N×I`)
             /// as row-major `f64` arrays, `h` in seconds. Computes in `f64` and rounds
@@ -265,14 +255,14 @@ macro_rules! const_ctor {
                     h: h as $t,
                     half_h: (0.5 * h) as $t,
                     quarter_h2: (0.25 * h * h) as $t,
-                    gb: const_ctor!(@round $t, gb, N, I),
-                    gc: const_ctor!(@round $t, gc, N, N),
-                    gk: const_ctor!(@round $t, gk, N, N),
+                    gb: ops::const_round!($t, rows gb),
+                    gc: ops::const_round!($t, rows gc),
+                    gk: ops::const_round!($t, rows gk),
                     start: match start {
                         Some((mb, mc, mk)) => Some(InputStart {
-                            minv_b: const_ctor!(@round $t, mb, N, I),
-                            minv_c: const_ctor!(@round $t, mc, N, N),
-                            minv_k: const_ctor!(@round $t, mk, N, N),
+                            minv_b: ops::const_round!($t, rows mb),
+                            minv_c: ops::const_round!($t, rows mc),
+                            minv_k: ops::const_round!($t, rows mk),
                         }),
                         None => None,
                     },
@@ -280,20 +270,6 @@ macro_rules! const_ctor {
             }
         }
     };
-    (@round $t:ty, $a:expr, $r:expr, $c:expr) => {{
-        let a = $a;
-        let mut r = [[0.0 as $t; $c]; $r];
-        let mut i = 0;
-        while i < $r {
-            let mut j = 0;
-            while j < $c {
-                r[i][j] = a[i][j] as $t;
-                j += 1;
-            }
-            i += 1;
-        }
-        r
-    }};
 }
 const_ctor!(f32);
 const_ctor!(f64);

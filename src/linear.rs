@@ -155,7 +155,7 @@ impl<T: Real, const N: usize> Linear<T, N> {
 
 /// Const-fn construction, for operators computed at compile time into flash.
 macro_rules! const_ctor {
-    ($t:ty) => {
+    ($t:ident) => {
         impl<const N: usize> Linear<$t, N> {
             /// `const fn` twin of [`Linear::new`]: `M, C, K` as row-major `f64` arrays
             /// (`m[i][j]` is row `i`, column `j`), `h` in seconds. Computes in `f64` and
@@ -194,9 +194,9 @@ macro_rules! const_ctor {
                     ops: const_ctor!(@interleave $t, op.g, op.gc, op.gk),
                     start: match op.start {
                         Some((mi, mc, mk)) => Some(StartOps {
-                            minv: const_ctor!(@round $t, mi),
-                            minv_c: const_ctor!(@round $t, mc),
-                            minv_k: const_ctor!(@round $t, mk),
+                            minv: ops::const_round!($t, rows mi),
+                            minv_c: ops::const_round!($t, rows mc),
+                            minv_k: ops::const_round!($t, rows mk),
                         }),
                         None => None,
                     },
@@ -209,7 +209,7 @@ macro_rules! const_ctor {
             }
         }
     };
-    (@interleave $t:ty, $g:expr, $gc:expr, $gk:expr) => {{
+    (@interleave $t:ident, $g:expr, $gc:expr, $gk:expr) => {{
         let (g, gc, gk) = ($g, $gc, $gk);
         let mut r = [[[0.0 as $t; N]; 3]; N];
         let mut i = 0;
@@ -219,20 +219,6 @@ macro_rules! const_ctor {
                 r[i][0][j] = g[i][j] as $t;
                 r[i][1][j] = -(gc[i][j] as $t);
                 r[i][2][j] = -(gk[i][j] as $t);
-                j += 1;
-            }
-            i += 1;
-        }
-        r
-    }};
-    (@round $t:ty, $a:expr) => {{
-        let a = $a;
-        let mut r = [[0.0 as $t; N]; N];
-        let mut i = 0;
-        while i < N {
-            let mut j = 0;
-            while j < N {
-                r[i][j] = a[i][j] as $t;
                 j += 1;
             }
             i += 1;
@@ -376,10 +362,5 @@ pub(crate) fn initial_state<T: Real, const N: usize>(
         return Err(Error::NonFiniteInput);
     }
     let a0 = mat_vec(&ops.minv, p0) - mat_vec(&ops.minv_c, v0) - mat_vec(&ops.minv_k, u0);
-    let s = State::from_parts(*u0, *v0, a0, 0);
-    if s.is_finite() {
-        Ok(s)
-    } else {
-        Err(Error::NonFiniteState)
-    }
+    State::initial_computed(u0, v0, a0)
 }

@@ -801,7 +801,7 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
 
 /// Const-fn construction, for modal operators computed at compile time into flash.
 macro_rules! const_ctor {
-    ($t:ty) => {
+    ($t:ident) => {
         impl<const N: usize, const R: usize, const I: usize, const O: usize> Modal<$t, N, R, I, O> {
             /// `const fn` twin of [`Modal::new`] (the `R` lowest modes), bit-identical to
             /// it. In a `static`, the compiler solves the eigenproblem and no eigen-solver
@@ -839,44 +839,20 @@ macro_rules! const_ctor {
                     h: h as $t,
                     half_h: op.half_h as $t,
                     quarter_h2: op.quarter_h2 as $t,
-                    g_gamma: const_ctor!(@r2 $t, op.g_gamma, R, I),
-                    g_c: const_ctor!(@r1 $t, op.g_c, R),
-                    g_k: const_ctor!(@r1 $t, op.g_k, R),
-                    gamma: const_ctor!(@r2 $t, op.gamma, R, I),
-                    c: const_ctor!(@r1 $t, op.c, R),
-                    k: const_ctor!(@r1 $t, op.k, R),
-                    out: const_ctor!(@r2 $t, op.out, O, R),
-                    phi: const_ctor!(@r2 $t, op.phi, N, R),
-                    proj: const_ctor!(@r2 $t, op.proj, R, N),
+                    g_gamma: ops::const_round!($t, rows op.g_gamma),
+                    g_c: ops::const_round!($t, vec op.g_c),
+                    g_k: ops::const_round!($t, vec op.g_k),
+                    gamma: ops::const_round!($t, rows op.gamma),
+                    c: ops::const_round!($t, vec op.c),
+                    k: ops::const_round!($t, vec op.k),
+                    out: ops::const_round!($t, rows op.out),
+                    phi: ops::const_round!($t, rows op.phi),
+                    proj: ops::const_round!($t, rows op.proj),
                     modes,
                 })
             }
         }
     };
-    (@r1 $t:ty, $a:expr, $n:expr) => {{
-        let a = $a;
-        let mut r = [0.0 as $t; $n];
-        let mut i = 0;
-        while i < $n {
-            r[i] = a[i] as $t;
-            i += 1;
-        }
-        r
-    }};
-    (@r2 $t:ty, $a:expr, $rows:expr, $cols:expr) => {{
-        let a = $a;
-        let mut r = [[0.0 as $t; $cols]; $rows];
-        let mut i = 0;
-        while i < $rows {
-            let mut j = 0;
-            while j < $cols {
-                r[i][j] = a[i][j] as $t;
-                j += 1;
-            }
-            i += 1;
-        }
-        r
-    }};
 }
 const_ctor!(f32);
 const_ctor!(f64);

@@ -270,12 +270,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         if !solve_in_place(&mut lu, &mut a0, scale) {
             return Err(Error::SingularMass);
         }
-        let s = State::from_parts(*u0, *v0, a0, 0);
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteState)
-        }
+        State::initial_computed(u0, v0, a0)
     }
 
     /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M`).
@@ -287,12 +282,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         v0: &SVector<T, N>,
         a0: &SVector<T, N>,
     ) -> Result<State<T, N>, Error> {
-        let s = State::from_parts(*u0, *v0, *a0, 0);
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteInput)
-        }
+        State::initial_given(u0, v0, a0)
     }
 
     /// Advance `state` from `t_{n−1}` to `t_n` under the load `p_n = p(t_n)`, committing

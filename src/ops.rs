@@ -227,6 +227,54 @@ pub(crate) const fn all_finite_rect<const R: usize, const C: usize>(a: &[[f64; C
     true
 }
 
+/// Round `f64` rows once to `f32` (round-to-nearest), in `const` contexts.
+pub(crate) const fn rows_to_f32<const R: usize, const C: usize>(
+    a: &[[f64; C]; R],
+) -> [[f32; C]; R] {
+    let mut r = [[0.0; C]; R];
+    let mut i = 0;
+    while i < R {
+        r[i] = vec_to_f32(&a[i]);
+        i += 1;
+    }
+    r
+}
+
+/// Round an `f64` vector once to `f32` (round-to-nearest), in `const` contexts.
+pub(crate) const fn vec_to_f32<const N: usize>(a: &[f64; N]) -> [f32; N] {
+    let mut r = [0.0; N];
+    let mut i = 0;
+    while i < N {
+        r[i] = a[i] as f32;
+        i += 1;
+    }
+    r
+}
+
+/// `*a`, in `const` contexts (the `f64` arm of [`const_round!`]).
+pub(crate) const fn copied<A: Copy>(a: &A) -> A {
+    *a
+}
+
+/// `const_round!(f32, rows)` / `const_round!(f64, rows)`: an `f64` array (vector or
+/// rows, `vec`/`rows` selects) as the scalar type the `const` constructors are written
+/// for. `f64` is the identity, `f32` rounds once.
+macro_rules! const_round {
+    (f64, rows $a:expr) => {
+        $crate::ops::copied(&$a)
+    };
+    (f64, vec $a:expr) => {
+        $crate::ops::copied(&$a)
+    };
+    (f32, rows $a:expr) => {
+        $crate::ops::rows_to_f32(&$a)
+    };
+    (f32, vec $a:expr) => {
+        $crate::ops::vec_to_f32(&$a)
+    };
+}
+pub(crate) use const_round;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -44,6 +44,31 @@ impl<T: Real, const N: usize> State<T, N> {
     pub fn time(&self, h: T) -> T {
         T::from_f64_rounded(self.n as f64 * h.as_f64())
     }
+    /// The state at step 0 from given `u0, v0, a0`.
+    /// Errors: [`Error::NonFiniteInput`] if any entry is not finite.
+    pub(crate) fn initial_given(
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        a0: &SVector<T, N>,
+    ) -> Result<Self, Error> {
+        Self::initial_computed(u0, v0, *a0).map_err(|_| Error::NonFiniteInput)
+    }
+
+    /// The state at step 0 with a computed initial acceleration `a0` (inputs already
+    /// checked finite). Errors: [`Error::NonFiniteState`] if `a0` overflowed.
+    pub(crate) fn initial_computed(
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        a0: SVector<T, N>,
+    ) -> Result<Self, Error> {
+        let s = Self::from_parts(*u0, *v0, a0, 0);
+        if s.is_finite() {
+            Ok(s)
+        } else {
+            Err(Error::NonFiniteState)
+        }
+    }
+
     /// Every entry of `u`, `v`, `a` is finite.
     pub fn is_finite(&self) -> bool {
         self.u
@@ -95,12 +120,7 @@ pub trait Stepper<T: Real, const N: usize> {
         v0: &SVector<T, N>,
         a0: &SVector<T, N>,
     ) -> Result<State<T, N>, Error> {
-        let s = State::from_parts(*u0, *v0, *a0, 0);
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteInput)
-        }
+        State::initial_given(u0, v0, a0)
     }
 
     /// Advance `state` from `t_{n−1}` to `t_n` under the load `p_n = p(t_n)`.

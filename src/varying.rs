@@ -145,12 +145,7 @@ impl<T: Real, const N: usize> Varying<T, N> {
         if !solve_in_place(&mut lu, &mut a0, max_abs(&k.mass)) {
             return Err(Error::SingularMass);
         }
-        let s = State::from_parts(*u0, *v0, a0, 0);
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteState)
-        }
+        State::initial_computed(u0, v0, a0)
     }
 
     /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M(0)`).
@@ -162,12 +157,7 @@ impl<T: Real, const N: usize> Varying<T, N> {
         v0: &SVector<T, N>,
         a0: &SVector<T, N>,
     ) -> Result<State<T, N>, Error> {
-        let s = State::from_parts(*u0, *v0, *a0, 0);
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteInput)
-        }
+        State::initial_given(u0, v0, a0)
     }
 
     /// Advance `state` from `t_{n−1}` to `t_n = n·h` under the load `p_n = p(t_n)`, with
