@@ -67,7 +67,7 @@ impl Kind {
         match self {
             Kind::Aem => 3 * n * n + 7 * n,
             Kind::AemAForm => 12 * n * n,
-            Kind::NewmarkLa | Kind::CentralDiff => 3 * n * n + 8 * n,
+            Kind::NewmarkLa | Kind::CentralDiff => 3 * n * n + 7 * n,
             Kind::GenAlpha | Kind::Hht => 4 * n * n + 10 * n,
             Kind::Exact => 11 * n * n,
         }

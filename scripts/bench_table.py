@@ -21,7 +21,7 @@ for dirpath, _, files in os.walk(root):
 SCHEMES = [
     ("aem", "AEM `Linear`", lambda n: 3 * n * n + 7 * n),
     ("aem-aform", "AEM `AForm`", lambda n: 12 * n * n),
-    ("newmark", "`Newmark`", lambda n: 3 * n * n + 8 * n),
+    ("newmark", "`Newmark`", lambda n: 3 * n * n + 7 * n),
     ("gen-alpha", "`GeneralizedAlpha`", lambda n: 4 * n * n + 10 * n),
     ("exact", "`Exact`", lambda n: 11 * n * n),
 ]
