@@ -13,10 +13,10 @@ cd "$(dirname "$0")/.."
 TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
-EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal)
+EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes)
 # Broken on purpose: "example feature" pairs that must exit with failure (status 1).
 BROKEN=("qemu_timer qemu-inject-nan" "qemu_timer qemu-tight-bound" "qemu_nonlinear qemu-inject-nan"
-    "qemu_modal qemu-modal-tight-bound")
+    "qemu_modal qemu-modal-tight-bound" "qemu_schemes qemu-inject-nan")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
 TARGET_DIR=${CARGO_TARGET_DIR:-target}
 OUT=$TARGET_DIR/qemu
