@@ -19,6 +19,9 @@
 //! - Generalized-α and HHT get the load as the textbook scheme does,
 //!   `(1 − α_f) p_n + α_f p_{n−1}` (`step_with_previous_load`).
 
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use std::fmt::Write as _;
 use std::hint::black_box;
 use std::time::Instant;
@@ -224,39 +227,12 @@ fn sweep<const N: usize>(pb: &Problem<N>) -> Vec<Row> {
 // ---------- Example 4 ----------
 
 fn example4() -> Problem<3> {
-    type M3 = SMatrix<f64, 3, 3>;
-    type V3 = SVector<f64, 3>;
-    let m = M3::new(52.0, 10.0, 20.0, 10.0, 150.0, 30.0, 20.0, 30.0, 441.0);
-    let k = M3::new(
-        1472.0, 407.0, 5553.0, 407.0, 1001.0, 4154.0, 5553.0, 4154.0, 43516.0,
-    );
-    let l = m.cholesky().unwrap().l();
-    let li = l.try_inverse().unwrap();
-    let eig = (li * k * li.transpose()).symmetric_eigen();
-    let mut idx = [0usize, 1, 2];
-    idx.sort_by(|&a, &b| eig.eigenvalues[a].partial_cmp(&eig.eigenvalues[b]).unwrap());
-    let phi = M3::from_fn(|i, j| (li.transpose() * eig.eigenvectors)[(i, idx[j])]);
-    let w = idx.map(|i| eig.eigenvalues[i].sqrt());
-    let xi = [0.3, 0.05, 0.09];
-    let c =
-        m * phi * M3::from_diagonal(&V3::from_fn(|i, _| 2.0 * xi[i] * w[i])) * phi.transpose() * m;
-    let (u0, v0) = (V3::new(10.0, 1.0, 5.0), V3::new(0.0, 50.0, 20.0));
-    let f = phi.transpose() * V3::repeat(10.0);
-    let eta0 = phi.transpose() * m * u0;
-    let deta0 = phi.transpose() * m * v0;
+    // Data and exact modal solution from the shared test references.
+    let (m, k, xi, u0, v0, p) = support::example4();
+    let exact = support::ModalExact::new(&m, &k, xi, &u0, &v0, &p);
+    let c = exact.c;
     let n_base = (5.0 / BASE).round() as usize;
-    let reference = (0..=n_base)
-        .map(|i| {
-            let t = i as f64 * BASE;
-            phi * V3::from_fn(|j, _| {
-                let wd = w[j] * (1.0 - xi[j] * xi[j]).sqrt();
-                let st = f[j] / (w[j] * w[j]);
-                let a = eta0[j] - st;
-                let b = (deta0[j] + xi[j] * w[j] * a) / wd;
-                st + (-xi[j] * w[j] * t).exp() * (a * (wd * t).cos() + b * (wd * t).sin())
-            })
-        })
-        .collect();
+    let reference = (0..=n_base).map(|i| exact.u(i as f64 * BASE)).collect();
     Problem {
         name: "Example 4 (3-DOF, Caughey damping, step load, 0–5 s)",
         m,
@@ -264,7 +240,7 @@ fn example4() -> Problem<3> {
         k,
         u0,
         v0,
-        load: Box::new(|_| V3::repeat(10.0)),
+        load: Box::new(move |_| p),
         reference,
         hs: vec![200, 100, 40, 20, 10, 4, 2, 1],
     }

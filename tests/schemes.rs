@@ -1,71 +1,46 @@
 //! The comparator schemes against exact solutions and independent implementations.
 
+mod support;
+
 use aemstep::{Error, Exact, GeneralizedAlpha, Linear, Newmark, Stepper};
 use nalgebra::{SMatrix, SVector, matrix, vector};
 
 type M3 = SMatrix<f64, 3, 3>;
 type V3 = SVector<f64, 3>;
 
-/// Paper Example 4 (spec §7): M, K, Caughey C (modal ratios 0.3, 0.05, 0.09), with the
-/// exact modal solution under p = 10·(1,1,1) H(t), u0 = (10, 1, 5), v0 = (0, 50, 20).
+/// Paper Example 4 (spec §7): M, K, Caughey C (modal ratios 0.3, 0.05, 0.09) and the exact
+/// modal solution under p = 10·(1,1,1) H(t), u0 = (10, 1, 5), v0 = (0, 50, 20), from the
+/// shared test references (`tests/support`).
 struct Example4 {
     m: M3,
     c: M3,
     k: M3,
-    phi: M3,
-    w: [f64; 3],
-    xi: [f64; 3],
+    exact: support::ModalExact<3>,
 }
 
 impl Example4 {
     fn new() -> Self {
-        let m = M3::new(52.0, 10.0, 20.0, 10.0, 150.0, 30.0, 20.0, 30.0, 441.0);
-        let k = M3::new(
-            1472.0, 407.0, 5553.0, 407.0, 1001.0, 4154.0, 5553.0, 4154.0, 43516.0,
-        );
-        // Mass-normalised modes from the symmetric problem L⁻¹ K L⁻ᵀ, M = L Lᵀ.
-        let l = m.cholesky().unwrap().l();
-        let li = l.try_inverse().unwrap();
-        let eig = (li * k * li.transpose()).symmetric_eigen();
-        let mut idx = [0usize, 1, 2];
-        idx.sort_by(|&a, &b| eig.eigenvalues[a].partial_cmp(&eig.eigenvalues[b]).unwrap());
-        let phi = M3::from_fn(|i, j| (li.transpose() * eig.eigenvectors)[(i, idx[j])]);
-        let w = idx.map(|i| eig.eigenvalues[i].sqrt());
-        let xi = [0.3, 0.05, 0.09];
-        let d = M3::from_diagonal(&V3::from_fn(|i, _| 2.0 * xi[i] * w[i]));
-        let c = m * phi * d * phi.transpose() * m;
+        let (m, k, xi, u0, v0, p) = support::example4();
+        let exact = support::ModalExact::new(&m, &k, xi, &u0, &v0, &p);
         Self {
             m,
-            c,
+            c: exact.c,
             k,
-            phi,
-            w,
-            xi,
+            exact,
         }
     }
     fn load() -> V3 {
-        V3::repeat(10.0)
+        support::example4().5
     }
     fn u0() -> V3 {
-        vector![10.0, 1.0, 5.0]
+        support::example4().3
     }
     fn v0() -> V3 {
-        vector![0.0, 50.0, 20.0]
+        support::example4().4
     }
-    /// Exact u(t) by modal superposition (damped free response + static step response).
+    /// Exact u(t) by modal superposition.
     fn exact(&self, t: f64) -> V3 {
-        let eta0 = self.phi.transpose() * self.m * Self::u0();
-        let deta0 = self.phi.transpose() * self.m * Self::v0();
-        let f = self.phi.transpose() * Self::load();
-        let eta = V3::from_fn(|i, _| {
-            let (w, xi) = (self.w[i], self.xi[i]);
-            let wd = w * (1.0 - xi * xi).sqrt();
-            let st = f[i] / (w * w);
-            let a = eta0[i] - st;
-            let b = (deta0[i] + xi * w * a) / wd;
-            st + (-xi * w * t).exp() * (a * (wd * t).cos() + b * (wd * t).sin())
-        });
-        self.phi * eta
+        self.exact.u(t)
     }
 }
 
