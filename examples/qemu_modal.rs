@@ -188,10 +188,7 @@ static OVERRUN: AtomicBool = AtomicBool::new(false);
 #[exception]
 fn SysTick() {
     static mut LOCAL: Option<Ctx> = None;
-    if LOCAL.is_none() {
-        *LOCAL = cortex_m::interrupt::free(|cs| CTX.borrow(cs).borrow_mut().take());
-    }
-    let Some((sys, tx, state)) = LOCAL.as_mut() else {
+    let Some((sys, tx, state)) = fw::handover(&CTX, LOCAL) else {
         return;
     };
     let n = state.steps() as u32 + 1;

@@ -13,14 +13,30 @@
 //! painted with `0xCCCC_CCCC` at reset by cortex-m-rt's `paint-stack` feature.
 #![allow(dead_code)] // each example uses a different subset
 
+use core::cell::RefCell;
 use core::panic::PanicInfo;
 
 // Links cortex-m's single-core critical section, which cortex-m-semihosting 0.6 needs.
 use cortex_m as _;
+use cortex_m::interrupt::Mutex;
 use cortex_m::peripheral::SYST;
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{ExceptionFrame, exception};
 use cortex_m_semihosting::{debug, hprintln};
+
+/// The hand-over of an interrupt handler's context: `main` leaves it in `ctx` (a `static`
+/// behind a critical section); on the handler's first run it is moved into the handler's
+/// own `local` (a `static mut` of the handler), so later runs take no critical section.
+/// `None` until `main` has handed it over.
+pub fn handover<'a, C>(
+    ctx: &Mutex<RefCell<Option<C>>>,
+    local: &'a mut Option<C>,
+) -> Option<&'a mut C> {
+    if local.is_none() {
+        *local = cortex_m::interrupt::free(|cs| ctx.borrow(cs).borrow_mut().take());
+    }
+    local.as_mut()
+}
 
 /// End the QEMU run with exit status 0.
 pub fn exit_success() -> ! {
