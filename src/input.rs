@@ -17,6 +17,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::linear::{round_rows, rows_f64};
 use crate::ops::{self, Mat};
+use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
 /// Start-up operators `M⁻¹B`, `M⁻¹C`, `M⁻¹K` for `q0 = M⁻¹(B w0 − C v0 − K u0)`.
@@ -152,12 +153,7 @@ impl<T: Real, const N: usize, const I: usize> LinearInput<T, N, I> {
         w0: &SVector<T, I>,
     ) -> Result<State<T, N>, Error> {
         let ops = self.start.as_ref().ok_or(Error::SingularMass)?;
-        let finite = u0
-            .iter()
-            .chain(v0.iter())
-            .chain(w0.iter())
-            .all(|x| x.is_finite());
-        if !finite {
+        if !initial_inputs_finite(u0, v0, w0) {
             return Err(Error::NonFiniteInput);
         }
         let a0 = SVector::<T, N>::from_fn(|i, _| {

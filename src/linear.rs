@@ -16,6 +16,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::ops;
+use crate::scalar::initial_inputs_finite;
 use crate::{AForm, Error, Real, State, Stepper};
 
 /// Operators for the start-up acceleration `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0`.
@@ -353,12 +354,7 @@ pub(crate) fn initial_state<T: Real, const N: usize>(
     p0: &SVector<T, N>,
 ) -> Result<State<T, N>, Error> {
     let ops = ops.ok_or(Error::SingularMass)?;
-    let inputs_finite = u0
-        .iter()
-        .chain(v0.iter())
-        .chain(p0.iter())
-        .all(|x| x.is_finite());
-    if !inputs_finite {
+    if !initial_inputs_finite(u0, v0, p0) {
         return Err(Error::NonFiniteInput);
     }
     let a0 = mat_vec(&ops.minv, p0) - mat_vec(&ops.minv_c, v0) - mat_vec(&ops.minv_k, u0);

@@ -22,6 +22,7 @@ use core::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
 /// The derivatives of the internal force `F(u, v)` at one point (the tangent operator).
@@ -253,7 +254,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         v0: &SVector<T, N>,
         p0: &SVector<T, N>,
     ) -> Result<State<T, N>, Error> {
-        if !(all_finite(u0) && all_finite(v0) && all_finite(p0)) {
+        if !initial_inputs_finite(u0, v0, p0) {
             return Err(Error::NonFiniteInput);
         }
         let m = model.mass();
@@ -264,13 +265,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         if !all_finite(&f) {
             return Err(Error::NonFiniteForce);
         }
-        let scale = m.iter().fold(T::zero(), |s, x| s.max(x.abs()));
-        let mut a0 = p0 - f;
-        let mut lu = m;
-        if !solve_in_place(&mut lu, &mut a0, scale) {
-            return Err(Error::SingularMass);
-        }
-        State::initial_computed(u0, v0, a0)
+        initial_from_equation(u0, v0, &m, p0 - f)
     }
 
     /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M`).
@@ -473,6 +468,25 @@ fn finite_difference_jacobian<T: Real, const N: usize, Mo: Model<T, N> + ?Sized>
         }
     }
     Ok((j, scale))
+}
+
+/// The state at step 0 with the acceleration from the equation of motion,
+/// `a0 = M⁻¹ r` (`r = p0 − F(u0, v0)`, or `p0 − C v0 − K u0`), solved by
+/// [`solve_in_place`] with the pivot threshold scaled by `max|M_ij|`.
+///
+/// Errors: [`Error::SingularMass`], [`Error::NonFiniteState`]. Cost: `N³/3 + N²`.
+pub(crate) fn initial_from_equation<T: Real, const N: usize>(
+    u0: &SVector<T, N>,
+    v0: &SVector<T, N>,
+    m: &SMatrix<T, N, N>,
+    mut r: SVector<T, N>,
+) -> Result<State<T, N>, Error> {
+    let scale = m.iter().fold(T::zero(), |s, x| s.max(x.abs()));
+    let mut lu = *m;
+    if !solve_in_place(&mut lu, &mut r, scale) {
+        return Err(Error::SingularMass);
+    }
+    State::initial_computed(u0, v0, r)
 }
 
 /// Solve `A x = b` in place (`b` becomes `x`) by Gaussian elimination with partial

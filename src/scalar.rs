@@ -1,6 +1,6 @@
 //! The scalar types the kernel runs in: `f32` and `f64`.
 
-use nalgebra::RealField;
+use nalgebra::{RealField, SVector};
 
 mod sealed {
     pub trait Sealed {}
@@ -17,6 +17,20 @@ pub trait Real: RealField + Copy + sealed::Sealed {
     fn as_f64(self) -> f64;
     /// Round an `f64` to `Self` (round-to-nearest; exact for `f64`).
     fn from_f64_rounded(x: f64) -> Self;
+}
+
+/// The input check of every start-up function: `u0`, `v0` and the load at `t = 0` (`p0`,
+/// or `w0` of an input map) are finite. (A chained iterator: on Cortex-M it compiles
+/// smaller than a loop over slices.)
+pub(crate) fn initial_inputs_finite<T: Real, const N: usize, const I: usize>(
+    u0: &SVector<T, N>,
+    v0: &SVector<T, N>,
+    p0: &SVector<T, I>,
+) -> bool {
+    u0.iter()
+        .chain(v0.iter())
+        .chain(p0.iter())
+        .all(|x| x.is_finite())
 }
 
 impl Real for f32 {

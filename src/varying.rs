@@ -18,7 +18,8 @@ use core::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::nonlinear::solve_in_place;
+use crate::nonlinear::{initial_from_equation, solve_in_place};
+use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
 /// The coefficient matrices at one instant.
@@ -93,10 +94,6 @@ fn finite_coefficients<T: Real, const N: usize>(k: &Coefficients<T, N>) -> bool 
         .all(|x| x.is_finite())
 }
 
-fn max_abs<T: Real, const N: usize>(a: &SMatrix<T, N, N>) -> T {
-    a.iter().fold(T::zero(), |s, x| s.max(x.abs()))
-}
-
 impl<T: Real, const N: usize> Varying<T, N> {
     /// A stepper with time step `h` (s).
     ///
@@ -131,21 +128,12 @@ impl<T: Real, const N: usize> Varying<T, N> {
         v0: &SVector<T, N>,
         p0: &SVector<T, N>,
     ) -> Result<State<T, N>, Error> {
-        let finite = u0
-            .iter()
-            .chain(v0.iter())
-            .chain(p0.iter())
-            .all(|x| x.is_finite());
+        let finite = initial_inputs_finite(u0, v0, p0);
         let k = coefficients.coefficients(T::zero());
         if !(finite && finite_coefficients(&k)) {
             return Err(Error::NonFiniteInput);
         }
-        let mut a0 = p0 - k.damping * v0 - k.stiffness * u0;
-        let mut lu = k.mass;
-        if !solve_in_place(&mut lu, &mut a0, max_abs(&k.mass)) {
-            return Err(Error::SingularMass);
-        }
-        State::initial_computed(u0, v0, a0)
+        initial_from_equation(u0, v0, &k.mass, p0 - k.damping * v0 - k.stiffness * u0)
     }
 
     /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M(0)`).
