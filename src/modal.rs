@@ -255,6 +255,10 @@ const fn sqrt(x: f64) -> f64 {
     y
 }
 
+/// The sweep budget of [`jacobi_eigen`]: far beyond what quadratic convergence needs; a
+/// guard, not a tuning knob.
+const JACOBI_MAX_SWEEPS: u32 = 64;
+
 /// Eigen-decomposition of a symmetric `a` by cyclic Jacobi rotations: `(λ, V)` with
 /// `a V = V diag(λ)`, `V` orthogonal (row-major), unsorted.
 ///
@@ -262,7 +266,12 @@ const fn sqrt(x: f64) -> f64 {
 /// bounds that a const-generic `N` cannot meet without leaking type-level integers into
 /// every caller, and it is not `const`. Jacobi is backward stable, accurate to `O(ε‖a‖)`
 /// and converges quadratically (≲ 10 sweeps for `N ≤ 50`); `≈ 4N³` flops a sweep.
-const fn jacobi_eigen<const N: usize>(mut a: Rows<N>) -> Result<([f64; N], Rows<N>), Error> {
+/// [`Error::EigenNotConverged`] after `max_sweeps` sweeps (callers pass
+/// [`JACOBI_MAX_SWEEPS`]).
+const fn jacobi_eigen<const N: usize>(
+    mut a: Rows<N>,
+    max_sweeps: u32,
+) -> Result<([f64; N], Rows<N>), Error> {
     let mut v = [[0.0; N]; N];
     let mut fro2 = 0.0;
     let mut i = 0;
@@ -276,9 +285,8 @@ const fn jacobi_eigen<const N: usize>(mut a: Rows<N>) -> Result<([f64; N], Rows<
         i += 1;
     }
     let fro = sqrt(fro2);
-    // 64 sweeps: far beyond what quadratic convergence needs; a guard, not a tuning knob.
     let mut sweep = 0;
-    while sweep < 64 {
+    while sweep < max_sweeps {
         let mut off = 0.0;
         let mut p = 0;
         while p < N {
@@ -472,7 +480,7 @@ const fn modes_of<const N: usize>(m: &Rows<N>, k: &Rows<N>) -> Result<([f64; N],
         }
         i += 1;
     }
-    let (lam, q) = match jacobi_eigen(a) {
+    let (lam, q) = match jacobi_eigen(a, JACOBI_MAX_SWEEPS) {
         Ok(e) => e,
         Err(e) => return Err(e),
     };
@@ -1025,6 +1033,25 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The sweep guard: a matrix that needs rotations fails with `EigenNotConverged` when
+    /// the budget is too small, and converges within the real budget.
+    #[test]
+    fn jacobi_reports_non_convergence_past_its_sweep_budget() {
+        let a = [[2.0, 1.0, 0.5], [1.0, 3.0, 0.25], [0.5, 0.25, 4.0]];
+        assert_eq!(
+            jacobi_eigen(a, 0).map(|_| ()),
+            Err(Error::EigenNotConverged)
+        );
+        assert_eq!(
+            jacobi_eigen(a, 1).map(|_| ()),
+            Err(Error::EigenNotConverged)
+        );
+        let (lam, _) = jacobi_eigen(a, JACOBI_MAX_SWEEPS).unwrap();
+        // Trace and determinant are invariants: Σλ = 9, Πλ = det a = 19.375.
+        assert!((lam.iter().sum::<f64>() - 9.0).abs() < 1e-14);
+        assert!((lam.iter().product::<f64>() - 19.375).abs() < 1e-12);
+    }
 
     /// The `const` square root is within 1 ulp of the correctly rounded one (libm's
     /// `sqrt` is correctly rounded) over 40 decades and at the edges.
