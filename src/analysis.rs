@@ -44,7 +44,10 @@ pub type Complex = (f64, f64);
 /// analysed).
 ///
 /// Cost: three steps and `O(1)` flops.
-pub fn amplification_matrix<T: Real, S: Stepper<T, 1>>(stepper: &S) -> Matrix3 {
+pub fn amplification_matrix<T: Real, S>(stepper: &S) -> Matrix3
+where
+    S: Stepper<T, 1, Input = SVector<T, 1>, State = State<T, 1>>,
+{
     let h = stepper.time_step().as_f64();
     // Raw columns: the images of the unit states e_u, e_v, e_a.
     let mut raw = [[0.0; 3]; 3];
@@ -266,21 +269,21 @@ pub enum Scheme {
 pub fn sdof(scheme: Scheme, s: f64, xi: f64) -> Result<SdofProperties, Error> {
     let (m, c, k) = (matrix![1.0], matrix![2.0 * xi], matrix![1.0]);
     let a = match scheme {
-        Scheme::Aem => amplification_matrix(&Linear::new(&m, &c, &k, s)?),
+        Scheme::Aem => amplification_matrix(&Linear::<f64, 1>::new(&m, &c, &k, s)?),
         Scheme::AemAForm => {
             let f: AForm<f64, 1> = Linear::new(&m, &c, &k, s)?.a_form();
             amplification_matrix(&f)
         }
         Scheme::Newmark { beta, gamma } => {
-            amplification_matrix(&Newmark::new(&m, &c, &k, s, beta, gamma)?)
+            amplification_matrix(&Newmark::<f64, 1>::new(&m, &c, &k, s, beta, gamma)?)
         }
         Scheme::GeneralizedAlpha { rho_inf } => {
-            amplification_matrix(&GeneralizedAlpha::new(&m, &c, &k, s, rho_inf)?)
+            amplification_matrix(&GeneralizedAlpha::<f64, 1>::new(&m, &c, &k, s, rho_inf)?)
         }
         Scheme::Hht { alpha } => {
-            amplification_matrix(&GeneralizedAlpha::hht(&m, &c, &k, s, alpha)?)
+            amplification_matrix(&GeneralizedAlpha::<f64, 1>::hht(&m, &c, &k, s, alpha)?)
         }
-        Scheme::Exact => amplification_matrix(&Exact::new(&m, &c, &k, s)?),
+        Scheme::Exact => amplification_matrix(&Exact::<f64, 1>::new(&m, &c, &k, s)?),
     };
     Ok(SdofProperties::from_matrix(a, s, xi))
 }

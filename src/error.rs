@@ -54,6 +54,10 @@ pub enum Error {
     NonClassicalDamping,
     /// The symmetric eigen-solver did not converge (only with pathological input).
     EigenNotConverged,
+    /// An operator computed from the data overflows the scalar type: it is not finite in
+    /// `f64`, or exceeds the largest finite value of `T` (e.g. `f32`) and would round to
+    /// `∞`.
+    OperatorOverflow,
     /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) is not finite or is
     /// outside its documented range.
     InvalidParameter,
@@ -98,6 +102,7 @@ impl Error {
             }
             Error::EigenNotConverged => "the symmetric eigen-solver did not converge",
             Error::InvalidParameter => "a scheme parameter is not finite or out of range",
+            Error::OperatorOverflow => "an operator overflows the scalar type",
         }
     }
 }

@@ -38,34 +38,42 @@
 #[cfg(feature = "std")]
 extern crate std;
 
-mod aform;
-pub mod analysis;
+/// The `nalgebra` this crate's API is written in (version 0.35): use `aemstep::nalgebra`
+/// so your matrices and vectors are the same types as the crate's.
+pub use nalgebra;
+
+// The state and the interface every scheme shares.
 mod error;
-mod exact;
-mod generalized_alpha;
-mod input;
-mod linear;
-pub mod modal;
-pub mod models;
-mod newmark;
-mod nonlinear;
-mod ops;
 mod scalar;
 mod state;
-mod varying;
+mod stepper;
 
-pub use aform::AForm;
+// The kernel: the shared predictor–corrector and the blocked step over interleaved rows.
+mod kinematics;
+mod kernel;
+
+// Dense linear algebra (LU, Cholesky, symmetric eigen, matrix exponential), in one place.
+mod linalg;
+
+// The constant-coefficient schemes, one file each.
+mod schemes;
+
+// Nonlinear (Newton) and time-varying steppers.
+mod nonlinear;
+
+// Modal reduction, stability analysis, ready-made models.
+pub mod analysis;
+pub mod modal;
+pub mod models;
+
 pub use error::Error;
-pub use exact::Exact;
-pub use generalized_alpha::{AlphaParameters, GeneralizedAlpha};
-pub use input::LinearInput;
-pub use linear::Linear;
 pub use modal::{Damping, Modal, ModalState};
-pub use newmark::Newmark;
+pub use nonlinear::varying::{Coefficients, TimeVarying, Varying};
 pub use nonlinear::{Iterations, Model, NewtonReport, NewtonSettings, Nonlinear, Tangent};
 pub use scalar::Real;
-pub use state::{State, Stepper};
-pub use varying::{Coefficients, TimeVarying, Varying};
+pub use schemes::{AForm, AlphaParameters, Exact, GeneralizedAlpha, Linear, LinearInput, Newmark};
+pub use state::State;
+pub use stepper::{StepInput, StepState, Stepper};
 
 /// The README's code blocks, compiled and run as doctests.
 #[cfg(doctest)]

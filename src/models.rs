@@ -3,9 +3,7 @@
 //!
 //! The benchmark building of this repository's tables is [`five_storey_building`].
 
-/// A row-major `N×N` matrix of `f64` (`a[i][j]`: row `i`, column `j`), the form
-/// [`Linear::from_rows`](crate::Linear::from_rows) takes.
-pub type Rows<const N: usize> = [[f64; N]; N];
+pub use crate::linalg::Rows;
 
 /// Lumped masses and storey stiffnesses of a shear building with `N` storeys, ground
 /// storey first: returns `(M, K)`, `M = diag(m)`, `K` tridiagonal with
@@ -76,6 +74,37 @@ pub const fn five_storey_building() -> (Rows<5>, Rows<5>, Rows<5>) {
     let (a0, a1) = rayleigh_coefficients(w1, w2, FIVE_STOREY_DAMPING);
     let c = rayleigh(&m, &k, a0, a1);
     (m, c, k)
+}
+
+/// The output matrix of the `N` inter-storey drifts of a shear building with DOFs ground
+/// storey first: row `i` is `u_i − u_{i−1}` (`u_{−1} = 0`, the ground). `const`.
+pub const fn storey_drifts<const N: usize>() -> Rows<N> {
+    let mut y = [[0.0; N]; N];
+    let mut i = 0;
+    while i < N {
+        y[i][i] = 1.0;
+        if i > 0 {
+            y[i][i - 1] = -1.0;
+        }
+        i += 1;
+    }
+    y
+}
+
+/// The influence matrix `B = −M ι` (`ι = (1, …, 1)`) of base excitation: with it,
+/// `p = B a_g(t)` for a ground acceleration `a_g` and `u` relative to the ground. `const`.
+pub const fn base_excitation<const N: usize>(m: &Rows<N>) -> [[f64; 1]; N] {
+    let mut b = [[0.0; 1]; N];
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < N {
+            b[i][0] -= m[i][j];
+            j += 1;
+        }
+        i += 1;
+    }
+    b
 }
 
 #[cfg(test)]

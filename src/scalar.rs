@@ -17,6 +17,10 @@ pub trait Real: RealField + Copy + sealed::Sealed {
     fn as_f64(self) -> f64;
     /// Round an `f64` to `Self` (round-to-nearest; exact for `f64`).
     fn from_f64_rounded(x: f64) -> Self;
+    /// The largest finite value of `Self`, as `f64` (operators above it are rejected with
+    /// [`Error::OperatorOverflow`](crate::Error::OperatorOverflow) instead of rounding to
+    /// `∞`).
+    const MAX: f64;
 }
 
 /// The input check of every start-up function: `u0`, `v0` and the load at `t = 0` (`p0`,
@@ -34,6 +38,7 @@ pub(crate) fn initial_inputs_finite<T: Real, const N: usize, const I: usize>(
 }
 
 impl Real for f32 {
+    const MAX: f64 = f32::MAX as f64;
     #[inline(always)]
     fn as_f64(self) -> f64 {
         self as f64
@@ -45,6 +50,7 @@ impl Real for f32 {
 }
 
 impl Real for f64 {
+    const MAX: f64 = f64::MAX;
     #[inline(always)]
     fn as_f64(self) -> f64 {
         self

@@ -1,8 +1,8 @@
-//! The state every stepper advances, and the interface they share.
+//! The state every full-order stepper advances.
 
 use nalgebra::SVector;
 
-use crate::{Error, Real};
+use crate::{Error, Real, StepState};
 
 /// The state at step `n`: displacement `u`, velocity `v`, acceleration `a` (the paper's
 /// fictitious load `q`) and the step count. Time is `n·h`, computed from the count
@@ -93,99 +93,13 @@ impl<T: Real + defmt::Format, const N: usize> defmt::Format for State<T, N> {
     }
 }
 
-/// A fixed-step integrator for `M u'' + C u' + K u = p(t)` with `N` degrees of freedom.
-///
-/// Every scheme of the crate implements it, so switching scheme is a one-line change.
-pub trait Stepper<T: Real, const N: usize> {
-    /// The time step `h` (s).
-    fn time_step(&self) -> T;
-
-    /// The state at `t = 0` with the initial acceleration from the equation of motion,
-    /// `a0 = M⁻¹ (p0 − C v0 − K u0)` (paper eq. 40).
-    ///
-    /// Errors: [`Error::NonFiniteInput`]; [`Error::SingularMass`] if `M` is singular.
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error>;
-
-    /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M`).
-    ///
-    /// Errors: [`Error::NonFiniteInput`].
-    fn start_with_acceleration(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        a0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        State::initial_given(u0, v0, a0)
-    }
-
-    /// Advance `state` from `t_{n−1}` to `t_n` under the load `p_n = p(t_n)`.
-    ///
-    /// Fixed cost, no allocation, no panic, no data-dependent branch. A NaN load gives a
-    /// NaN state: use [`Stepper::try_step`] where that must not happen.
-    fn step(&self, state: &mut State<T, N>, p: &SVector<T, N>);
-
-    /// Advance with the load samples at both ends of the step, `p_prev = p(t_{n−1})` and
-    /// `p = p(t_n)` — what a loop over a sampled signal has anyway. Generic code that
-    /// calls this drives every scheme at its full order:
-    ///
-    /// - schemes whose step depends on `p_n` only — the AEM ([`Linear`](crate::Linear),
-    ///   [`AForm`](crate::AForm)), [`Newmark`](crate::Newmark), and
-    ///   [`Exact`](crate::Exact), which recovers `p_{n−1}` from its state — ignore
-    ///   `p_prev` (this default);
-    /// - [`GeneralizedAlpha`](crate::GeneralizedAlpha) takes the load as
-    ///   `(1 − α_f) p + α_f p_prev`, the textbook form; through [`Stepper::step`] it must
-    ///   assume `p_prev = p`, which is first order for a time-varying load.
-    ///
-    /// Cost, panics, allocation: as [`Stepper::step`].
+impl<T: Real, const N: usize> StepState for State<T, N> {
     #[inline]
-    fn step_with_previous_load(
-        &self,
-        state: &mut State<T, N>,
-        p_prev: &SVector<T, N>,
-        p: &SVector<T, N>,
-    ) {
-        let _ = p_prev;
-        self.step(state, p);
+    fn is_finite(&self) -> bool {
+        State::is_finite(self)
     }
-
-    /// [`Stepper::step`], committed only if the new state is finite.
-    ///
-    /// Errors: [`Error::NonFiniteState`] (e.g. a NaN load sample), leaving `state`
-    /// bit-identical to what it was. Cost: one step plus a copy and a scan of `3N` values.
-    fn try_step(&self, state: &mut State<T, N>, p: &SVector<T, N>) -> Result<(), Error> {
-        commit_if_finite(state, |next| self.step(next, p))
-    }
-
-    /// [`Stepper::step_with_previous_load`], committed only if the new state is finite.
-    ///
-    /// Errors: as [`Stepper::try_step`]; `state` is unchanged on error.
-    fn try_step_with_previous_load(
-        &self,
-        state: &mut State<T, N>,
-        p_prev: &SVector<T, N>,
-        p: &SVector<T, N>,
-    ) -> Result<(), Error> {
-        commit_if_finite(state, |next| self.step_with_previous_load(next, p_prev, p))
-    }
-}
-
-/// Run `step` on a copy of `state` and commit it only if the result is finite.
-#[inline]
-fn commit_if_finite<T: Real, const N: usize>(
-    state: &mut State<T, N>,
-    step: impl FnOnce(&mut State<T, N>),
-) -> Result<(), Error> {
-    let mut next = *state;
-    step(&mut next);
-    if next.is_finite() {
-        *state = next;
-        Ok(())
-    } else {
-        Err(Error::NonFiniteState)
+    #[inline]
+    fn steps(&self) -> u64 {
+        self.n
     }
 }

@@ -18,7 +18,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::linear::{StartOps, initial_state, mat_vec_blocked};
+use crate::kernel::{StartOps, initial_state, mat_vec_blocked};
 use crate::{Error, Real, State, Stepper};
 
 /// The amplification operator `A` and load operator `b` of the linear AEM step, as
@@ -94,6 +94,9 @@ impl<T: Real, const N: usize> AForm<T, N> {
 }
 
 impl<T: Real, const N: usize> Stepper<T, N> for AForm<T, N> {
+    type Input = SVector<T, N>;
+    type State = State<T, N>;
+
     fn time_step(&self) -> T {
         self.h
     }
@@ -106,6 +109,8 @@ impl<T: Real, const N: usize> Stepper<T, N> for AForm<T, N> {
     ) -> Result<State<T, N>, Error> {
         initial_state(self.start.as_ref(), u0, v0, p0)
     }
+
+    crate::stepper::full_order_state!();
 
     /// Cost: `12N²` multiply-adds.
     #[inline]

@@ -18,10 +18,14 @@
 //! an analytic tangent the tangent evaluation is `N` extra force evaluations (a directional
 //! finite difference per column of `J`). Stack: about three `N×N` matrices of `T`.
 
+pub(crate) mod varying;
+
 use core::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::kinematics::Kinematics;
+use crate::linalg::lu::solve_in_place;
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
@@ -168,7 +172,7 @@ pub struct NewtonReport<T> {
 ///
 /// ```
 /// use aemstep::{Model, NewtonSettings, Nonlinear, Tangent};
-/// use nalgebra::{matrix, vector, SMatrix, SVector};
+/// use aemstep::nalgebra::{matrix, vector, SMatrix, SVector};
 ///
 /// struct Duffing;
 /// impl Model<f32, 1> for Duffing {
@@ -186,10 +190,10 @@ pub struct NewtonReport<T> {
 /// // exact solution u = e^{-0.1t} sin t, so p(t) = -0.01 e^{-0.1t} sin t + e^{-0.3t} sin³t
 /// let p = |t: f32| vector![-0.01 * (-0.1 * t).exp() * t.sin() + (-0.3 * t).exp() * t.sin().powi(3)];
 /// let h = 0.01;
-/// let stepper = Nonlinear::<f32, 1>::new(h, NewtonSettings::exactly(2, 1e-5))?;
+/// let stepper = Nonlinear::<f32, 1>::new(0.01, NewtonSettings::exactly(2, 1e-5))?;
 /// let mut s = stepper.start(&Duffing, &vector![0.0], &vector![1.0], &p(0.0))?;
 /// for n in 1..=300 {
-///     let report = stepper.step(&Duffing, &mut s, &p(n as f32 * h))?;
+///     let report = stepper.try_step(&Duffing, &mut s, &p(n as f32 * h))?;
 ///     assert!(report.converged && report.iterations == 2);
 /// }
 /// let t = 3.0f32;
@@ -198,34 +202,28 @@ pub struct NewtonReport<T> {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Nonlinear<T, const N: usize> {
-    h: T,
-    half_h: T,
-    quarter_h2: T,
+    kin: Kinematics<T>,
     settings: NewtonSettings<T>,
     _n: PhantomData<[T; N]>,
 }
 
 impl<T: Real, const N: usize> Nonlinear<T, N> {
-    /// A stepper with time step `h` (s) and the given Newton settings.
+    /// A stepper with time step `h` (s, in `f64` like every constructor; the kinematics
+    /// are rounded once to `T`) and the given Newton settings.
     ///
     /// Errors: [`Error::InvalidTimeStep`] (`h` not finite or `≤ 0`),
     /// [`Error::InvalidNewtonSettings`] (zero iterations, or a tolerance that is negative
     /// or not finite). Cost: O(1).
-    pub fn new(h: T, settings: NewtonSettings<T>) -> Result<Self, Error> {
-        if !(h.is_finite() && h > T::zero()) {
-            return Err(Error::InvalidTimeStep);
-        }
+    pub fn new(h: f64, settings: NewtonSettings<T>) -> Result<Self, Error> {
+        let kin = Kinematics::aem(h)?.round();
         let budget = match settings.iterations {
             Iterations::UpTo(k) | Iterations::Exactly(k) => k,
         };
         if budget == 0 || !settings.tolerance.is_finite() || settings.tolerance < T::zero() {
             return Err(Error::InvalidNewtonSettings);
         }
-        let hf = h.as_f64();
         Ok(Self {
-            h,
-            half_h: T::from_f64_rounded(0.5 * hf),
-            quarter_h2: T::from_f64_rounded(0.25 * hf * hf),
+            kin,
             settings,
             _n: PhantomData,
         })
@@ -233,7 +231,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
 
     /// The time step `h` (s).
     pub fn time_step(&self) -> T {
-        self.h
+        self.kin.h
     }
 
     /// The Newton settings.
@@ -291,7 +289,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
     /// iteration budget, see [`NewtonSettings::tolerance`]), [`Error::NonFiniteState`].
     ///
     /// Cost: see [`Nonlinear`]; no allocation, no panic.
-    pub fn step<Mo: Model<T, N> + ?Sized>(
+    pub fn try_step<Mo: Model<T, N> + ?Sized>(
         &self,
         model: &Mo,
         state: &mut State<T, N>,
@@ -309,7 +307,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
     /// when Newton did not converge (then `report.converged` is `false` and the caller
     /// decides: accept it, retry with a smaller step, or stop).
     ///
-    /// Errors: as [`Nonlinear::step`] except [`Error::NotConverged`]. Cost: as a step.
+    /// Errors: as [`Nonlinear::try_step`] except [`Error::NotConverged`]. Cost: as a step.
     pub fn trial_step<Mo: Model<T, N> + ?Sized>(
         &self,
         model: &Mo,
@@ -323,9 +321,8 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         if !m.iter().all(|x| x.is_finite()) {
             return Err(Error::NonFiniteInput);
         }
-        let (b, c) = (self.half_h, self.quarter_h2);
-        let vh = state.v + state.a * b;
-        let uh = state.u + state.v * self.h + state.a * c;
+        let (b, c) = (self.kin.gamma_h, self.kin.beta_h2);
+        let (vh, uh) = self.kin.predict_all(&state.u, &state.v, &state.a);
         let (budget, fixed) = match self.settings.iterations {
             Iterations::UpTo(k) => (k, false),
             Iterations::Exactly(k) => (k, true),
@@ -335,8 +332,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         let mut iterations = 0u32;
         let mut last_delta = T::zero();
         loop {
-            let u = uh + q * c;
-            let v = vh + q * b;
+            let (v, u) = self.kin.correct_all(&vh, &uh, &q);
             let f = model.force(&u, &v);
             if !all_finite(&f) {
                 return Err(Error::NonFiniteForce);
@@ -487,61 +483,4 @@ pub(crate) fn initial_from_equation<T: Real, const N: usize>(
         return Err(Error::SingularMass);
     }
     State::initial_computed(u0, v0, r)
-}
-
-/// Solve `A x = b` in place (`b` becomes `x`) by Gaussian elimination with partial
-/// pivoting; `a` is overwritten. Returns `false` — with `b` unspecified — when a pivot is
-/// at most `N·ε·scale` (`scale`: the magnitude of `A`'s entries), i.e. `A` is singular to
-/// working precision. Cost: `N³/3 + N²` multiply-adds; no allocation, no panic.
-pub(crate) fn solve_in_place<T: Real, const N: usize>(
-    a: &mut SMatrix<T, N, N>,
-    b: &mut SVector<T, N>,
-    scale: T,
-) -> bool {
-    let tiny = T::from_f64_rounded(N as f64) * T::default_epsilon() * scale;
-    // Column-major storage, `a[c][r]` = A(r, c); plain array indexing with loop-bounded
-    // indices, which the compiler proves in bounds (no panic path in the binary).
-    let a = &mut a.data.0;
-    let x = &mut b.data.0[0];
-    for col in 0..N {
-        let mut piv = col;
-        let mut best = a[col][col].abs();
-        for r in col + 1..N {
-            let e = a[col][r].abs();
-            if e > best {
-                best = e;
-                piv = r;
-            }
-        }
-        // A NaN or infinite pivot is rejected too.
-        if !best.is_finite() || best <= tiny {
-            return false;
-        }
-        if piv != col {
-            for column in a.iter_mut() {
-                column.swap(piv, col);
-            }
-            x.swap(piv, col);
-        }
-        let d = a[col][col];
-        for r in col + 1..N {
-            let f = a[col][r] / d;
-            if f != T::zero() {
-                for k in col + 1..N {
-                    let p = a[k][col];
-                    a[k][r] -= f * p;
-                }
-                let xc = x[col];
-                x[r] -= f * xc;
-            }
-        }
-    }
-    for col in (0..N).rev() {
-        let mut s = x[col];
-        for k in col + 1..N {
-            s -= a[k][col] * x[k];
-        }
-        x[col] = s / a[col][col];
-    }
-    true
 }

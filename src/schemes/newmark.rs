@@ -14,56 +14,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::linear::{StartOps, initial_state, interleave, newmark_step};
-pub(crate) use crate::linear::{round_rows, rows_f64};
-use crate::ops::{self, Mat};
+use crate::kernel::{StartOps, interleave, initial_state, newmark_operators, newmark_step};
+use crate::kinematics::Kinematics;
+use crate::linalg::{self, rows_f64};
 use crate::{Error, Real, State, Stepper};
-
-/// `y += A x` for a row-major `A`.
-#[inline(always)]
-pub(crate) fn mac<T: Real, const N: usize>(y: &mut [T; N], a: &[[T; N]; N], x: &[T; N]) {
-    for i in 0..N {
-        let mut s = T::zero();
-        for j in 0..N {
-            s += a[i][j] * x[j];
-        }
-        y[i] += s;
-    }
-}
-
-/// Check inputs; `(M, C, K)` in `f64` and the start-up operators (`None` if `M` is
-/// singular).
-pub(crate) type Checked<const N: usize> = (Mat<N>, Mat<N>, Mat<N>, Option<StartOps<f64, N>>);
-
-pub(crate) fn check_inputs<T: Real, const N: usize>(
-    m: &SMatrix<T, N, N>,
-    c: &SMatrix<T, N, N>,
-    k: &SMatrix<T, N, N>,
-    h: T,
-) -> Result<Checked<N>, Error> {
-    let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
-    if !(ops::all_finite(&m) && ops::all_finite(&c) && ops::all_finite(&k)) {
-        return Err(Error::NonFiniteInput);
-    }
-    let hf = h.as_f64();
-    if !(hf.is_finite() && hf > 0.0) {
-        return Err(Error::InvalidTimeStep);
-    }
-    let start = ops::inverse(&m).map(|mi| StartOps {
-        minv: mi,
-        minv_c: ops::mul(&mi, &c),
-        minv_k: ops::mul(&mi, &k),
-    });
-    Ok((m, c, k, start))
-}
-
-pub(crate) fn round_start<T: Real, const N: usize>(s: &StartOps<f64, N>) -> StartOps<T, N> {
-    StartOps {
-        minv: round_rows(&s.minv),
-        minv_c: round_rows(&s.minv_c),
-        minv_k: round_rows(&s.minv_k),
-    }
-}
 
 /// A Newmark-family stepper (β, γ) for constant `M, C, K`.
 ///
@@ -72,16 +26,16 @@ pub(crate) fn round_start<T: Real, const N: usize>(s: &StartOps<f64, N>) -> Star
 ///
 /// ```
 /// use aemstep::{Linear, Newmark, Stepper};
-/// use nalgebra::{matrix, vector};
+/// use aemstep::nalgebra::{matrix, vector};
 /// let (m, c, k, h) = (matrix![1.0], matrix![0.0], matrix![25.0], 0.01);
 /// // let sys = Linear::new(&m, &c, &k, h)?;
-/// let sys = Newmark::linear_acceleration(&m, &c, &k, h)?;
+/// let sys = Newmark::<f64, 1>::linear_acceleration(&m, &c, &k, h)?;
 /// let mut s = sys.start(&vector![1.0], &vector![0.0], &vector![0.0])?;
 /// for _ in 0..100 {
 ///     sys.step(&mut s, &vector![0.0]);
 /// }
 /// assert!((s.u()[0] - 5.0f64.cos()).abs() < 1e-3);
-/// # let _ = Linear::new(&m, &c, &k, h)?;
+/// # let _ = Linear::<f64, 1>::new(&m, &c, &k, h)?;
 /// # Ok::<(), aemstep::Error>(())
 /// ```
 ///
@@ -92,8 +46,7 @@ pub(crate) fn round_start<T: Real, const N: usize>(s: &StartOps<f64, N>) -> Star
 pub struct Newmark<T, const N: usize> {
     /// `[G[i], −GC[i], −GK[i]]` for every row `i`, as in `Linear`.
     ops: [[[T; N]; 3]; N],
-    /// `[h, (1 − γ) h, (β + 1/2 − γ) h², γ h, β h²]`: the kinematics of `newmark_step`.
-    coef: [T; 5],
+    kin: Kinematics<T>,
     start: Option<StartOps<T, N>>,
 }
 
@@ -104,50 +57,40 @@ impl<T: Real, const N: usize> Newmark<T, N> {
     ///
     /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
     /// [`Error::InvalidParameter`] (β or γ negative or not finite),
-    /// [`Error::SingularEffectiveMatrix`] (`M + γh C + βh² K` singular; e.g. central
-    /// difference with singular `M`).
+    /// [`Error::SingularEffectiveMatrix`] (`M + γh C + βh² K` singular to working
+    /// precision against its terms; e.g. central difference with singular `M`),
+    /// [`Error::OperatorOverflow`].
     ///
     /// Cost: about `5N³` flops in `f64`, four `N×N` `f64` temporaries on the stack.
     pub fn new(
-        m: &SMatrix<T, N, N>,
-        c: &SMatrix<T, N, N>,
-        k: &SMatrix<T, N, N>,
-        h: T,
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        h: f64,
         beta: f64,
         gamma: f64,
     ) -> Result<Self, Error> {
-        let (m, c, k, start) = check_inputs(m, c, k, h)?;
-        if !(beta.is_finite() && gamma.is_finite() && beta >= 0.0 && gamma >= 0.0) {
-            return Err(Error::InvalidParameter);
-        }
-        let hf = h.as_f64();
-        let meff = ops::add_scaled(&ops::add_scaled(&m, gamma * hf, &c), beta * hf * hf, &k);
-        let g = ops::inverse(&meff).ok_or(Error::SingularEffectiveMatrix)?;
-        let coef = [
-            hf,
-            (1.0 - gamma) * hf,
-            (beta + 0.5 - gamma) * hf * hf,
-            gamma * hf,
-            beta * hf * hf,
-        ];
+        let op = newmark_operators(&rows_f64(m), &rows_f64(c), &rows_f64(k), h, beta, gamma, T::MAX)?;
+        let one = T::one();
+        let (g, gc, gk) = (
+            linalg::round_rows(&op.g),
+            linalg::round_rows(&op.gc),
+            linalg::round_rows(&op.gk),
+        );
         Ok(Self {
-            ops: interleave(
-                &round_rows(&g),
-                &round_rows(&ops::mul(&g, &c)),
-                &round_rows(&ops::mul(&g, &k)),
-            ),
-            coef: coef.map(T::from_f64_rounded),
-            start: start.as_ref().map(round_start),
+            ops: interleave([&g, &gc, &gk], [one, -one, -one]),
+            kin: op.kin.round(),
+            start: op.start.map(|(_, s)| s.round()),
         })
     }
 
     /// Average acceleration (trapezoidal), β = 1/4, γ = 1/2: the same recurrence as the
     /// AEM [`Linear`](crate::Linear) (bit-identical operators). Errors: as [`Newmark::new`].
     pub fn average_acceleration(
-        m: &SMatrix<T, N, N>,
-        c: &SMatrix<T, N, N>,
-        k: &SMatrix<T, N, N>,
-        h: T,
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        h: f64,
     ) -> Result<Self, Error> {
         Self::new(m, c, k, h, 0.25, 0.5)
     }
@@ -155,10 +98,10 @@ impl<T: Real, const N: usize> Newmark<T, N> {
     /// Linear acceleration, β = 1/6, γ = 1/2: second order, stable for `ωh ≤ 2√3`.
     /// Errors: as [`Newmark::new`].
     pub fn linear_acceleration(
-        m: &SMatrix<T, N, N>,
-        c: &SMatrix<T, N, N>,
-        k: &SMatrix<T, N, N>,
-        h: T,
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        h: f64,
     ) -> Result<Self, Error> {
         Self::new(m, c, k, h, 1.0 / 6.0, 0.5)
     }
@@ -166,19 +109,22 @@ impl<T: Real, const N: usize> Newmark<T, N> {
     /// Central difference, β = 0, γ = 1/2: second order, stable for `ωh ≤ 2`
     /// (undamped). Needs `M + (h/2) C` invertible. Errors: as [`Newmark::new`].
     pub fn central_difference(
-        m: &SMatrix<T, N, N>,
-        c: &SMatrix<T, N, N>,
-        k: &SMatrix<T, N, N>,
-        h: T,
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        h: f64,
     ) -> Result<Self, Error> {
         Self::new(m, c, k, h, 0.0, 0.5)
     }
 }
 
 impl<T: Real, const N: usize> Stepper<T, N> for Newmark<T, N> {
+    type Input = SVector<T, N>;
+    type State = State<T, N>;
+
     #[inline]
     fn time_step(&self) -> T {
-        self.coef[0]
+        self.kin.h
     }
 
     fn start(
@@ -193,6 +139,8 @@ impl<T: Real, const N: usize> Stepper<T, N> for Newmark<T, N> {
     /// Cost: `3N²` multiply-adds + `7N` (the kernel [`Linear`](crate::Linear) steps with).
     #[inline]
     fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
-        newmark_step(&self.ops, self.coef, s, p);
+        newmark_step(&self.ops, &self.kin, s, p);
     }
+
+    crate::stepper::full_order_state!();
 }

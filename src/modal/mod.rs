@@ -23,9 +23,11 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::models::Rows;
-use crate::ops;
-use crate::{Error, Real, State};
+use crate::kinematics::Kinematics;
+use crate::linalg::cholesky::{cholesky, lower_solve, lower_transpose_solve};
+use crate::linalg::symmetric_eigen::{JACOBI_MAX_SWEEPS, jacobi_eigen};
+use crate::linalg::{self, Rows, all_finite, max_abs, mul, rows_f64, sqrt, transpose};
+use crate::{Error, Real, State, StepState, Stepper};
 
 /// Relative tolerance below which `M`, `K` count as symmetric: `|a_ij − a_ji| ≤
 /// 64 ε max|a|` (rounding of a matrix assembled in `f64`).
@@ -107,37 +109,6 @@ pub const fn lowest_modes<const R: usize>() -> [usize; R] {
     r
 }
 
-/// The output matrix of the `N` inter-storey drifts of a shear building with DOFs ground
-/// storey first: row `i` is `u_i − u_{i−1}` (`u_{−1} = 0`, the ground). `const`.
-pub const fn storey_drifts<const N: usize>() -> Rows<N> {
-    let mut y = [[0.0; N]; N];
-    let mut i = 0;
-    while i < N {
-        y[i][i] = 1.0;
-        if i > 0 {
-            y[i][i - 1] = -1.0;
-        }
-        i += 1;
-    }
-    y
-}
-
-/// The influence matrix `B = −M ι` (`ι = (1, …, 1)`) of base excitation: with it,
-/// `p = B a_g(t)` for a ground acceleration `a_g` and `u` relative to the ground. `const`.
-pub const fn base_excitation<const N: usize>(m: &Rows<N>) -> [[f64; 1]; N] {
-    let mut b = [[0.0; 1]; N];
-    let mut i = 0;
-    while i < N {
-        let mut j = 0;
-        while j < N {
-            b[i][0] -= m[i][j];
-            j += 1;
-        }
-        i += 1;
-    }
-    b
-}
-
 /// A modal (reduced) AEM stepper: `R` of the `N` modes of `M u'' + C u' + K u = B w(t)`,
 /// `I` input signals `w`, `O` outputs `y = Y u`.
 ///
@@ -151,17 +122,17 @@ pub const fn base_excitation<const N: usize>(m: &Rows<N>) -> [[f64; 1]; N] {
 /// by the compiler into flash); in `f64`, rounded once to `T`.
 ///
 /// ```
-/// use aemstep::{models, Damping, Modal};
-/// use aemstep::modal::{base_excitation, storey_drifts};
-/// use nalgebra::vector;
+/// use aemstep::{models, Damping, Modal, Stepper};
+/// use aemstep::models::{base_excitation, storey_drifts};
+/// use aemstep::nalgebra::vector;
 ///
 /// // The benchmark 5-storey building: 2 modes, base excitation, roof drift out.
 /// let (m, _c, k) = models::five_storey_building();
 /// let (w1, w2) = (9.0, 26.3); // rad/s, see `five_storey_building`
 /// let (a0, a1) = models::rayleigh_coefficients(w1, w2, 0.05);
 /// let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-/// let sys = Modal::<f32, 5, 2>::new(
-///     &m, &k, &Damping::Rayleigh { a0, a1 }, &base_excitation(&m), &roof, 0.02,
+/// let sys = Modal::<f32, 5, 2>::from_rows(
+///     m, k, Damping::Rayleigh { a0, a1 }, base_excitation(&m), roof, 0.02,
 /// )?;
 /// let mut s = sys.start_at_rest(&vector![0.0])?;
 /// sys.step(&mut s, &vector![0.1 * 9.80665]);
@@ -171,9 +142,7 @@ pub const fn base_excitation<const N: usize>(m: &Rows<N>) -> [[f64; 1]; N] {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Modal<T, const N: usize, const R: usize, const I: usize = 1, const O: usize = 1> {
-    h: T,
-    half_h: T,
-    quarter_h2: T,
+    kin: Kinematics<T>,
     /// `g_r Γ_r`: input projection times the modal effective inverse, `R×I`.
     g_gamma: [[T; I]; R],
     /// `g_r · 2ξ_r ω_r`.
@@ -199,23 +168,6 @@ pub struct Modal<T, const N: usize, const R: usize, const I: usize = 1, const O:
 // Construction, all in `const fn` `f64`: the same code serves `Modal::new` at run time and
 // `Modal::from_rows` evaluated by the compiler, so both give bit-identical operators.
 
-/// Largest `|a_ij|` (finite input: checked before every use).
-const fn max_abs<const R: usize, const C: usize>(a: &[[f64; C]; R]) -> f64 {
-    let mut s = 0.0f64;
-    let mut i = 0;
-    while i < R {
-        let mut j = 0;
-        while j < C {
-            if a[i][j].abs() > s {
-                s = a[i][j].abs();
-            }
-            j += 1;
-        }
-        i += 1;
-    }
-    s
-}
-
 const fn is_symmetric<const N: usize>(a: &Rows<N>) -> bool {
     let tol = SYMMETRY_TOL * max_abs(a);
     let mut i = 0;
@@ -230,227 +182,6 @@ const fn is_symmetric<const N: usize>(a: &Rows<N>) -> bool {
         i += 1;
     }
     true
-}
-
-/// `√x` for finite `x ≥ 0`, in `const`: Newton's iteration from a bit-level first guess
-/// (relative error ≤ 6 %), iterated until it stops changing (≤ 1 ulp from the correctly
-/// rounded root; at most 64 iterations, 6 for normal numbers). `NaN` for `x < 0`.
-const fn sqrt(x: f64) -> f64 {
-    if x == 0.0 || !x.is_finite() {
-        return x;
-    }
-    if x < 0.0 {
-        return f64::NAN;
-    }
-    let mut y = f64::from_bits((x.to_bits() >> 1) + 0x1FF8_0000_0000_0000);
-    let mut i = 0;
-    while i < 64 {
-        let z = 0.5 * (y + x / y);
-        if z == y {
-            break;
-        }
-        y = z;
-        i += 1;
-    }
-    y
-}
-
-/// The sweep budget of [`jacobi_eigen`]: far beyond what quadratic convergence needs; a
-/// guard, not a tuning knob.
-const JACOBI_MAX_SWEEPS: u32 = 64;
-
-/// Eigen-decomposition of a symmetric `a` by cyclic Jacobi rotations: `(λ, V)` with
-/// `a V = V diag(λ)`, `V` orthogonal (row-major), unsorted.
-///
-/// Jacobi rather than `nalgebra::SymmetricEigen`: the latter needs `Const<N>: DimSub<U1>`
-/// bounds that a const-generic `N` cannot meet without leaking type-level integers into
-/// every caller, and it is not `const`. Jacobi is backward stable, accurate to `O(ε‖a‖)`
-/// and converges quadratically (≲ 10 sweeps for `N ≤ 50`); `≈ 4N³` flops a sweep.
-/// [`Error::EigenNotConverged`] after `max_sweeps` sweeps (callers pass
-/// [`JACOBI_MAX_SWEEPS`]).
-const fn jacobi_eigen<const N: usize>(
-    mut a: Rows<N>,
-    max_sweeps: u32,
-) -> Result<([f64; N], Rows<N>), Error> {
-    let mut v = [[0.0; N]; N];
-    let mut fro2 = 0.0;
-    let mut i = 0;
-    while i < N {
-        v[i][i] = 1.0;
-        let mut j = 0;
-        while j < N {
-            fro2 += a[i][j] * a[i][j];
-            j += 1;
-        }
-        i += 1;
-    }
-    let fro = sqrt(fro2);
-    let mut sweep = 0;
-    while sweep < max_sweeps {
-        let mut off = 0.0;
-        let mut p = 0;
-        while p < N {
-            let mut q = 0;
-            while q < N {
-                if p != q {
-                    off += a[p][q] * a[p][q];
-                }
-                q += 1;
-            }
-            p += 1;
-        }
-        if sqrt(off) <= f64::EPSILON * fro {
-            let mut lam = [0.0; N];
-            let mut i = 0;
-            while i < N {
-                lam[i] = a[i][i];
-                i += 1;
-            }
-            return Ok((lam, v));
-        }
-        let mut p = 0;
-        while p < N {
-            let mut q = p + 1;
-            while q < N {
-                let apq = a[p][q];
-                // Below rounding of the diagonal pair: already decoupled.
-                if apq.abs() <= 0.25 * f64::EPSILON * sqrt((a[p][p] * a[q][q]).abs()) {
-                    a[p][q] = 0.0;
-                    a[q][p] = 0.0;
-                    q += 1;
-                    continue;
-                }
-                // Rotation zeroing a_pq: cot 2φ = θ, t = tan φ (the smaller root).
-                let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
-                let t = if theta.abs() > 1e150 {
-                    0.5 / theta
-                } else {
-                    let t = 1.0 / (theta.abs() + sqrt(theta * theta + 1.0));
-                    if theta < 0.0 { -t } else { t }
-                };
-                let c = 1.0 / sqrt(t * t + 1.0);
-                let s = t * c;
-                let mut k = 0;
-                while k < N {
-                    let (akp, akq) = (a[k][p], a[k][q]);
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                    k += 1;
-                }
-                k = 0;
-                while k < N {
-                    let (apk, aqk) = (a[p][k], a[q][k]);
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                    k += 1;
-                }
-                k = 0;
-                while k < N {
-                    let (vkp, vkq) = (v[k][p], v[k][q]);
-                    v[k][p] = c * vkp - s * vkq;
-                    v[k][q] = s * vkp + c * vkq;
-                    k += 1;
-                }
-                // Zeroed by construction; store the exact zero, not its rounding.
-                a[p][q] = 0.0;
-                a[q][p] = 0.0;
-                q += 1;
-            }
-            p += 1;
-        }
-        sweep += 1;
-    }
-    Err(Error::EigenNotConverged)
-}
-
-/// Cholesky factor `L` (lower, row-major) of a symmetric `m`; `None` unless every pivot
-/// exceeds `N ε max|m|` (positive definite and not singular to working precision).
-const fn cholesky<const N: usize>(m: &Rows<N>) -> Option<Rows<N>> {
-    let tiny = N as f64 * f64::EPSILON * max_abs(m);
-    let mut l = [[0.0; N]; N];
-    let mut j = 0;
-    while j < N {
-        let mut s = m[j][j];
-        let mut k = 0;
-        while k < j {
-            s -= l[j][k] * l[j][k];
-            k += 1;
-        }
-        if s.is_nan() || s <= tiny {
-            return None;
-        }
-        let d = sqrt(s);
-        l[j][j] = d;
-        let mut i = j + 1;
-        while i < N {
-            let mut s = m[i][j];
-            let mut k = 0;
-            while k < j {
-                s -= l[i][k] * l[j][k];
-                k += 1;
-            }
-            l[i][j] = s / d;
-            i += 1;
-        }
-        j += 1;
-    }
-    Some(l)
-}
-
-/// `L⁻¹ B` for lower-triangular `L` with a nonzero diagonal (forward substitution).
-const fn lower_solve<const N: usize>(l: &Rows<N>, b: &Rows<N>) -> Rows<N> {
-    let mut x = [[0.0; N]; N];
-    let mut c = 0;
-    while c < N {
-        let mut i = 0;
-        while i < N {
-            let mut s = b[i][c];
-            let mut k = 0;
-            while k < i {
-                s -= l[i][k] * x[k][c];
-                k += 1;
-            }
-            x[i][c] = s / l[i][i];
-            i += 1;
-        }
-        c += 1;
-    }
-    x
-}
-
-/// `L⁻ᵀ B` for lower-triangular `L` with a nonzero diagonal (back substitution).
-const fn lower_transpose_solve<const N: usize>(l: &Rows<N>, b: &Rows<N>) -> Rows<N> {
-    let mut x = [[0.0; N]; N];
-    let mut c = 0;
-    while c < N {
-        let mut i = N;
-        while i > 0 {
-            i -= 1;
-            let mut s = b[i][c];
-            let mut k = i + 1;
-            while k < N {
-                s -= l[k][i] * x[k][c];
-                k += 1;
-            }
-            x[i][c] = s / l[i][i];
-        }
-        c += 1;
-    }
-    x
-}
-
-const fn transpose<const N: usize>(a: &Rows<N>) -> Rows<N> {
-    let mut t = [[0.0; N]; N];
-    let mut i = 0;
-    while i < N {
-        let mut j = 0;
-        while j < N {
-            t[j][i] = a[i][j];
-            j += 1;
-        }
-        i += 1;
-    }
-    t
 }
 
 /// `(ω², Φ)` of `K φ = ω² M φ`, ascending, `Φᵀ M Φ = I` (`Φ` row-major, column `r` is
@@ -543,42 +274,11 @@ const fn modal_damping<const N: usize>(
             }
         }
         Damping::Matrix(c) => {
-            if !ops::all_finite(&c) {
+            if !all_finite(&c) {
                 return Err(Error::NonFiniteInput);
             }
             // D = Φᵀ C Φ
-            let mut cp = [[0.0; N]; N];
-            let mut i = 0;
-            while i < N {
-                let mut s = 0;
-                while s < N {
-                    let mut acc = 0.0;
-                    let mut l = 0;
-                    while l < N {
-                        acc += c[i][l] * phi[l][s];
-                        l += 1;
-                    }
-                    cp[i][s] = acc;
-                    s += 1;
-                }
-                i += 1;
-            }
-            let mut d = [[0.0; N]; N];
-            let mut r = 0;
-            while r < N {
-                let mut s = 0;
-                while s < N {
-                    let mut acc = 0.0;
-                    let mut l = 0;
-                    while l < N {
-                        acc += phi[l][r] * cp[l][s];
-                        l += 1;
-                    }
-                    d[r][s] = acc;
-                    s += 1;
-                }
-                r += 1;
-            }
+            let d = mul(&transpose(phi), &mul(&c, phi));
             let mut scale = 0.0f64;
             let mut r = 0;
             while r < N {
@@ -608,8 +308,7 @@ const fn modal_damping<const N: usize>(
 
 /// Every operator of a [`Modal`], in `f64`.
 struct ModalOps<const N: usize, const R: usize, const I: usize, const O: usize> {
-    half_h: f64,
-    quarter_h2: f64,
+    kin: Kinematics<f64>,
     g_gamma: [[f64; I]; R],
     g_c: [f64; R],
     g_k: [f64; R],
@@ -649,16 +348,17 @@ const fn modal_operators<const N: usize, const R: usize, const I: usize, const O
         }
         i += 1;
     }
-    if !(ops::all_finite(m)
-        && ops::all_finite(k)
-        && ops::all_finite_rect(b)
-        && ops::all_finite_rect(y))
+    if !(all_finite(m)
+        && all_finite(k)
+        && all_finite(b)
+        && all_finite(y))
     {
         return Err(Error::NonFiniteInput);
     }
-    if !(h.is_finite() && h > 0.0) {
-        return Err(Error::InvalidTimeStep);
-    }
+    let kin = match Kinematics::aem(h) {
+        Ok(kin) => kin,
+        Err(e) => return Err(e),
+    };
     let (lam, phi) = match modes_of(m, k) {
         Ok(x) => x,
         Err(e) => return Err(e),
@@ -667,10 +367,8 @@ const fn modal_operators<const N: usize, const R: usize, const I: usize, const O
         Ok(x) => x,
         Err(e) => return Err(e),
     };
-    let (half_h, quarter_h2) = (0.5 * h, 0.25 * h * h);
     let mut op = ModalOps {
-        half_h,
-        quarter_h2,
+        kin,
         g_gamma: [[0.0; I]; R],
         g_c: [0.0; R],
         g_k: [0.0; R],
@@ -685,7 +383,7 @@ const fn modal_operators<const N: usize, const R: usize, const I: usize, const O
     while r < R {
         let mode = modes[r];
         let (c, lam) = (c_all[mode], lam[mode]);
-        let meff = 1.0 + half_h * c + quarter_h2 * lam;
+        let meff = 1.0 + kin.gamma_h * c + kin.beta_h2 * lam;
         if !(meff.is_finite() && meff > f64::EPSILON) {
             return Err(Error::SingularEffectiveMatrix);
         }
@@ -734,22 +432,15 @@ const fn modal_operators<const N: usize, const R: usize, const I: usize, const O
     Ok(op)
 }
 
-fn round1<T: Real, const A: usize>(a: &[f64; A]) -> [T; A] {
-    a.map(T::from_f64_rounded)
-}
-
-fn round2<T: Real, const A: usize, const B: usize>(a: &[[f64; B]; A]) -> [[T; B]; A] {
-    a.map(|r| r.map(T::from_f64_rounded))
-}
-
 impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Modal<T, N, R, I, O> {
     /// A modal stepper keeping the `R` lowest modes of `M u'' + C u' + K u = B w(t)`.
     ///
     /// - `m`, `k`: `N×N` row-major (units e.g. kg, N/m); `M` symmetric positive
     ///   definite, `K` symmetric (to `64 ε` relative).
     /// - `damping`: classical damping ([`Damping`]).
-    /// - `b`: influence matrix, `N×I` (e.g. [`base_excitation`]).
-    /// - `y`: output matrix, `O×N` (e.g. a row selecting the roof, or [`storey_drifts`]).
+    /// - `b`: influence matrix, `N×I` (e.g. [`base_excitation`](crate::models::base_excitation)).
+    /// - `y`: output matrix, `O×N` (e.g. a row selecting the roof, or
+    ///   [`storey_drifts`](crate::models::storey_drifts)).
     /// - `h`: time step (s).
     ///
     /// Computed in `f64` by the same `const` code as `Modal::from_rows` (bit-identical
@@ -764,11 +455,11 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
     /// Cost: `O(N³)` `f64` flops (Jacobi: `≈ 4N³` a sweep, a few sweeps) and a few `N×N`
     /// `f64` temporaries on the stack; once.
     pub fn new(
-        m: &Rows<N>,
-        k: &Rows<N>,
+        m: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
         damping: &Damping<N>,
-        b: &[[f64; I]; N],
-        y: &[[f64; N]; O],
+        b: &SMatrix<f64, N, I>,
+        y: &SMatrix<f64, O, N>,
         h: f64,
     ) -> Result<Self, Error> {
         Self::with_modes(m, k, damping, b, y, lowest_modes(), h)
@@ -780,28 +471,26 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
     /// Errors: as [`Modal::new`]; [`Error::InvalidModeSelection`] also for an index
     /// `≥ N` or a repeated one.
     pub fn with_modes(
-        m: &Rows<N>,
-        k: &Rows<N>,
+        m: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
         damping: &Damping<N>,
-        b: &[[f64; I]; N],
-        y: &[[f64; N]; O],
+        b: &SMatrix<f64, N, I>,
+        y: &SMatrix<f64, O, N>,
         modes: [usize; R],
         h: f64,
     ) -> Result<Self, Error> {
-        let op = modal_operators(m, k, damping, b, y, &modes, h)?;
+        let op = modal_operators(&rows_f64(m), &rows_f64(k), damping, &rows_f64(b), &rows_f64(y), &modes, h)?;
         Ok(Self {
-            h: T::from_f64_rounded(h),
-            half_h: T::from_f64_rounded(op.half_h),
-            quarter_h2: T::from_f64_rounded(op.quarter_h2),
-            g_gamma: round2(&op.g_gamma),
-            g_c: round1(&op.g_c),
-            g_k: round1(&op.g_k),
-            gamma: round2(&op.gamma),
-            c: round1(&op.c),
-            k: round1(&op.k),
-            out: round2(&op.out),
-            phi: round2(&op.phi),
-            proj: round2(&op.proj),
+            kin: op.kin.round(),
+            g_gamma: linalg::round_rows(&op.g_gamma),
+            g_c: linalg::round_vec(&op.g_c),
+            g_k: linalg::round_vec(&op.g_k),
+            gamma: linalg::round_rows(&op.gamma),
+            c: linalg::round_vec(&op.c),
+            k: linalg::round_vec(&op.k),
+            out: linalg::round_rows(&op.out),
+            phi: linalg::round_rows(&op.phi),
+            proj: linalg::round_rows(&op.proj),
             modes,
         })
     }
@@ -844,18 +533,16 @@ macro_rules! const_ctor {
                     Err(e) => return Err(e),
                 };
                 Ok(Self {
-                    h: h as $t,
-                    half_h: op.half_h as $t,
-                    quarter_h2: op.quarter_h2 as $t,
-                    g_gamma: ops::const_round!($t, rows op.g_gamma),
-                    g_c: ops::const_round!($t, vec op.g_c),
-                    g_k: ops::const_round!($t, vec op.g_k),
-                    gamma: ops::const_round!($t, rows op.gamma),
-                    c: ops::const_round!($t, vec op.c),
-                    k: ops::const_round!($t, vec op.k),
-                    out: ops::const_round!($t, rows op.out),
-                    phi: ops::const_round!($t, rows op.phi),
-                    proj: ops::const_round!($t, rows op.proj),
+                    kin: linalg::const_round!($t, kin op.kin),
+                    g_gamma: linalg::const_round!($t, rows op.g_gamma),
+                    g_c: linalg::const_round!($t, vec op.g_c),
+                    g_k: linalg::const_round!($t, vec op.g_k),
+                    gamma: linalg::const_round!($t, rows op.gamma),
+                    c: linalg::const_round!($t, vec op.c),
+                    k: linalg::const_round!($t, vec op.k),
+                    out: linalg::const_round!($t, rows op.out),
+                    phi: linalg::const_round!($t, rows op.phi),
+                    proj: linalg::const_round!($t, rows op.proj),
                     modes,
                 })
             }
@@ -866,11 +553,6 @@ const_ctor!(f32);
 const_ctor!(f64);
 
 impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Modal<T, N, R, I, O> {
-    /// The time step `h` (s).
-    pub fn time_step(&self) -> T {
-        self.h
-    }
-
     /// The kept modes (indices in ascending frequency, `0` the fundamental).
     pub fn modes(&self) -> &[usize; R] {
         &self.modes
@@ -897,51 +579,6 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
         SMatrix::from_fn(|r, j| self.gamma[r][j])
     }
 
-    /// The state at `t = 0` from `u0`, `v0` (projected on the kept modes:
-    /// `η0 = Φ_Rᵀ M u0`, exact when `u0` lies in their span) and `w0`, with
-    /// `η0'' = Γ w0 − 2ξω η0' − ω² η0`.
-    ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::NonFiniteState`]. Cost: `2R·N + R·I`.
-    pub fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        w0: &SVector<T, I>,
-    ) -> Result<ModalState<T, R>, Error> {
-        let ok = u0
-            .iter()
-            .chain(v0.iter())
-            .chain(w0.iter())
-            .all(|x| x.is_finite());
-        if !ok {
-            return Err(Error::NonFiniteInput);
-        }
-        let mut s = ModalState {
-            eta: [T::zero(); R],
-            deta: [T::zero(); R],
-            ddeta: [T::zero(); R],
-            n: 0,
-        };
-        for r in 0..R {
-            let (mut e, mut de, mut f) = (T::zero(), T::zero(), T::zero());
-            for i in 0..N {
-                e += self.proj[r][i] * u0[i];
-                de += self.proj[r][i] * v0[i];
-            }
-            for j in 0..I {
-                f += self.gamma[r][j] * w0[j];
-            }
-            s.eta[r] = e;
-            s.deta[r] = de;
-            s.ddeta[r] = f - self.c[r] * de - self.k[r] * e;
-        }
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteState)
-        }
-    }
-
     /// The state at `t = 0` at rest (`u0 = v0 = 0`) under the input `w0`.
     ///
     /// Errors: [`Error::NonFiniteInput`]. Cost: `R·I`.
@@ -949,41 +586,16 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
         self.start(&SVector::zeros(), &SVector::zeros(), w0)
     }
 
-    /// Advance `state` from `t_{n−1}` to `t_n` under the input `w_n = w(t_n)`: each kept
-    /// mode takes one scalar AEM step.
-    ///
-    /// Cost: `R·I + 7R` multiply-adds; fixed, no allocation, no panic. A NaN input gives a
-    /// NaN state: use [`Modal::try_step`] where that must not happen.
-    #[inline]
-    pub fn step(&self, s: &mut ModalState<T, R>, w: &SVector<T, I>) {
-        let (half_h, h, quarter_h2) = (self.half_h, self.h, self.quarter_h2);
-        for r in 0..R {
-            let vh = s.deta[r] + half_h * s.ddeta[r];
-            let uh = s.eta[r] + h * s.deta[r] + quarter_h2 * s.ddeta[r];
-            let mut q = T::zero();
-            for j in 0..I {
-                q += self.g_gamma[r][j] * w[j];
+    /// `Φ_Rᵀ M x` (the modal coordinates of `x`, exact when `x` lies in the span of the
+    /// kept modes). Cost: `R·N`.
+    fn project(&self, x: &SVector<T, N>) -> [T; R] {
+        core::array::from_fn(|r| {
+            let mut e = T::zero();
+            for i in 0..N {
+                e += self.proj[r][i] * x[i];
             }
-            q -= self.g_c[r] * vh + self.g_k[r] * uh;
-            s.ddeta[r] = q;
-            s.deta[r] = vh + half_h * q;
-            s.eta[r] = uh + quarter_h2 * q;
-        }
-        s.n = s.n.wrapping_add(1);
-    }
-
-    /// [`Modal::step`], committed only if the new state is finite.
-    ///
-    /// Errors: [`Error::NonFiniteState`], leaving `state` bit-identical.
-    pub fn try_step(&self, state: &mut ModalState<T, R>, w: &SVector<T, I>) -> Result<(), Error> {
-        let mut next = *state;
-        self.step(&mut next, w);
-        if next.is_finite() {
-            *state = next;
-            Ok(())
-        } else {
-            Err(Error::NonFiniteState)
-        }
+            e
+        })
     }
 
     /// The outputs `y = Y u ≈ (Y Φ_R) η` (displacement units). Cost: `O·R`.
@@ -1013,10 +625,97 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
             y
         })
     }
+}
+
+impl<T: Real, const R: usize> StepState for ModalState<T, R> {
+    #[inline]
+    fn is_finite(&self) -> bool {
+        ModalState::is_finite(self)
+    }
+    #[inline]
+    fn steps(&self) -> u64 {
+        self.n
+    }
+}
+
+impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Stepper<T, N>
+    for Modal<T, N, R, I, O>
+{
+    type Input = SVector<T, I>;
+    type State = ModalState<T, R>;
+
+    #[inline]
+    fn time_step(&self) -> T {
+        self.kin.h
+    }
+
+    /// The state at `t = 0` from `u0`, `v0` (projected on the kept modes:
+    /// `η0 = Φ_Rᵀ M u0`, exact when `u0` lies in their span) and `w0`, with
+    /// `η0'' = Γ w0 − 2ξω η0' − ω² η0`.
+    ///
+    /// Errors: [`Error::NonFiniteInput`], [`Error::NonFiniteState`]. Cost: `2R·N + R·I`.
+    fn start(
+        &self,
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        w0: &SVector<T, I>,
+    ) -> Result<ModalState<T, R>, Error> {
+        if !crate::scalar::initial_inputs_finite(u0, v0, w0) {
+            return Err(Error::NonFiniteInput);
+        }
+        let (eta, deta) = (self.project(u0), self.project(v0));
+        let ddeta = core::array::from_fn(|r| {
+            let mut f = T::zero();
+            for j in 0..I {
+                f += self.gamma[r][j] * w0[j];
+            }
+            f - self.c[r] * deta[r] - self.k[r] * eta[r]
+        });
+        let s = ModalState { eta, deta, ddeta, n: 0 };
+        if s.is_finite() { Ok(s) } else { Err(Error::NonFiniteState) }
+    }
+
+    /// The state at `t = 0` from `u0, v0, a0`, each projected on the kept modes
+    /// (`η = Φ_Rᵀ M x`). Errors: [`Error::NonFiniteInput`]. Cost: `3R·N`.
+    fn start_with_acceleration(
+        &self,
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        a0: &SVector<T, N>,
+    ) -> Result<ModalState<T, R>, Error> {
+        if !crate::scalar::initial_inputs_finite(u0, v0, a0) {
+            return Err(Error::NonFiniteInput);
+        }
+        let s = ModalState {
+            eta: self.project(u0),
+            deta: self.project(v0),
+            ddeta: self.project(a0),
+            n: 0,
+        };
+        if s.is_finite() { Ok(s) } else { Err(Error::NonFiniteState) }
+    }
+
+    /// Each kept mode takes one scalar AEM step under the input `w_n`.
+    ///
+    /// Cost: `R·I + 7R` multiply-adds; fixed, no allocation, no panic.
+    #[inline]
+    fn step(&self, s: &mut ModalState<T, R>, w: &SVector<T, I>) {
+        for r in 0..R {
+            let (vh, uh) = self.kin.predict(s.eta[r], s.deta[r], s.ddeta[r]);
+            let mut q = T::zero();
+            for j in 0..I {
+                q += self.g_gamma[r][j] * w[j];
+            }
+            q -= self.g_c[r] * vh + self.g_k[r] * uh;
+            s.ddeta[r] = q;
+            (s.deta[r], s.eta[r]) = self.kin.correct(vh, uh, q);
+        }
+        s.n = s.n.wrapping_add(1);
+    }
 
     /// The full `N`-DOF state `u = Φ_R η`, `v = Φ_R η'`, `a = Φ_R η''` (on demand, not
     /// every step). Cost: `3N·R`.
-    pub fn full_state(&self, s: &ModalState<T, R>) -> State<T, N> {
+    fn full_state(&self, s: &ModalState<T, R>) -> State<T, N> {
         let map = |x: &[T; R]| {
             SVector::<T, N>::from_fn(|i, _| {
                 let mut y = T::zero();
@@ -1027,53 +726,5 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
             })
         };
         State::from_parts(map(&s.eta), map(&s.deta), map(&s.ddeta), s.n)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The sweep guard: a matrix that needs rotations fails with `EigenNotConverged` when
-    /// the budget is too small, and converges within the real budget.
-    #[test]
-    fn jacobi_reports_non_convergence_past_its_sweep_budget() {
-        let a = [[2.0, 1.0, 0.5], [1.0, 3.0, 0.25], [0.5, 0.25, 4.0]];
-        assert_eq!(
-            jacobi_eigen(a, 0).map(|_| ()),
-            Err(Error::EigenNotConverged)
-        );
-        assert_eq!(
-            jacobi_eigen(a, 1).map(|_| ()),
-            Err(Error::EigenNotConverged)
-        );
-        let (lam, _) = jacobi_eigen(a, JACOBI_MAX_SWEEPS).unwrap();
-        // Trace and determinant are invariants: Σλ = 9, Πλ = det a = 19.375.
-        assert!((lam.iter().sum::<f64>() - 9.0).abs() < 1e-14);
-        assert!((lam.iter().product::<f64>() - 19.375).abs() < 1e-12);
-    }
-
-    /// The `const` square root is within 1 ulp of the correctly rounded one (libm's
-    /// `sqrt` is correctly rounded) over 40 decades and at the edges.
-    #[test]
-    fn const_sqrt_within_one_ulp() {
-        let mut x = 1e-300f64;
-        let mut worst = 0u64;
-        while x < 1e300 {
-            for f in [1.0, 1.37, 2.0, 3.99, 7.3] {
-                let v = x * f;
-                let (a, b) = (sqrt(v).to_bits(), nalgebra::ComplexField::sqrt(v).to_bits());
-                worst = worst.max(a.abs_diff(b));
-            }
-            x *= 1.0e10;
-        }
-        assert!(worst <= 1, "{worst} ulp");
-        assert_eq!(sqrt(0.0), 0.0);
-        assert_eq!(sqrt(4.0), 2.0);
-        assert!(sqrt(-1.0).is_nan());
-        assert_eq!(sqrt(f64::INFINITY), f64::INFINITY);
-        // Subnormal input still converges.
-        let t = 4.9e-324f64;
-        assert!((sqrt(t) - 2.2227587494850775e-162).abs() <= 1e-177);
     }
 }

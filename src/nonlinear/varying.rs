@@ -18,7 +18,9 @@ use core::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::nonlinear::{initial_from_equation, solve_in_place};
+use crate::kinematics::Kinematics;
+use crate::linalg::lu::solve_in_place;
+use crate::nonlinear::initial_from_equation;
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
@@ -62,7 +64,7 @@ impl<T: Real, const N: usize, F: Fn(T) -> Coefficients<T, N>> TimeVarying<T, N> 
 ///
 /// ```
 /// use aemstep::{Coefficients, Varying};
-/// use nalgebra::{matrix, vector};
+/// use aemstep::nalgebra::{matrix, vector};
 ///
 /// // u'' + (1 + t/10) u = 0: a stiffening oscillator.
 /// let coeffs = |t: f64| Coefficients {
@@ -73,16 +75,14 @@ impl<T: Real, const N: usize, F: Fn(T) -> Coefficients<T, N>> TimeVarying<T, N> 
 /// let stepper = Varying::<f64, 1>::new(0.01)?;
 /// let mut s = stepper.start(&coeffs, &vector![1.0], &vector![0.0], &vector![0.0])?;
 /// for _ in 0..100 {
-///     stepper.step(&coeffs, &mut s, &vector![0.0])?;
+///     stepper.try_step(&coeffs, &mut s, &vector![0.0])?;
 /// }
 /// assert_eq!(s.steps(), 100);
 /// # Ok::<(), aemstep::Error>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Varying<T, const N: usize> {
-    h: T,
-    half_h: T,
-    quarter_h2: T,
+    kin: Kinematics<T>,
     _n: PhantomData<[T; N]>,
 }
 
@@ -95,25 +95,19 @@ fn finite_coefficients<T: Real, const N: usize>(k: &Coefficients<T, N>) -> bool 
 }
 
 impl<T: Real, const N: usize> Varying<T, N> {
-    /// A stepper with time step `h` (s).
+    /// A stepper with time step `h` (s, `f64`; the kinematics are rounded once to `T`).
     ///
     /// Errors: [`Error::InvalidTimeStep`] (`h` not finite or `≤ 0`). Cost: O(1).
-    pub fn new(h: T) -> Result<Self, Error> {
-        if !(h.is_finite() && h > T::zero()) {
-            return Err(Error::InvalidTimeStep);
-        }
-        let hf = h.as_f64();
+    pub fn new(h: f64) -> Result<Self, Error> {
         Ok(Self {
-            h,
-            half_h: T::from_f64_rounded(0.5 * hf),
-            quarter_h2: T::from_f64_rounded(0.25 * hf * hf),
+            kin: Kinematics::aem(h)?.round(),
             _n: PhantomData,
         })
     }
 
     /// The time step `h` (s).
     pub fn time_step(&self) -> T {
-        self.h
+        self.kin.h
     }
 
     /// The state at `t = 0` with `q0 = M(0)⁻¹ (p0 − C(0) v0 − K(0) u0)` (paper eq. 40).
@@ -158,21 +152,20 @@ impl<T: Real, const N: usize> Varying<T, N> {
     ///
     /// Cost: one coefficient evaluation, `N³/3 + 5N²` multiply-adds; no allocation, no
     /// panic.
-    pub fn step<Co: TimeVarying<T, N> + ?Sized>(
+    pub fn try_step<Co: TimeVarying<T, N> + ?Sized>(
         &self,
         coefficients: &Co,
         state: &mut State<T, N>,
         p: &SVector<T, N>,
     ) -> Result<(), Error> {
         let n = state.n.wrapping_add(1);
-        let t = T::from_f64_rounded(n as f64 * self.h.as_f64());
+        let t = T::from_f64_rounded(n as f64 * self.kin.h.as_f64());
         let k = coefficients.coefficients(t);
         if !(finite_coefficients(&k) && p.iter().all(|x| x.is_finite())) {
             return Err(Error::NonFiniteInput);
         }
-        let (b, c) = (self.half_h, self.quarter_h2);
-        let vh = state.v + state.a * b;
-        let uh = state.u + state.v * self.h + state.a * c;
+        let (b, c) = (self.kin.gamma_h, self.kin.beta_h2);
+        let (vh, uh) = self.kin.predict_all(&state.u, &state.v, &state.a);
         let mut meff = k.mass + k.damping * b + k.stiffness * c;
         let scale = k
             .mass
@@ -186,7 +179,8 @@ impl<T: Real, const N: usize> Varying<T, N> {
         if !solve_in_place(&mut meff, &mut q, scale) {
             return Err(Error::SingularEffectiveMatrixAtStep { step: n });
         }
-        let next = State::from_parts(uh + q * c, vh + q * b, q, n);
+        let (v, u) = self.kin.correct_all(&vh, &uh, &q);
+        let next = State::from_parts(u, v, q, n);
         if !next.is_finite() {
             return Err(Error::NonFiniteState);
         }

@@ -17,16 +17,17 @@
 //! **The load.** The weighted load `p_{n−α_f} = (1 − α_f) p_n + α_f p_{n−1}` needs the
 //! previous sample, which the shared [`State`] does not carry (the scheme's acceleration
 //! does not satisfy the equation of motion at `t_{n−1}`, so `p_{n−1}` cannot be recovered
-//! from it). [`GeneralizedAlpha::step_with_previous_load`] takes both samples and is the
+//! from it). [`Stepper::step_with_previous_input`] takes both samples and is the
 //! textbook scheme, second order for any load. [`Stepper::step`] takes `p_{n−1} = p_n`: it
 //! is the textbook scheme for free vibration and piecewise-constant loads, but only first
 //! order in `h` for loads that vary in time (an `α_f h` lag).
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::linear::{StartOps, initial_state};
-use crate::newmark::{check_inputs, round_rows, round_start};
-use crate::ops;
+use crate::kernel::{StartOps, initial_state, start_operators, terms_scale};
+use crate::kinematics::{Kinematics, check_time_step};
+use crate::linalg::lu::Lu;
+use crate::linalg::{add_scaled, all_finite, finite_as, round_rows, rows_f64, scaled};
 use crate::{Error, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
@@ -86,8 +87,8 @@ impl AlphaParameters {
 ///
 /// ```
 /// use aemstep::{GeneralizedAlpha, Stepper};
-/// use nalgebra::{matrix, vector};
-/// let sys = GeneralizedAlpha::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], 0.01, 0.8)?;
+/// use aemstep::nalgebra::{matrix, vector};
+/// let sys = GeneralizedAlpha::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], 0.01, 0.8)?;
 /// let mut s = sys.start(&vector![1.0], &vector![0.0], &vector![0.0])?;
 /// for _ in 0..100 {
 ///     sys.step(&mut s, &vector![0.0]);
@@ -97,15 +98,11 @@ impl AlphaParameters {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GeneralizedAlpha<T, const N: usize> {
-    h: T,
     params: AlphaParameters,
     /// `1 − α_f`, `α_f`.
     w1: T,
     w0: T,
-    c_va: T,
-    c_ua: T,
-    gamma_h: T,
-    beta_h2: T,
+    kin: Kinematics<T>,
     /// `a_n = G p̄ − GK u_{n−1} + Av v_{n−1} + Aa a_{n−1}`.
     g: [[T; N]; N],
     gk: [[T; N]; N],
@@ -120,10 +117,10 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
     ///
     /// Errors: as [`GeneralizedAlpha::with_parameters`].
     pub fn new(
-        m: &SMatrix<T, N, N>,
-        c: &SMatrix<T, N, N>,
-        k: &SMatrix<T, N, N>,
-        h: T,
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        h: f64,
         rho_inf: f64,
     ) -> Result<Self, Error> {
         Self::with_parameters(m, c, k, h, AlphaParameters::chung_hulbert(rho_inf)?)
@@ -133,10 +130,10 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
     ///
     /// Errors: as [`GeneralizedAlpha::with_parameters`].
     pub fn hht(
-        m: &SMatrix<T, N, N>,
-        c: &SMatrix<T, N, N>,
-        k: &SMatrix<T, N, N>,
-        h: T,
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        h: f64,
         alpha: f64,
     ) -> Result<Self, Error> {
         Self::with_parameters(m, c, k, h, AlphaParameters::hht(alpha)?)
@@ -147,17 +144,22 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
     /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
     /// [`Error::InvalidParameter`] (a parameter not finite, `α_m ≥ 1`, `α_f ≥ 1`, `β < 0`
     /// or `γ < 0`), [`Error::SingularEffectiveMatrix`] (`(1 − α_m) M + (1 − α_f)(γh C +
-    /// βh² K)` singular).
+    /// βh² K)` singular to working precision against its terms),
+    /// [`Error::OperatorOverflow`].
     ///
     /// Cost: about `9N³` flops in `f64`, six `N×N` `f64` temporaries on the stack.
     pub fn with_parameters(
-        m: &SMatrix<T, N, N>,
-        c: &SMatrix<T, N, N>,
-        k: &SMatrix<T, N, N>,
-        h: T,
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        h: f64,
         p: AlphaParameters,
     ) -> Result<Self, Error> {
-        let (m, c, k, start) = check_inputs(m, c, k, h)?;
+        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+        if !(all_finite(&m) && all_finite(&c) && all_finite(&k)) {
+            return Err(Error::NonFiniteInput);
+        }
+        let hf = check_time_step(h)?;
         let AlphaParameters {
             alpha_m,
             alpha_f,
@@ -170,47 +172,38 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
         if !(finite && alpha_m < 1.0 && alpha_f < 1.0 && beta >= 0.0 && gamma >= 0.0) {
             return Err(Error::InvalidParameter);
         }
-        let hf = h.as_f64();
         let f1 = 1.0 - alpha_f;
-        let meff = ops::add_scaled(
-            &ops::add_scaled(
-                &ops::add_scaled(&[[0.0; N]; N], 1.0 - alpha_m, &m),
-                f1 * gamma * hf,
-                &c,
-            ),
-            f1 * beta * hf * hf,
-            &k,
-        );
-        let g = ops::inverse(&meff).ok_or(Error::SingularEffectiveMatrix)?;
-        let gc = ops::mul(&g, &c);
-        let gk = ops::mul(&g, &k);
-        let gm = ops::mul(&g, &m);
+        let (wm, wc, wk) = (1.0 - alpha_m, f1 * gamma * hf, f1 * beta * hf * hf);
+        let meff = add_scaled(&add_scaled(&scaled(wm, &m), wc, &c), wk, &k);
+        let scale = terms_scale(&scaled(wm, &m), &c, &k, wc, wk);
+        if !all_finite(&meff) {
+            return Err(Error::OperatorOverflow);
+        }
+        let lu = Lu::new(&meff, scale).ok_or(Error::SingularEffectiveMatrix)?;
+        let (g, gc, gk, gm) = (lu.inverse(), lu.solve(&c), lu.solve(&k), lu.solve(&m));
         // a_n = G p̄ − α_m GM a − (1−α_f) GC v̂ − (1−α_f) GK û − α_f (GC v + GK u), with
         // v̂ = v + (1−γ)h a, û = u + h v + (1/2−β)h² a, collected on (u, v, a).
-        let av = ops::add_scaled(&ops::add_scaled(&[[0.0; N]; N], -1.0, &gc), -f1 * hf, &gk);
-        let aa = ops::add_scaled(
-            &ops::add_scaled(
-                &ops::add_scaled(&[[0.0; N]; N], -alpha_m, &gm),
-                -f1 * (1.0 - gamma) * hf,
-                &gc,
-            ),
+        let av = add_scaled(&scaled(-1.0, &gc), -f1 * hf, &gk);
+        let aa = add_scaled(
+            &add_scaled(&scaled(-alpha_m, &gm), -f1 * (1.0 - gamma) * hf, &gc),
             -f1 * (0.5 - beta) * hf * hf,
             &gk,
         );
+        let max = T::MAX;
+        if ![&g, &gk, &av, &aa].iter().all(|x| finite_as(x, max)) {
+            return Err(Error::OperatorOverflow);
+        }
+        let start = start_operators(&m, &c, &k, max)?;
         Ok(Self {
-            h,
             params: p,
             w1: T::from_f64_rounded(f1),
             w0: T::from_f64_rounded(alpha_f),
-            c_va: T::from_f64_rounded((1.0 - gamma) * hf),
-            c_ua: T::from_f64_rounded((0.5 - beta) * hf * hf),
-            gamma_h: T::from_f64_rounded(gamma * hf),
-            beta_h2: T::from_f64_rounded(beta * hf * hf),
+            kin: Kinematics::newmark(hf, beta, gamma)?.round(),
             g: round_rows(&g),
             gk: round_rows(&gk),
             av: round_rows(&av),
             aa: round_rows(&aa),
-            start: start.as_ref().map(round_start),
+            start: start.map(|(_, s)| s.round()),
         })
     }
 
@@ -235,10 +228,8 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
             anew[i] = q;
         }
         for j in 0..N {
-            let uh = s.u[j] + self.h * s.v[j] + self.c_ua * s.a[j];
-            let vh = s.v[j] + self.c_va * s.a[j];
-            s.u[j] = uh + self.beta_h2 * anew[j];
-            s.v[j] = vh + self.gamma_h * anew[j];
+            let (vh, uh) = self.kin.predict(s.u[j], s.v[j], s.a[j]);
+            (s.v[j], s.u[j]) = self.kin.correct(vh, uh, anew[j]);
             s.a[j] = anew[j];
         }
         s.n = s.n.wrapping_add(1);
@@ -246,9 +237,14 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
 }
 
 impl<T: Real, const N: usize> Stepper<T, N> for GeneralizedAlpha<T, N> {
+    type Input = SVector<T, N>;
+    type State = State<T, N>;
+
+    crate::stepper::full_order_state!();
+
     #[inline]
     fn time_step(&self) -> T {
-        self.h
+        self.kin.h
     }
 
     fn start(
@@ -260,10 +256,10 @@ impl<T: Real, const N: usize> Stepper<T, N> for GeneralizedAlpha<T, N> {
         initial_state(self.start.as_ref(), u0, v0, p0)
     }
 
-    /// [`Stepper::step_with_previous_load`] with `p_prev = p`: exact for free vibration and
+    /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration and
     /// constant loads, but FIRST order for a time-varying load (the weighted load
     /// `(1 − α_f) p_n + α_f p_{n−1}` needs the previous sample, which the shared [`State`]
-    /// does not carry). Drive it with `step_with_previous_load` for second order.
+    /// does not carry). Drive it with `step_with_previous_input` for second order.
     /// Cost: `4N²` multiply-adds + `10N`.
     #[inline]
     fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
@@ -275,7 +271,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for GeneralizedAlpha<T, N> {
     ///
     /// Cost: `4N²` multiply-adds + `10N`. No allocation, no panic.
     #[inline]
-    fn step_with_previous_load(
+    fn step_with_previous_input(
         &self,
         s: &mut State<T, N>,
         p_prev: &SVector<T, N>,

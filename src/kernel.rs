@@ -1,0 +1,296 @@
+//! The step kernel of the constant-coefficient Newmark family (the AEM and
+//! [`Newmark`](crate::Newmark)), and the blocked matrix–vector products it runs on.
+//!
+//! Operators are stored interleaved by row, `ops[i] = [G[i], −GC[i], −GK[i]]` with
+//! `G = (M + γh C + βh² K)⁻¹`, so row `i` of all three is one contiguous run that
+//! multiplies `x = (p, v̂, û)`; `q_i` is a single multiply-accumulate chain over it.
+
+use nalgebra::SVector;
+
+use crate::kinematics::Kinematics;
+use crate::linalg::lu::Lu;
+use crate::linalg::{Mat, add_scaled, all_finite, finite_as, max_abs, round_rows};
+use crate::scalar::initial_inputs_finite;
+use crate::{Error, Real, State};
+
+/// One step of the Newmark family in eliminated form over interleaved operator rows:
+///
+/// ```text
+/// (v̂, û) = predict(u, v, a)       q = G p − GC v̂ − GK û       (v, u) = correct(v̂, û, q)
+/// ```
+///
+/// Cost: `3N²` multiply-adds + `7N`; branch-free, panic-free.
+#[inline(always)]
+pub(crate) fn newmark_step<T: Real, const N: usize>(
+    ops: &[[[T; N]; 3]; N],
+    kin: &Kinematics<T>,
+    s: &mut State<T, N>,
+    p: &SVector<T, N>,
+) {
+    // x = (p, v̂, û): the vector every interleaved operator row multiplies.
+    let mut x = [[T::zero(); N]; 3];
+    for j in 0..N {
+        x[0][j] = p[j];
+        (x[1][j], x[2][j]) = kin.predict(s.u[j], s.v[j], s.a[j]);
+    }
+    mat_vec_blocked(ops, &x, s.a.as_mut_slice());
+    // A separate pass with constant indices (once unrolled), so v̂, û are used straight
+    // from registers.
+    for j in 0..N {
+        (s.v[j], s.u[j]) = kin.correct(x[1][j], x[2][j], s.a[j]);
+    }
+    s.n = s.n.wrapping_add(1);
+}
+
+/// One AEM step with the load through an influence matrix, `q = (GB) w − GC v̂ − GK û`
+/// ([`LinearInput`](crate::LinearInput)): `gb` is `N×I`, `ops[i] = [−GC[i], −GK[i]]`.
+///
+/// Cost: `2N² + N·I` multiply-adds + `7N`; branch-free, panic-free.
+#[inline(always)]
+pub(crate) fn input_step<T: Real, const N: usize, const I: usize>(
+    gb: &[[T; I]; N],
+    ops: &[[[T; N]; 2]; N],
+    kin: &Kinematics<T>,
+    s: &mut State<T, N>,
+    w: &SVector<T, I>,
+) {
+    let mut x = [[T::zero(); N]; 2];
+    for j in 0..N {
+        (x[0][j], x[1][j]) = kin.predict(s.u[j], s.v[j], s.a[j]);
+    }
+    mat_vec_blocked(ops, &x, s.a.as_mut_slice());
+    for j in 0..N {
+        let mut q = s.a[j];
+        for k in 0..I {
+            q += gb[j][k] * w[k];
+        }
+        s.a[j] = q;
+        (s.v[j], s.u[j]) = kin.correct(x[0][j], x[1][j], q);
+    }
+    s.n = s.n.wrapping_add(1);
+}
+
+/// Operator rows processed together by the steps (two accumulators: on the Cortex-M4F
+/// this is what keeps the f32 fast form at or below 3 instructions a multiply-add for
+/// N = 6 and 12; 3 or 4 rows spill registers at one size or the other).
+pub(crate) const BLOCK: usize = 2;
+
+/// `R` dot products of interleaved operator rows (each `K` blocks of `N`) with `x`: `R`
+/// accumulators, so each `x` value is loaded once for `R` multiply-adds. Each sum starts
+/// from its first product (no `0 +`), then accumulates block by block, in order.
+#[inline(always)]
+pub(crate) fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
+    rows: &[[[T; N]; K]; R],
+    x: &[[T; N]; K],
+) -> [T; R] {
+    let mut q = [T::zero(); R];
+    if N == 0 || K == 0 {
+        return q;
+    }
+    for r in 0..R {
+        q[r] = rows[r][0][0] * x[0][0];
+    }
+    for b in 0..K {
+        let first = if b == 0 { 1 } else { 0 };
+        for j in first..N {
+            let xj = x[b][j];
+            for r in 0..R {
+                q[r] += rows[r][b][j] * xj;
+            }
+        }
+    }
+    q
+}
+
+/// `out = rows · x` for `N` interleaved rows, in blocks of [`BLOCK`] rows (the remainder
+/// row first).
+#[inline(always)]
+pub(crate) fn mat_vec_blocked<T: Real, const N: usize, const K: usize>(
+    rows: &[[[T; N]; K]; N],
+    x: &[[T; N]; K],
+    out: &mut [T],
+) {
+    let (rest, blocks) = rows.as_rchunks::<BLOCK>();
+    let (out_rest, out_blocks) = out.as_rchunks_mut::<BLOCK>();
+    for (row, o) in rest.iter().zip(out_rest) {
+        [*o] = dots(core::array::from_ref(row), x);
+    }
+    for (rows, o) in blocks.iter().zip(out_blocks) {
+        *o = dots(rows, x);
+    }
+}
+
+/// `y = A x` for a row-major `A` (`R×C`). `R·C` multiply-adds.
+#[inline(always)]
+pub(crate) fn mat_vec<T: Real, const R: usize, const C: usize>(
+    a: &[[T; C]; R],
+    x: &SVector<T, C>,
+) -> SVector<T, R> {
+    SVector::from_fn(|i, _| {
+        let mut s = T::zero();
+        for j in 0..C {
+            s += a[i][j] * x[j];
+        }
+        s
+    })
+}
+
+/// `[G[i], −GC[i], −GK[i]]` for every row `i` (the storage of the kernel's operators).
+pub(crate) fn interleave<T: Real, const N: usize, const K: usize>(
+    blocks: [&[[T; N]; N]; K],
+    signs: [T; K],
+) -> [[[T; N]; K]; N] {
+    core::array::from_fn(|i| core::array::from_fn(|b| blocks[b][i].map(|x| signs[b] * x)))
+}
+
+/// Operators for the start-up acceleration `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0`
+/// (paper eq. 40).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StartOps<T, const N: usize> {
+    pub minv: [[T; N]; N],
+    pub minv_c: [[T; N]; N],
+    pub minv_k: [[T; N]; N],
+}
+
+impl<const N: usize> StartOps<f64, N> {
+    /// Rounded once to `T` (run time).
+    pub(crate) fn round<T: Real>(&self) -> StartOps<T, N> {
+        StartOps {
+            minv: round_rows(&self.minv),
+            minv_c: round_rows(&self.minv_c),
+            minv_k: round_rows(&self.minv_k),
+        }
+    }
+}
+
+/// The factorization of `M` and the `StartOps` of `(M, C, K)`; `None` when `M` is singular to working
+/// precision. Errors: [`Error::OperatorOverflow`] if an operator is not finite or exceeds
+/// `max` (the largest finite value of the scalar type it will be rounded to).
+pub(crate) const fn start_operators<const N: usize>(
+    m: &Mat<N, N>,
+    c: &Mat<N, N>,
+    k: &Mat<N, N>,
+    max: f64,
+) -> Result<Option<(Lu<N>, StartOps<f64, N>)>, Error> {
+    let lu = match Lu::new(m, max_abs(m)) {
+        Some(lu) => lu,
+        None => return Ok(None),
+    };
+    let s = StartOps {
+        minv: lu.inverse(),
+        minv_c: lu.solve(c),
+        minv_k: lu.solve(k),
+    };
+    if finite_as(&s.minv, max) && finite_as(&s.minv_c, max) && finite_as(&s.minv_k, max) {
+        Ok(Some((lu, s)))
+    } else {
+        Err(Error::OperatorOverflow)
+    }
+}
+
+/// The `f64` operators of the Newmark-family kernel: `G = M_eff⁻¹`, `G C`, `G K` with
+/// `M_eff = M + γh C + βh² K`, the kinematics, and the start-up operators.
+pub(crate) struct KernelOps<const N: usize> {
+    pub g: Mat<N, N>,
+    pub gc: Mat<N, N>,
+    pub gk: Mat<N, N>,
+    pub kin: Kinematics<f64>,
+    /// The factorization of `M_eff`, for further solves (e.g. `G B`).
+    pub lu: Lu<N>,
+    /// The factorization of `M` (if regular) and the start-up operators.
+    pub start: Option<(Lu<N>, StartOps<f64, N>)>,
+}
+
+/// `|M| + γh|C| + βh²|K|` entrywise, its largest entry: the scale against which the
+/// effective matrix is judged singular (a sum that cancels to rounding is singular).
+pub(crate) const fn terms_scale<const N: usize>(
+    m: &Mat<N, N>,
+    c: &Mat<N, N>,
+    k: &Mat<N, N>,
+    wc: f64,
+    wk: f64,
+) -> f64 {
+    let mut s = 0.0f64;
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < N {
+            let t = m[i][j].abs() + wc.abs() * c[i][j].abs() + wk.abs() * k[i][j].abs();
+            if t > s {
+                s = t;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    s
+}
+
+/// Check `M, C, K, h, β, γ` and build the kernel's operators by factorizing `M_eff` and
+/// solving (paper eqs. 19–23 in eliminated form for β = 1/4, γ = 1/2). `max`: the
+/// largest finite value of the scalar type the operators will be rounded to.
+///
+/// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
+/// [`Error::InvalidParameter`] (β or γ negative or not finite),
+/// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`].
+pub(crate) const fn newmark_operators<const N: usize>(
+    m: &Mat<N, N>,
+    c: &Mat<N, N>,
+    k: &Mat<N, N>,
+    h: f64,
+    beta: f64,
+    gamma: f64,
+    max: f64,
+) -> Result<KernelOps<N>, Error> {
+    if !(all_finite(m) && all_finite(c) && all_finite(k)) {
+        return Err(Error::NonFiniteInput);
+    }
+    if !(beta.is_finite() && gamma.is_finite() && beta >= 0.0 && gamma >= 0.0) {
+        return Err(Error::InvalidParameter);
+    }
+    let kin = match Kinematics::newmark(h, beta, gamma) {
+        Ok(kin) => kin,
+        Err(e) => return Err(e),
+    };
+    let (wc, wk) = (kin.gamma_h, kin.beta_h2);
+    let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
+    if !all_finite(&meff) {
+        return Err(Error::OperatorOverflow);
+    }
+    let lu = match Lu::new(&meff, terms_scale(m, c, k, wc, wk)) {
+        Some(lu) => lu,
+        None => return Err(Error::SingularEffectiveMatrix),
+    };
+    let (g, gc, gk) = (lu.inverse(), lu.solve(c), lu.solve(k));
+    if !(finite_as(&g, max) && finite_as(&gc, max) && finite_as(&gk, max)) {
+        return Err(Error::OperatorOverflow);
+    }
+    let start = match start_operators(m, c, k, max) {
+        Ok(s) => s,
+        Err(e) => return Err(e),
+    };
+    Ok(KernelOps {
+        g,
+        gc,
+        gk,
+        kin,
+        lu,
+        start,
+    })
+}
+
+/// `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0` and the state at step 0; `ops` is `None` when
+/// `M` is singular ([`Error::SingularMass`]).
+pub(crate) fn initial_state<T: Real, const N: usize>(
+    ops: Option<&StartOps<T, N>>,
+    u0: &SVector<T, N>,
+    v0: &SVector<T, N>,
+    p0: &SVector<T, N>,
+) -> Result<State<T, N>, Error> {
+    let ops = ops.ok_or(Error::SingularMass)?;
+    if !initial_inputs_finite(u0, v0, p0) {
+        return Err(Error::NonFiniteInput);
+    }
+    let a0 = mat_vec(&ops.minv, p0) - mat_vec(&ops.minv_c, v0) - mat_vec(&ops.minv_k, u0);
+    State::initial_computed(u0, v0, a0)
+}

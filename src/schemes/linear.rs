@@ -1,0 +1,214 @@
+//! The linear AEM kernel: `M u'' + C u' + K u = p(t)` with constant `M, C, K`.
+//!
+//! With `q = u''` taken as the mean of its end values on each step (paper §2, eqs. 19–23)
+//! and the equation of motion enforced at `t_n`, eliminating `v_n, u_n` gives
+//!
+//! ```text
+//! v̂ = v_{n−1} + (h/2) q_{n−1}             û = u_{n−1} + h v̂ − (h²/4) q_{n−1}
+//! q_n = G p_n − (G C) v̂ − (G K) û          G = (M + (h/2) C + (h²/4) K)⁻¹
+//! v_n = v̂ + (h/2) q_n                      u_n = û + (h²/4) q_n
+//! ```
+//!
+//! `G`, `GC`, `GK` are computed once, in `f64` (LU of the effective matrix and solves),
+//! and rounded once to `T`. A step costs `3N²` multiply-adds plus `7N` for the kinematics
+//! ([`crate::kinematics`]). The same numbers, in the paper's literal
+//! `U_n = A U_{n−1} + b p_n` form, come from [`Linear::a_form`].
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::kernel::{StartOps, initial_state, interleave, newmark_operators, newmark_step};
+use crate::kinematics::Kinematics;
+use crate::linalg::{self, Rows, rows_f64};
+use crate::{AForm, Error, Real, State, Stepper};
+
+/// The linear constant-coefficient AEM stepper (paper Algorithm 1, eliminated form).
+///
+/// `T` is `f32` or `f64`; `N` the number of degrees of freedom. Build it once with
+/// [`Linear::new`] (run time, from `nalgebra` matrices) or [`Linear::from_rows`]
+/// (`const fn`, from row-major arrays: operators computed by the compiler into flash).
+/// Both take the data in `f64` and round the operators once, so they are bit-identical.
+/// Then [`Stepper::start`] and [`Stepper::step`] (or the checked [`Stepper::try_step`]).
+///
+/// Size: `6N² + 5` values of `T` (`3N²` for stepping, `3N²` for start-up).
+///
+/// ```
+/// use aemstep::{Linear, Stepper};
+/// use aemstep::nalgebra::{matrix, vector};
+///
+/// // u'' + 25 u = 0 (paper Example 1), h = 0.01 s
+/// let sys = Linear::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], 0.01)?;
+/// let mut s = sys.start(&vector![1.0], &vector![0.0], &vector![0.0])?;
+/// for _ in 0..100 {
+///     sys.step(&mut s, &vector![0.0]);
+/// }
+/// assert!((s.u()[0] - 5.0f64.cos()).abs() < 2e-3); // t = 1 s, O(h²) phase error
+/// # Ok::<(), aemstep::Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+// `repr(C)` with `ops` first: the step addresses every operator value as a small
+// immediate offset from `self` (Thumb-2 `vldr` reaches ±1020 bytes).
+#[repr(C)]
+pub struct Linear<T, const N: usize> {
+    /// The step operators, interleaved by row so that row `i` of all three is one
+    /// contiguous run of `3N` values: `ops[i] = [G[i], −(GC)[i], −(GK)[i]]`
+    /// (`G = M_eff⁻¹`). `q_i` is then a single multiply-accumulate chain over that run
+    /// (negation is exact, so the values are those of `G`, `GC`, `GK`).
+    ops: [[[T; N]; 3]; N],
+    kin: Kinematics<T>,
+    start: Option<StartOps<T, N>>,
+}
+
+impl<T: Real, const N: usize> Linear<T, N> {
+    /// Precompute the step operators for `M u'' + C u' + K u = p(t)` with step `h` (s).
+    ///
+    /// `M, C, K` are `N×N` in `f64` (whatever `T`: the operators are computed in `f64`
+    /// and rounded once, so the same data gives bit-identical operators through
+    /// [`Linear::from_rows`]), fully populated, not necessarily symmetric. `M` may be
+    /// singular as long as `M + (h/2) C + (h²/4) K` is not (then start with
+    /// [`Stepper::start_with_acceleration`]).
+    ///
+    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (`h ≤ 0`, not finite,
+    /// or `h²` out of range), [`Error::SingularEffectiveMatrix`] (singular to working
+    /// precision against the size of its terms `|M| + (h/2)|C| + (h²/4)|K|`),
+    /// [`Error::OperatorOverflow`] (an operator does not fit `T`).
+    ///
+    /// Cost: about `4N³` flops in `f64` and a few `N×N` `f64` temporaries on the stack.
+    pub fn new(
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        h: f64,
+    ) -> Result<Self, Error> {
+        let op = newmark_operators(&rows_f64(m), &rows_f64(c), &rows_f64(k), h, 0.25, 0.5, T::MAX)?;
+        let one = T::one();
+        let (g, gc, gk) = (linalg::round_rows(&op.g), linalg::round_rows(&op.gc), linalg::round_rows(&op.gk));
+        Ok(Self {
+            ops: interleave([&g, &gc, &gk], [one, -one, -one]),
+            kin: op.kin.round(),
+            start: op.start.map(|(_, s)| s.round()),
+        })
+    }
+
+    /// `G = (M + (h/2) C + (h²/4) K)⁻¹`.
+    pub fn effective_inverse(&self) -> SMatrix<T, N, N> {
+        SMatrix::from_fn(|i, j| self.ops[i][0][j])
+    }
+
+    /// The paper's literal form `U_n = A U_{n−1} + b p_n` of this stepper (`12N²`
+    /// multiply-adds a step): the reference the fast form is tested against, and a way to
+    /// inspect the amplification operator. Cost to build: about `6N³` flops in `T`.
+    pub fn a_form(&self) -> AForm<T, N> {
+        let block = |b: usize, sign: T| self.ops.map(|row| row[b].map(|x| sign * x));
+        let one = T::one();
+        let (g, gc, gk) = (block(0, one), block(1, -one), block(2, -one));
+        AForm::from_operators(self.kin.h, &g, &gc, &gk, self.start)
+    }
+}
+
+/// Const-fn construction, for operators computed at compile time into flash.
+macro_rules! const_ctor {
+    ($t:ident) => {
+        impl<const N: usize> Linear<$t, N> {
+            /// `const fn` twin of [`Linear::new`]: `M, C, K` as row-major `f64` arrays
+            /// (`m[i][j]` is row `i`, column `j`), `h` in seconds. Bit-identical to
+            /// [`Linear::new`] given the same values.
+            ///
+            /// In a `static`, the operators are evaluated by the compiler and no
+            /// factorization code is linked in:
+            ///
+            /// ```
+            /// use aemstep::Linear;
+            /// static SYS: Linear<f32, 1> = match Linear::<f32, 1>::from_rows(
+            ///     [[1.0]], [[0.28]], [[4.0]], 0.002,
+            /// ) {
+            ///     Ok(s) => s,
+            ///     Err(e) => panic!("{}", e.as_str()),
+            /// };
+            /// assert_eq!(SYS.time_step_const(), 0.002);
+            /// ```
+            ///
+            /// **Size limit at compile time.** The compiler evaluates about `4N³` flops;
+            /// past a few million steps of evaluation rustc stops with the
+            /// `long_running_const_eval` lint (deny by default). Measured with rustc 1.95:
+            /// `Linear<f32, N>` compiles in a `static` up to `N = 64` (pinned by a test);
+            /// larger `N` needs `#![allow(long_running_const_eval)]` at the crate root of
+            /// the firmware, or [`Linear::new`] at run time.
+            ///
+            /// Errors: as [`Linear::new`].
+            pub const fn from_rows(
+                m: Rows<N>,
+                c: Rows<N>,
+                k: Rows<N>,
+                h: f64,
+            ) -> Result<Self, Error> {
+                let op = match newmark_operators(&m, &c, &k, h, 0.25, 0.5, $t::MAX as f64) {
+                    Ok(op) => op,
+                    Err(e) => return Err(e),
+                };
+                let (g, gc, gk) = (
+                    linalg::const_round!($t, rows op.g),
+                    linalg::const_round!($t, rows op.gc),
+                    linalg::const_round!($t, rows op.gk),
+                );
+                let mut ops = [[[0.0; N]; 3]; N];
+                let mut i = 0;
+                while i < N {
+                    let mut j = 0;
+                    while j < N {
+                        ops[i][0][j] = g[i][j];
+                        ops[i][1][j] = -gc[i][j];
+                        ops[i][2][j] = -gk[i][j];
+                        j += 1;
+                    }
+                    i += 1;
+                }
+                Ok(Self {
+                    ops,
+                    kin: linalg::const_round!($t, kin op.kin),
+                    start: match op.start {
+                        Some((_, s)) => Some(StartOps {
+                            minv: linalg::const_round!($t, rows s.minv),
+                            minv_c: linalg::const_round!($t, rows s.minv_c),
+                            minv_k: linalg::const_round!($t, rows s.minv_k),
+                        }),
+                        None => None,
+                    },
+                })
+            }
+
+            /// The time step `h` (s), in `const` contexts.
+            pub const fn time_step_const(&self) -> $t {
+                self.kin.h
+            }
+        }
+    };
+}
+const_ctor!(f32);
+const_ctor!(f64);
+
+impl<T: Real, const N: usize> Stepper<T, N> for Linear<T, N> {
+    type Input = SVector<T, N>;
+    type State = State<T, N>;
+
+    #[inline]
+    fn time_step(&self) -> T {
+        self.kin.h
+    }
+
+    fn start(
+        &self,
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        p0: &SVector<T, N>,
+    ) -> Result<State<T, N>, Error> {
+        initial_state(self.start.as_ref(), u0, v0, p0)
+    }
+
+    crate::stepper::full_order_state!();
+
+    /// Cost: `3N²` multiply-adds + `7N` (see the module docs for the recurrence).
+    #[inline]
+    fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
+        newmark_step(&self.ops, &self.kin, s, p);
+    }
+}

@@ -1,0 +1,21 @@
+//! The constant-coefficient linear schemes, one file each, all behind
+//! [`Stepper`](crate::Stepper):
+//!
+//! - [`Linear`]: the AEM in eliminated form (`3N²` a step), the crate's kernel.
+//! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference.
+//! - [`LinearInput`]: loads through an influence matrix `p = B w` (`2N² + N·I`).
+//! - [`Newmark`], [`GeneralizedAlpha`], [`Exact`]: the comparators.
+
+mod aform;
+mod exact;
+mod generalized_alpha;
+mod input;
+mod linear;
+mod newmark;
+
+pub use aform::AForm;
+pub use exact::Exact;
+pub use generalized_alpha::{AlphaParameters, GeneralizedAlpha};
+pub use input::LinearInput;
+pub use linear::Linear;
+pub use newmark::Newmark;
