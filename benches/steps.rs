@@ -14,7 +14,7 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use aemstep::{Exact, GeneralizedAlpha, Linear, Newmark, Real, Stepper};
+use aemstep::{Exact, GeneralizedAlpha, Linear, Newmark, Real, State, Stepper};
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, BenchmarkId, Criterion};
 use nalgebra::{SMatrix, SVector};
@@ -52,7 +52,11 @@ fn system<const N: usize>() -> Box<(SMatrix<f64, N, N>, SMatrix<f64, N, N>, SMat
     Box::new((m, c, k))
 }
 
-fn bench_stepper<T: Real, S: Stepper<T, N>, const N: usize>(
+fn bench_stepper<
+    T: Real,
+    S: Stepper<T, N, Input = SVector<T, N>, State = State<T, N>>,
+    const N: usize,
+>(
     g: &mut BenchmarkGroup<'_, WallTime>,
     name: &str,
     sys: &S,
@@ -67,24 +71,24 @@ fn bench_stepper<T: Real, S: Stepper<T, N>, const N: usize>(
 
 fn per_step<T: Real, const N: usize>(c: &mut Criterion, ty: &str) {
     let sys = system::<N>();
-    let (m, cc, k) = (sys.0.cast::<T>(), sys.1.cast::<T>(), sys.2.cast::<T>());
-    let h = T::from_f64_rounded(0.01);
+    let (m, cc, k) = (&sys.0, &sys.1, &sys.2);
+    let h = 0.01;
     let mut g = c.benchmark_group(format!("step/{ty}"));
     g.warm_up_time(Duration::from_millis(200))
         .measurement_time(Duration::from_millis(700))
         .sample_size(20);
-    let lin = Box::new(Linear::new(&m, &cc, &k, h).expect("linear"));
+    let lin = Box::new(Linear::<T, N>::new(m, cc, k, h).expect("linear"));
     bench_stepper(&mut g, "aem", &*lin);
     let af = Box::new(lin.a_form());
     bench_stepper(&mut g, "aem-aform", &*af);
     drop(af);
-    let nm = Box::new(Newmark::linear_acceleration(&m, &cc, &k, h).expect("newmark"));
+    let nm = Box::new(Newmark::<T, N>::linear_acceleration(m, cc, k, h).expect("newmark"));
     bench_stepper(&mut g, "newmark", &*nm);
     drop(nm);
-    let ga = Box::new(GeneralizedAlpha::new(&m, &cc, &k, h, 0.8).expect("gen-alpha"));
+    let ga = Box::new(GeneralizedAlpha::<T, N>::new(m, cc, k, h, 0.8).expect("gen-alpha"));
     bench_stepper(&mut g, "gen-alpha", &*ga);
     drop(ga);
-    let ex = Box::new(Exact::new(&m, &cc, &k, h).expect("exact"));
+    let ex = Box::new(Exact::<T, N>::new(m, cc, k, h).expect("exact"));
     bench_stepper(&mut g, "exact", &*ex);
     g.finish();
 }
@@ -113,18 +117,18 @@ fn example10_n<const N: usize>(c: &mut Criterion) {
         .measurement_time(Duration::from_millis(1500))
         .sample_size(10);
     g.bench_function("build aem", |b| {
-        b.iter(|| Box::new(Linear::new(black_box(m), cc, k, h).expect("linear")))
+        b.iter(|| Box::new(Linear::<f64, _>::new(black_box(m), cc, k, h).expect("linear")))
     });
     g.bench_function("build aem-aform", |b| {
         b.iter(|| {
             Box::new(
-                Linear::new(black_box(m), cc, k, h)
+                Linear::<f64, _>::new(black_box(m), cc, k, h)
                     .expect("linear")
                     .a_form(),
             )
         })
     });
-    let lin = Box::new(Linear::new(m, cc, k, h).expect("linear"));
+    let lin = Box::new(Linear::<f64, _>::new(m, cc, k, h).expect("linear"));
     let af = Box::new(lin.a_form());
     let p = SVector::<f64, N>::from_element(1.0);
     let z = SVector::<f64, N>::zeros();

@@ -93,7 +93,7 @@ fn elastic<T: Real>(h: f64, t_end: f64, g: f64, windows: usize) -> Run {
         max_iterations: 0,
     };
     for n in 1..=steps {
-        match st.step(&Elastic, &mut s, &p) {
+        match st.try_step(&Elastic, &mut s, &p) {
             Ok(rep) => run.max_iterations = run.max_iterations.max(rep.iterations),
             Err(e) => {
                 run.failed = Some((n, e));
@@ -127,7 +127,7 @@ fn main() {
         let steps = (100.0 / h).round() as u64;
         let (mut first, mut all) = (0.0f64, 0.0f64);
         for n in 1..=steps {
-            st.step(&Pendulum, &mut s, &vector![0.0])
+            st.try_step(&Pendulum, &mut s, &vector![0.0])
                 .expect("converges");
             let de = (energy(s.u()[0], s.v()[0]) - e0).abs();
             all = all.max(de);

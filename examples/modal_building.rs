@@ -16,7 +16,8 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use aemstep::modal::{base_excitation, lowest_modes, storey_drifts};
+use aemstep::modal::lowest_modes;
+use aemstep::models::{base_excitation, storey_drifts};
 use aemstep::{Damping, Linear, LinearInput, Modal, Real, Stepper, models};
 use nalgebra::{SMatrix, SVector};
 
@@ -45,7 +46,7 @@ fn full_history(ag: &[f64], sub: usize) -> History {
     let (m, c, k) = models::five_storey_building();
     let b = SVector::<f64, 5>::from_fn(|i, _| base_excitation(&m)[i][0]);
     let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
-    let sys = Linear::new(&sm(m), &sm(c), &sm(k), H / sub as f64).unwrap();
+    let sys = Linear::<f64, _>::new(&sm(m), &sm(c), &sm(k), H / sub as f64).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &(b * ag[0])).unwrap();
     let mut out = vec![record(s.u())];
@@ -63,12 +64,12 @@ fn full_history(ag: &[f64], sub: usize) -> History {
 fn modal_history<const R: usize>(ag: &[f64]) -> History {
     let (m, c, k) = models::five_storey_building();
     let y = storey_drifts::<5>();
-    let sys = Modal::<f64, 5, R, 1, 5>::with_modes(
-        &m,
-        &k,
-        &Damping::Matrix(c),
-        &base_excitation(&m),
-        &y,
+    let sys = Modal::<f64, 5, R, 1, 5>::from_rows_with_modes(
+        m,
+        k,
+        Damping::Matrix(c),
+        base_excitation(&m),
+        y,
         lowest_modes(),
         H,
     )
@@ -132,8 +133,10 @@ fn time_per_step(ag: &[f64], mut f: impl FnMut(f64) -> f64) -> f64 {
 fn modal_ns<T: Real, const R: usize>(ag: &[f64]) -> f64 {
     let (m, c, k) = models::five_storey_building();
     let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    let sys =
-        Modal::<T, 5, R>::new(&m, &k, &Damping::Matrix(c), &base_excitation(&m), &roof, H).unwrap();
+    let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
+    let b = SMatrix::<f64, 5, 1>::from_fn(|i, _| base_excitation(&m)[i][0]);
+    let y = SMatrix::<f64, 1, 5>::from_fn(|_, j| roof[0][j]);
+    let sys = Modal::<T, 5, R>::new(&sm(m), &sm(k), &Damping::Matrix(c), &b, &y, H).unwrap();
     let mut s = sys.start_at_rest(&SVector::from([T::zero()])).unwrap();
     time_per_step(ag, |a| {
         sys.step(&mut s, &SVector::from([T::from_f64_rounded(a)]));
@@ -143,9 +146,9 @@ fn modal_ns<T: Real, const R: usize>(ag: &[f64]) -> f64 {
 
 fn linear_ns<T: Real>(ag: &[f64]) -> f64 {
     let (m, c, k) = models::five_storey_building();
-    let sm = |a: [[f64; 5]; 5]| SMatrix::<T, 5, 5>::from_fn(|i, j| T::from_f64_rounded(a[i][j]));
+    let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
     let b = SVector::<T, 5>::from_fn(|i, _| T::from_f64_rounded(base_excitation(&m)[i][0]));
-    let sys = Linear::new(&sm(m), &sm(c), &sm(k), T::from_f64_rounded(H)).unwrap();
+    let sys = Linear::<T, 5>::new(&sm(m), &sm(c), &sm(k), H).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &z).unwrap();
     time_per_step(ag, |a| {
@@ -156,9 +159,9 @@ fn linear_ns<T: Real>(ag: &[f64]) -> f64 {
 
 fn input_ns<T: Real>(ag: &[f64]) -> f64 {
     let (m, c, k) = models::five_storey_building();
-    let sm = |a: [[f64; 5]; 5]| SMatrix::<T, 5, 5>::from_fn(|i, j| T::from_f64_rounded(a[i][j]));
-    let b = SMatrix::<T, 5, 1>::from_fn(|i, _| T::from_f64_rounded(base_excitation(&m)[i][0]));
-    let sys = LinearInput::new(&sm(m), &sm(c), &sm(k), &b, T::from_f64_rounded(H)).unwrap();
+    let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
+    let b = SMatrix::<f64, 5, 1>::from_fn(|i, _| base_excitation(&m)[i][0]);
+    let sys = LinearInput::<T, 5, 1>::new(&sm(m), &sm(c), &sm(k), &b, H).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([T::zero()])).unwrap();
     time_per_step(ag, |a| {

@@ -7,12 +7,16 @@
 #[path = "../tests/support/mod.rs"]
 mod support;
 
-use aemstep::{Linear, Real, Stepper};
-use nalgebra::{SMatrix, SVector};
+use aemstep::{Linear, Real, State, Stepper};
+use nalgebra::SVector;
 use support::{ModalExact, example4, example4_printed_c, order};
 
 /// Max |u − u_exact| over 0 ≤ t ≤ 5 and the response at t = 1, 2, …, 5.
-fn run<T: Real, S: Stepper<T, 3>>(sys: &S, exact: &ModalExact<3>, show: bool) -> f64 {
+fn run<T: Real, S: Stepper<T, 3, Input = SVector<T, 3>, State = State<T, 3>>>(
+    sys: &S,
+    exact: &ModalExact<3>,
+    show: bool,
+) -> f64 {
     let (_, _, _, u0, v0, p) = example4();
     let cv = |a: &SVector<f64, 3>| a.map(T::from_f64_rounded);
     let h = sys.time_step().as_f64();
@@ -50,9 +54,8 @@ fn main() {
         exact.w[2],
         (exact.c - example4_printed_c()).abs().max()
     );
-    let f32m = |a: &SMatrix<f64, 3, 3>| a.map(|x| x as f32);
     println!("\nLinear<f64, 3>, h = 0.01 s:");
-    let sys = Linear::new(&m, &exact.c, &k, 0.01).expect("valid system");
+    let sys = Linear::<f64, _>::new(&m, &exact.c, &k, 0.01).expect("valid system");
     run(&sys, &exact, true);
 
     println!("\nmax |u − u_exact| over 0 ≤ t ≤ 5 (max |u| ≈ 17.3):");
@@ -62,10 +65,10 @@ fn main() {
     );
     let mut prev: Option<(f64, f64)> = None;
     for h in [0.02, 0.01, 0.005, 0.0025] {
-        let fast = Linear::new(&m, &exact.c, &k, h).expect("valid system");
+        let fast = Linear::<f64, _>::new(&m, &exact.c, &k, h).expect("valid system");
         let e64 = run(&fast, &exact, false);
         let ea = run(&fast.a_form(), &exact, false);
-        let f32sys = Linear::new(&f32m(&m), &f32m(&exact.c), &f32m(&k), h as f32).expect("valid");
+        let f32sys = Linear::<f32, 3>::new(&m, &exact.c, &k, h).expect("valid");
         let e32 = run(&f32sys, &exact, false);
         let ord = prev.map_or(String::from("—"), |(e, hp)| {
             format!("{:.3}", order(e, hp, e64, h))

@@ -66,7 +66,11 @@ fn empty_step<S, T, const N: usize>(_: &S, _: &mut State<T, N>, _: &SVector<T, N
 
 /// Instructions per step (in tenths) of `step` on `sys`, over `reps` steps from a
 /// non-zero state, and the stack bytes one step uses.
-fn measure<S: Stepper<T, N>, T: Real, const N: usize>(
+fn measure<
+    S: Stepper<T, N, Input = SVector<T, N>, State = State<T, N>>,
+    T: Real,
+    const N: usize,
+>(
     syst: &mut SYST,
     sys: &S,
     step: fn(&S, &mut State<T, N>, &SVector<T, N>),

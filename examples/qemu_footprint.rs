@@ -48,7 +48,7 @@ fn load(n: u32) -> SVector<f32, 5> {
 mod flash_modal {
     //! A modal model whose operators the compiler computed.
     use super::*;
-    use aemstep::modal::base_excitation;
+    use aemstep::models::base_excitation;
     use aemstep::{Damping, Modal};
 
     static MODAL: Modal<f32, 5, 2> = match Modal::<f32, 5, 2>::from_rows(
@@ -80,7 +80,7 @@ mod flash_modal {
 mod extra {
     //! The capabilities only the full build uses.
     use super::*;
-    use aemstep::modal::base_excitation;
+    use aemstep::models::base_excitation;
     use aemstep::{Damping, Modal, Model, NewtonSettings, Nonlinear, State};
     use nalgebra::SMatrix;
 
@@ -118,7 +118,7 @@ mod extra {
             Err(e) => fail!("nonlinear start: {}", e.as_str()),
         };
         for n in 1..=STEPS {
-            if let Err(e) = nl.step(&Hardening, &mut s, &load(n)) {
+            if let Err(e) = nl.try_step(&Hardening, &mut s, &load(n)) {
                 fail!("nonlinear step {}: {}", n, e.as_str());
             }
         }

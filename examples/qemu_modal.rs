@@ -35,7 +35,7 @@ use core::cell::RefCell;
 use core::hint::black_box;
 use core::sync::atomic::{AtomicBool, Ordering};
 
-use aemstep::modal::base_excitation;
+use aemstep::models::base_excitation;
 use aemstep::models::{self, Rows};
 use aemstep::{Damping, Linear, LinearInput, Modal, ModalState, State, Stepper};
 use cortex_m::interrupt::Mutex;

@@ -17,7 +17,7 @@
 //!   a test) × steps per simulated second; machine-independent cost: multiply-adds per
 //!   step × steps per simulated second.
 //! - Generalized-α and HHT get the load as the textbook scheme does,
-//!   `(1 − α_f) p_n + α_f p_{n−1}` (`step_with_previous_load`).
+//!   `(1 − α_f) p_n + α_f p_{n−1}` (`step_with_previous_input`).
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -28,7 +28,7 @@ use std::time::Instant;
 
 use aemstep::analysis::{Scheme as ASch, sdof};
 use aemstep::models::five_storey_building;
-use aemstep::{AForm, Exact, GeneralizedAlpha, Linear, Newmark, Real, State, Stepper};
+use aemstep::{Exact, GeneralizedAlpha, Linear, Newmark, Real, State, Stepper};
 use nalgebra::{SMatrix, SVector};
 use plotters::prelude::*;
 
@@ -77,54 +77,6 @@ impl Kind {
     }
 }
 
-enum Sch<T, const N: usize> {
-    Aem(Linear<T, N>),
-    AForm(AForm<T, N>),
-    Newmark(Newmark<T, N>),
-    Alpha(GeneralizedAlpha<T, N>),
-    Exact(Exact<T, N>),
-}
-
-impl<T: Real, const N: usize> Sch<T, N> {
-    fn build(
-        kind: Kind,
-        m: &SMatrix<T, N, N>,
-        c: &SMatrix<T, N, N>,
-        k: &SMatrix<T, N, N>,
-        h: T,
-    ) -> Self {
-        match kind {
-            Kind::Aem => Sch::Aem(Linear::new(m, c, k, h).unwrap()),
-            Kind::AemAForm => Sch::AForm(Linear::new(m, c, k, h).unwrap().a_form()),
-            Kind::NewmarkLa => Sch::Newmark(Newmark::linear_acceleration(m, c, k, h).unwrap()),
-            Kind::CentralDiff => Sch::Newmark(Newmark::central_difference(m, c, k, h).unwrap()),
-            Kind::GenAlpha => Sch::Alpha(GeneralizedAlpha::new(m, c, k, h, 0.8).unwrap()),
-            Kind::Hht => Sch::Alpha(GeneralizedAlpha::hht(m, c, k, h, -0.1).unwrap()),
-            Kind::Exact => Sch::Exact(Exact::new(m, c, k, h).unwrap()),
-        }
-    }
-    fn start(&self, u0: &SVector<T, N>, v0: &SVector<T, N>, p0: &SVector<T, N>) -> State<T, N> {
-        match self {
-            Sch::Aem(s) => s.start(u0, v0, p0),
-            Sch::AForm(s) => s.start(u0, v0, p0),
-            Sch::Newmark(s) => s.start(u0, v0, p0),
-            Sch::Alpha(s) => s.start(u0, v0, p0),
-            Sch::Exact(s) => s.start(u0, v0, p0),
-        }
-        .unwrap()
-    }
-    #[inline(always)]
-    fn step(&self, st: &mut State<T, N>, p_prev: &SVector<T, N>, p: &SVector<T, N>) {
-        match self {
-            Sch::Aem(s) => s.step(st, p),
-            Sch::AForm(s) => s.step(st, p),
-            Sch::Newmark(s) => s.step(st, p),
-            Sch::Alpha(s) => s.step_with_previous_load(st, p_prev, p),
-            Sch::Exact(s) => s.step(st, p),
-        }
-    }
-}
-
 /// One problem: matrices, initial state, load at grid index `i` of the 0.5 ms base grid,
 /// and the reference displacement at base-grid index `i`.
 struct Problem<const N: usize> {
@@ -161,29 +113,65 @@ impl Row {
     }
 }
 
+/// Build the stepper of `kind` (operators rounded once to `T`) and measure it.
 fn run<T: Real, const N: usize>(pb: &Problem<N>, kind: Kind, r: usize, ty: &'static str) -> Row {
     let h = r as f64 * BASE;
-    let cast = |a: &SMatrix<f64, N, N>| a.map(T::from_f64_rounded);
-    let vcast = |a: &SVector<f64, N>| a.map(T::from_f64_rounded);
-    let sys = Sch::<T, N>::build(
+    let (m, c, k) = (&pb.m, &pb.c, &pb.k);
+    let (err, ns) = match kind {
+        Kind::Aem => measure(&Linear::<T, N>::new(m, c, k, h).unwrap(), pb, r),
+        Kind::AemAForm => measure(&Linear::<T, N>::new(m, c, k, h).unwrap().a_form(), pb, r),
+        Kind::NewmarkLa => measure(
+            &Newmark::<T, N>::linear_acceleration(m, c, k, h).unwrap(),
+            pb,
+            r,
+        ),
+        Kind::CentralDiff => measure(
+            &Newmark::<T, N>::central_difference(m, c, k, h).unwrap(),
+            pb,
+            r,
+        ),
+        Kind::GenAlpha => measure(
+            &GeneralizedAlpha::<T, N>::new(m, c, k, h, 0.8).unwrap(),
+            pb,
+            r,
+        ),
+        Kind::Hht => measure(
+            &GeneralizedAlpha::<T, N>::hht(m, c, k, h, -0.1).unwrap(),
+            pb,
+            r,
+        ),
+        Kind::Exact => measure(&Exact::<T, N>::new(m, c, k, h).unwrap(), pb, r),
+    };
+    Row {
         kind,
-        &cast(&pb.m),
-        &cast(&pb.c),
-        &cast(&pb.k),
-        T::from_f64_rounded(h),
-    );
+        ty,
+        h,
+        err,
+        ns_per_step: ns,
+        macs_per_step: kind.macs(N),
+    }
+}
+
+/// The one generic driver: steps any scheme through the problem's sampled load with both
+/// samples of each step (`step_with_previous_input`, second order for every scheme) and
+/// returns (max error relative to max |u_ref|, host ns per step).
+fn measure<T: Real, const N: usize, S>(sys: &S, pb: &Problem<N>, r: usize) -> (f64, f64)
+where
+    S: Stepper<T, N, Input = SVector<T, N>, State = State<T, N>>,
+{
+    let vcast = |a: &SVector<f64, N>| a.map(T::from_f64_rounded);
     let n_base = pb.reference.len() - 1;
     let steps = n_base / r;
     let p0 = vcast(&(pb.load)(0));
-    let mut s = sys.start(&vcast(&pb.u0), &vcast(&pb.v0), &p0);
+    let mut s = sys.start(&vcast(&pb.u0), &vcast(&pb.v0), &p0).unwrap();
     let scale = pb.reference.iter().map(|u| u.amax()).fold(0.0, f64::max);
     let mut err = 0.0f64;
     let mut prev = p0;
     for n in 1..=steps {
         let p = vcast(&(pb.load)(n * r));
-        sys.step(&mut s, &prev, &p);
+        sys.step_with_previous_input(&mut s, &prev, &p);
         prev = p;
-        let u = s.u().map(|x| x.as_f64());
+        let u = sys.full_state(&s).u().map(|x| x.as_f64());
         let e = (u - pb.reference[n * r]).amax();
         if !e.is_finite() {
             err = f64::INFINITY;
@@ -194,23 +182,16 @@ fn run<T: Real, const N: usize>(pb: &Problem<N>, kind: Kind, r: usize, ty: &'sta
     // Host time per step: a tight loop with a constant load (best of 5 × 20 000 steps).
     let mut best = f64::INFINITY;
     let p = vcast(&(pb.load)(0)).map(|x| x + T::one());
-    let mut st = sys.start(&vcast(&pb.u0), &vcast(&pb.v0), &p);
+    let mut st = sys.start(&vcast(&pb.u0), &vcast(&pb.v0), &p).unwrap();
     for _ in 0..5 {
         let t0 = Instant::now();
         for _ in 0..20_000 {
-            sys.step(black_box(&mut st), &p, black_box(&p));
+            sys.step_with_previous_input(black_box(&mut st), &p, black_box(&p));
         }
         best = best.min(t0.elapsed().as_nanos() as f64 / 20_000.0);
     }
     black_box(&st);
-    Row {
-        kind,
-        ty,
-        h,
-        err: err / scale,
-        ns_per_step: best,
-        macs_per_step: kind.macs(N),
-    }
+    (err / scale, best)
 }
 
 fn sweep<const N: usize>(pb: &Problem<N>) -> Vec<Row> {
@@ -273,7 +254,7 @@ fn elcentro() -> Problem<5> {
         -mi * a
     };
     // Reference: Exact (f64) at the base step.
-    let ex = Exact::new(&m, &c, &k, BASE).unwrap();
+    let ex = Exact::<f64, _>::new(&m, &c, &k, BASE).unwrap();
     let z = SVector::<f64, 5>::zeros();
     let mut s = ex.start(&z, &z, &load(0)).unwrap();
     let mut reference = vec![z];
@@ -283,7 +264,7 @@ fn elcentro() -> Problem<5> {
     }
     // Cross-check: an independent exponential at h = 0.02 s, exact for the same
     // piecewise-linear load, must agree at the record's sample times to rounding.
-    let ex2 = Exact::new(&m, &c, &k, 0.02).unwrap();
+    let ex2 = Exact::<f64, _>::new(&m, &c, &k, 0.02).unwrap();
     let mut s2 = ex2.start(&z, &z, &load(0)).unwrap();
     let mut dev = 0.0f64;
     for j in 1..ag.len() {

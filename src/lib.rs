@@ -49,8 +49,8 @@ mod state;
 mod stepper;
 
 // The kernel: the shared predictor–corrector and the blocked step over interleaved rows.
-mod kinematics;
 mod kernel;
+mod kinematics;
 
 // Dense linear algebra (LU, Cholesky, symmetric eigen, matrix exponential), in one place.
 mod linalg;

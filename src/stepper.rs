@@ -182,7 +182,6 @@ pub(crate) fn commit_if_finite<S: StepState>(
     }
 }
 
-
 /// The two [`Stepper`] methods every full-order scheme (state [`State<T, N>`]) shares:
 /// `start_with_acceleration` (the given `u0, v0, a0`, checked finite) and `full_state`
 /// (a copy). Expands inside an `impl Stepper<T, N> for …` block.

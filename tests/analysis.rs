@@ -134,7 +134,8 @@ fn amplification_matrix_matches_a_form_blocks() {
     // Independent route: the paper's A (blocks ordered q, v, u) from `a_form`, reordered
     // to (u, v, a) and scaled to (u, h v, h² a) here.
     let (w, xi, h) = (3.0f64, 0.1, 0.07);
-    let lin = Linear::new(&matrix![1.0], &matrix![2.0 * xi * w], &matrix![w * w], h).unwrap();
+    let lin =
+        Linear::<f64, _>::new(&matrix![1.0], &matrix![2.0 * xi * w], &matrix![w * w], h).unwrap();
     let f = lin.a_form();
     let ours = amplification_matrix(&lin);
     let order = [2usize, 1, 0]; // (u, v, a) ← (q=0, v=1, u=2)
@@ -297,7 +298,8 @@ fn spectral_radius_of_known_matrices() {
     let d = [[0.9, 0.0, 0.0], [0.0, -0.7, 0.0], [0.0, 0.0, 0.2]];
     assert!((spectral_radius(&d) - 0.9).abs() < 1e-15);
     // A 1-DOF Newmark stepper's matrix equals the one `sdof` builds.
-    let nm = Newmark::new(&matrix![1.0], &matrix![0.0], &matrix![1.0], 0.5, 0.25, 0.5).unwrap();
+    let nm = Newmark::<f64, _>::new(&matrix![1.0], &matrix![0.0], &matrix![1.0], 0.5, 0.25, 0.5)
+        .unwrap();
     assert_eq!(nm.time_step(), 0.5);
     assert_eq!(
         amplification_matrix(&nm),

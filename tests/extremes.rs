@@ -5,7 +5,7 @@
 //! rounding unit; the measured values are printed (`--nocapture`) and quoted.
 
 use aemstep::analysis::{Scheme, sdof};
-use aemstep::{Exact, GeneralizedAlpha, Linear, Newmark, Stepper};
+use aemstep::{Exact, GeneralizedAlpha, Linear, Newmark, State, Stepper};
 use nalgebra::{SMatrix, SVector, matrix, vector};
 
 const EPS: f64 = f64::EPSILON;
@@ -64,7 +64,10 @@ fn spectral_radius_at_most_one_plus_ulps_from_1e_minus6_to_1e6() {
 /// Energy `u² + v²` (ω = 1) over `n` steps from u0 = 1, v0 = 0 (E0 = 1): returns
 /// (max over all steps of E − 1, max over the first 1000 steps of E, max over the second
 /// half of the run of E).
-fn growth<S: Stepper<f64, 1>>(sys: &S, n: usize) -> (f64, f64, f64) {
+fn growth<S: Stepper<f64, 1, Input = SVector<f64, 1>, State = State<f64, 1>>>(
+    sys: &S,
+    n: usize,
+) -> (f64, f64, f64) {
     let z = vector![0.0];
     let mut s = sys.start(&vector![1.0], &vector![0.0], &z).unwrap();
     let (mut worst, mut early, mut late) = (f64::NEG_INFINITY, 0.0f64, 0.0f64);
@@ -108,20 +111,30 @@ fn no_growth_over_a_million_steps() {
             let (m, c, k) = (matrix![1.0], matrix![2.0 * xi], matrix![1.0]);
             let floor = 4.0 * EPS * (1.0 + s * s / 4.0);
             let runs = [
-                ("aem", growth(&Linear::new(&m, &c, &k, s).unwrap(), n), 0.0),
+                (
+                    "aem",
+                    growth(&Linear::<f64, _>::new(&m, &c, &k, s).unwrap(), n),
+                    0.0,
+                ),
                 (
                     "newmark-aa",
-                    growth(&Newmark::average_acceleration(&m, &c, &k, s).unwrap(), n),
+                    growth(
+                        &Newmark::<f64, _>::average_acceleration(&m, &c, &k, s).unwrap(),
+                        n,
+                    ),
                     0.0,
                 ),
                 (
                     "exact",
-                    growth(&Exact::new(&m, &c, &k, s).unwrap(), n),
+                    growth(&Exact::<f64, _>::new(&m, &c, &k, s).unwrap(), n),
                     n as f64 * 16.0 * s.max(1.0) * EPS,
                 ),
                 (
                     "gen-α 0.8",
-                    growth(&GeneralizedAlpha::new(&m, &c, &k, s, 0.8).unwrap(), n),
+                    growth(
+                        &GeneralizedAlpha::<f64, _>::new(&m, &c, &k, s, 0.8).unwrap(),
+                        n,
+                    ),
                     0.0,
                 ),
             ];
@@ -148,10 +161,10 @@ fn ten_million<T: aemstep::Real>(n: usize) -> (f64, f64, f64) {
     let w = 2.0 * core::f64::consts::PI;
     let h = 0.01;
     let sys = Linear::<T, 1>::new(
-        &SMatrix::from_element(T::from_f64_rounded(1.0)),
-        &SMatrix::from_element(T::from_f64_rounded(0.0)),
-        &SMatrix::from_element(T::from_f64_rounded(w * w)),
-        T::from_f64_rounded(h),
+        &SMatrix::from_element(1.0),
+        &SMatrix::from_element(0.0),
+        &SMatrix::from_element(w * w),
+        h,
     )
     .unwrap();
     let z = SVector::<T, 1>::zeros();
@@ -206,7 +219,7 @@ fn rot(t: f64) -> SMatrix<f64, 2, 2> {
 
 /// Run a 2-DOF stepper from u0 (v0 = 0, p = 0) for `n` steps; returns the final state
 /// as (u, v).
-fn run2<S: Stepper<f64, 2>>(
+fn run2<S: Stepper<f64, 2, Input = SVector<f64, 2>, State = State<f64, 2>>>(
     sys: &S,
     u0: SVector<f64, 2>,
     n: usize,
@@ -248,7 +261,7 @@ fn stiff_system_frequency_ratio_1e6() {
     // error ~ε‖K‖ ≈ 4e-3 on it, i.e. a relative frequency error δω1/ω1 ≲ ε‖K‖/(2ω1²)
     // ≈ 7e-5, and a phase error ≤ ω1 t · 7e-5 = 7e-4 after 10 rad. (Any K with this
     // eigenvalue spread is known only to ε‖K‖ anyway; the kernel adds the same order.)
-    let aem = Linear::new(&m, &c, &k, h).unwrap();
+    let aem = Linear::<f64, _>::new(&m, &c, &k, h).unwrap();
     let (u, v) = run2(&aem, u0, n);
     let (eu, ev) = (modal(u), modal(v));
     let phi1 = 2.0 * (w1 * h / 2.0).atan();
@@ -279,7 +292,7 @@ fn stiff_system_frequency_ratio_1e6() {
     // G·K: mode 1 has the same bound. Mode 2 (amplitude 1e-6): the exponential's
     // squaring error ~2^15 ε ≈ 7e-12 a step, plus the coupling from mode 1,
     // ≤ ε (h²/2)‖K‖ |η1| ≈ 1.2e-8 a step (1.2e-2 relative), unsigned; bound 1.2e-2.
-    let ex = Exact::new(&m, &c, &k, h).unwrap();
+    let ex = Exact::<f64, _>::new(&m, &c, &k, h).unwrap();
     let (u, _) = run2(&ex, u0, n);
     let eu = modal(u);
     let x1 = (eu[0] - eta0[0] * (w1 * t).cos()).abs();
@@ -292,7 +305,7 @@ fn stiff_system_frequency_ratio_1e6() {
     // the rounding coupling from mode 1 that is re-injected every step, ≤ (h²/4) ε ‖K‖
     // |η1| ≈ 6e-9 (and damped at once): |η2| ≤ 1e-8 from 1e-6. Mode 1 keeps its
     // O(s1²) phase error (Chung–Hulbert's PE at ρ∞ = 0 is ≈ 3× the AEM's: measured).
-    let ga = GeneralizedAlpha::new(&m, &c, &k, h, 0.0).unwrap();
+    let ga = GeneralizedAlpha::<f64, _>::new(&m, &c, &k, h, 0.0).unwrap();
     let (u, _) = run2(&ga, u0, n);
     let eu = modal(u);
     let g1 = (eu[0] - eta0[0] * (w1 * t).cos()).abs();
@@ -319,7 +332,7 @@ fn ill_conditioned_mass_condition_1e8() {
     let u0 = q * vector![1.0, 1e-4];
     // Start-up: a0 = −M⁻¹ K u0 = −Q diag(1, 1e8) Qᵀ u0 = −Q (1, 1e4). M⁻¹ carries a
     // relative error ~cond(M) ε = 2e-8.
-    let aem = Linear::new(&m, &c, &k, h).unwrap();
+    let aem = Linear::<f64, _>::new(&m, &c, &k, h).unwrap();
     let z = SVector::<f64, 2>::zeros();
     let s0 = aem.start(&u0, &z, &z).unwrap();
     let a0 = -(q * vector![1.0, 1e4]);
@@ -352,7 +365,7 @@ fn tiny_step_1e_minus9() {
     let t = n as f64 * h;
     // f64: the period error s²/12 = 3e-18 is nothing; u ≈ 1 takes a rounding of ≤ ε/2 each
     // step (u + h v with |h v| ≤ 6e-9): ≤ n ε/2 = 1.1e-10 on u.
-    let sys = Linear::new(&matrix![1.0], &matrix![0.0], &matrix![w * w], h).unwrap();
+    let sys = Linear::<f64, _>::new(&matrix![1.0], &matrix![0.0], &matrix![w * w], h).unwrap();
     let mut s = sys
         .start(&vector![1.0], &vector![0.0], &vector![0.0])
         .unwrap();
@@ -370,13 +383,7 @@ fn tiny_step_1e_minus9() {
     // f32: a displacement increment h v ≤ 2.5e-13 is far below half an ulp of u ≈ 1
     // (6e-8): u stagnates at exactly 1, so the error is |1 − cos(ωt)| = 2e-5. This is the
     // expected f32 limit (use f64, or a larger h, when h·v ≪ ε₃₂·|u|).
-    let sys = Linear::<f32, 1>::new(
-        &matrix![1.0f32],
-        &matrix![0.0f32],
-        &matrix![(w * w) as f32],
-        h as f32,
-    )
-    .unwrap();
+    let sys = Linear::<f32, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![w * w], h).unwrap();
     let mut s = sys
         .start(&vector![1.0f32], &vector![0.0f32], &vector![0.0f32])
         .unwrap();
@@ -404,7 +411,7 @@ fn huge_time_1e6_seconds() {
     // AEM: exactly cos(nφ) with φ = 2 atan(s/2); rounding drifts the phase by ≲ 2ε a step
     // (relative to φ·n ≈ 1e5 rad): ≤ n · 2ε · … ≈ 4.4e-10 rad, plus the f64 evaluation
     // of cos(nφ) at 1e5 rad (≈ 1e5 ε): bound 1e-9.
-    let aem = Linear::new(&m, &c, &k, h).unwrap();
+    let aem = Linear::<f64, _>::new(&m, &c, &k, h).unwrap();
     let mut s = aem
         .start(&vector![1.0], &vector![0.0], &vector![0.0])
         .unwrap();
@@ -422,7 +429,7 @@ fn huge_time_1e6_seconds() {
     assert!(e_disc < 1e-9, "{e_disc:e}");
     // Exact scheme: against cos(ωt) itself. Its Φ has a phase error ≲ 2ε per step (no
     // squaring at s = 0.1): ≤ n · 2ε ≈ 4.4e-10 rad; bound 1e-9.
-    let ex = Exact::new(&m, &c, &k, h).unwrap();
+    let ex = Exact::<f64, _>::new(&m, &c, &k, h).unwrap();
     let mut s = ex
         .start(&vector![1.0], &vector![0.0], &vector![0.0])
         .unwrap();

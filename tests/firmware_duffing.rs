@@ -58,8 +58,7 @@ fn load(t: f64) -> f64 {
 /// not (converged, 2 iterations).
 fn trajectory<T: Real>(h: f64, steps: u32) -> (Vec<f64>, u32) {
     let r = T::from_f64_rounded;
-    let stepper =
-        Nonlinear::<T, 1>::new(r(h), NewtonSettings::exactly(2, r(TOL))).expect("settings");
+    let stepper = Nonlinear::<T, 1>::new(h, NewtonSettings::exactly(2, r(TOL))).expect("settings");
     let mut s = stepper
         .start(
             &Duffing,
@@ -71,7 +70,7 @@ fn trajectory<T: Real>(h: f64, steps: u32) -> (Vec<f64>, u32) {
     let (mut us, mut bad) = (Vec::new(), 0);
     for n in 1..=steps {
         let t = n as f64 * h;
-        match stepper.step(&Duffing, &mut s, &vector![r(load(t))]) {
+        match stepper.try_step(&Duffing, &mut s, &vector![r(load(t))]) {
             Ok(rep) if rep.converged && rep.iterations == 2 => {}
             _ => bad += 1,
         }

@@ -11,7 +11,7 @@
 //! - Prints the host f32 roof drift at the last step as bits, which `scripts/qemu.sh`
 //!   compares with the firmware's (host and Cortex-M4F f32 are bit-identical).
 
-use aemstep::modal::base_excitation;
+use aemstep::models::base_excitation;
 use aemstep::{Damping, Linear, Modal, Stepper, models};
 use nalgebra::{SMatrix, SVector};
 
@@ -39,12 +39,12 @@ const TRUNCATION_MEASURED: f64 = 4.825e-4;
 fn modal() -> Modal<f32, 5, 2> {
     let (m, c, k) = models::five_storey_building();
     let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    Modal::<f32, 5, 2>::new(
-        &m,
-        &k,
-        &Damping::Matrix(c),
-        &base_excitation(&m),
-        &roof,
+    Modal::<f32, 5, 2>::from_rows(
+        m,
+        k,
+        Damping::Matrix(c),
+        base_excitation(&m),
+        roof,
         elcentro::DT,
     )
     .unwrap()
@@ -55,7 +55,7 @@ fn full_roof() -> Vec<f64> {
     let (m, c, k) = models::five_storey_building();
     let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
     let b = SVector::<f64, 5>::from_fn(|i, _| base_excitation(&m)[i][0]);
-    let sys = Linear::new(&sm(m), &sm(c), &sm(k), elcentro::DT).unwrap();
+    let sys = Linear::<f64, _>::new(&sm(m), &sm(c), &sm(k), elcentro::DT).unwrap();
     let ag = &elcentro::AG_F64;
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &(b * ag[0])).unwrap();
@@ -133,12 +133,12 @@ fn reference_is_current_and_host_f32_run_is_within_bound() {
     // Truncation of 2 modes, f64, every step.
     let (m, c, k) = models::five_storey_building();
     let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    let m64 = Modal::<f64, 5, 2>::new(
-        &m,
-        &k,
-        &Damping::Matrix(c),
-        &base_excitation(&m),
-        &roof,
+    let m64 = Modal::<f64, 5, 2>::from_rows(
+        m,
+        k,
+        Damping::Matrix(c),
+        base_excitation(&m),
+        roof,
         elcentro::DT,
     )
     .unwrap();
@@ -171,12 +171,12 @@ fn reference_is_current_and_host_f32_run_is_within_bound() {
     assert!(err <= BOUND, "{err:e} > {BOUND:e}");
     // The check has teeth: one mode (3.6 mm at worst, see the README table) fails it.
     let (m, c, k) = models::five_storey_building();
-    let one = Modal::<f32, 5, 1>::new(
-        &m,
-        &k,
-        &Damping::Matrix(c),
-        &base_excitation(&m),
-        &[[0.0, 0.0, 0.0, 0.0, 1.0]],
+    let one = Modal::<f32, 5, 1>::from_rows(
+        m,
+        k,
+        Damping::Matrix(c),
+        base_excitation(&m),
+        [[0.0, 0.0, 0.0, 0.0, 1.0]],
         elcentro::DT,
     )
     .unwrap();

@@ -10,7 +10,7 @@
 //! `n · N · ε` times a factor 8 for the constant in front (measured ratios are quoted at
 //! each assertion).
 
-use aemstep::modal::base_excitation;
+use aemstep::models::base_excitation;
 use aemstep::{Error, Linear, LinearInput, Stepper, models};
 use nalgebra::{SMatrix, SVector};
 
@@ -57,8 +57,8 @@ fn compare<const N: usize, const I: usize>(seed: u64, steps: usize) -> f64 {
     let mut rng = Rng(seed);
     let (m, c, k, b) = random_system::<N, I>(&mut rng);
     let h = 0.01;
-    let lin = Linear::new(&m, &c, &k, h).unwrap();
-    let inp = LinearInput::new(&m, &c, &k, &b, h).unwrap();
+    let lin = Linear::<f64, _>::new(&m, &c, &k, h).unwrap();
+    let inp = LinearInput::<f64, _, _>::new(&m, &c, &k, &b, h).unwrap();
     let u0 = SVector::<f64, N>::from_fn(|_, _| rng.next());
     let v0 = SVector::<f64, N>::from_fn(|_, _| rng.next());
     let w0 = input_at::<I>(0, h);
@@ -161,19 +161,18 @@ fn const_and_runtime_constructors_agree_bit_for_bit() {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };
-    let f = |a: [[f64; 5]; 5]| SMatrix::<f32, 5, 5>::from_fn(|i, j| a[i][j] as f32);
-    // `new` takes T-valued matrices: exact here because every entry of the building's
-    // M, K and of B is an f32-representable number; C is not, so compare with C rounded.
+    // Both constructors take the f64 data (C is not f32-exact) and round once.
+    let f = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
     let c32 = c.map(|r| r.map(|x| x as f32 as f64));
     let rt = LinearInput::<f32, 5, 1>::new(
         &f(m),
         &f(c32),
         &f(k),
-        &SMatrix::<f32, 5, 1>::from_fn(|i, _| b[i][0] as f32),
+        &SMatrix::<f64, 5, 1>::from_fn(|i, _| b[i][0]),
         0.02,
     )
     .unwrap();
-    let ct = LinearInput::<f32, 5, 1>::from_rows(m, c32, k, b, 0.02f32 as f64).unwrap();
+    let ct = LinearInput::<f32, 5, 1>::from_rows(m, c32, k, b, 0.02).unwrap();
     assert_eq!(rt, ct);
     // The static one used the exact C; it differs from the rounded-C one, and equals a
     // fresh const evaluation.
@@ -227,7 +226,7 @@ fn errors_and_failed_step_leaves_state_unchanged() {
     let before = s;
     assert_eq!(
         sys.try_step(&mut s, &SVector::from([f64::NAN])),
-        Err(Error::NonFiniteState)
+        Err(Error::NonFiniteInput)
     );
     assert_eq!(s, before);
     sys.try_step(&mut s, &SVector::from([1.0])).unwrap();

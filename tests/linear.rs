@@ -9,8 +9,8 @@ use nalgebra::{DMatrix, DVector, SMatrix, SVector, matrix, vector};
 use support::*;
 
 fn sdof<T: Real>(w: f64, xi: f64, h: f64) -> Linear<T, 1> {
-    let c = |x: f64| SMatrix::<T, 1, 1>::new(T::from_f64_rounded(x));
-    Linear::new(&c(1.0), &c(2.0 * xi * w), &c(w * w), T::from_f64_rounded(h)).unwrap()
+    let c = |x: f64| SMatrix::<f64, 1, 1>::new(x);
+    Linear::new(&c(1.0), &c(2.0 * xi * w), &c(w * w), h).unwrap()
 }
 
 /// Numerical period of paper Example 1 (u'' + 25u = 0, u0 = 1, v0 = 0) from the mean
@@ -155,8 +155,7 @@ fn f32_vs_f64_sdof(p: f64) -> f64 {
 fn example4_error<T: Real>(h: f64) -> (f64, f64) {
     let (m, k, xi, u0, v0, p) = example4();
     let exact = ModalExact::new(&m, &k, xi, &u0, &v0, &p);
-    let cv = |a: &SMatrix<f64, 3, 3>| a.map(T::from_f64_rounded);
-    let sys = Linear::<T, 3>::new(&cv(&m), &cv(&exact.c), &cv(&k), T::from_f64_rounded(h)).unwrap();
+    let sys = Linear::<T, 3>::new(&m, &exact.c, &k, h).unwrap();
     let vv = |a: &SVector<f64, 3>| a.map(T::from_f64_rounded);
     let mut s = sys.start(&vv(&u0), &vv(&v0), &vv(&p)).unwrap();
     let (mut err, mut umax) = (0.0f64, 0.0f64);
@@ -209,7 +208,11 @@ fn example4_against_exact_modal_solution() {
 }
 
 /// Runs `stepper` for `steps` steps under `test_load` from fixed initial conditions.
-fn trajectory<T: Real, const N: usize, S: Stepper<T, N>>(
+fn trajectory<
+    T: Real,
+    const N: usize,
+    S: Stepper<T, N, Input = SVector<T, N>, State = State<T, N>>,
+>(
     sys: &S,
     steps: usize,
 ) -> Vec<State<T, N>> {
@@ -246,7 +249,7 @@ fn cross_check<const N: usize>(seed: u64) {
     let mut rng = Rng::new(seed);
     let (m, c, k) = random_system::<N>(&mut rng);
     let h = 0.01;
-    let fast = Linear::new(&m, &c, &k, h).unwrap();
+    let fast = Linear::<f64, _>::new(&m, &c, &k, h).unwrap();
     let aform = fast.a_form();
     let steps = 10_000;
     let tf = trajectory(&fast, steps);
@@ -309,13 +312,7 @@ fn cross_check<const N: usize>(seed: u64) {
     // f32 against f64: the operators rounded to f32 shift each frequency by ≈ ε₃₂ ≈ 6e-8
     // relative, i.e. a phase drift ω·t·ε₃₂ ≤ 9·100·6e-8 ≈ 5e-5 over the 100 s run (ω ≤ 9 rad/s
     // for these systems), plus per-step rounding; 1e-4 covers that, measured ≤ 4e-6.
-    let f32sys = Linear::<f32, N>::new(
-        &m.map(|x| x as f32),
-        &c.map(|x| x as f32),
-        &k.map(|x| x as f32),
-        h as f32,
-    )
-    .unwrap();
+    let f32sys = Linear::<f32, N>::new(&m, &c, &k, h).unwrap();
     let t32: Vec<State<f64, N>> = trajectory(&f32sys, steps)
         .iter()
         .map(|s| {
@@ -349,9 +346,18 @@ fn new_rejects_non_finite_entries() {
     let ok = matrix![1.0, 0.0; 0.0, 1.0];
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
         let b = matrix![1.0, bad; 0.0, 1.0];
-        assert_eq!(Linear::new(&b, &ok, &ok, 0.1), Err(Error::NonFiniteInput));
-        assert_eq!(Linear::new(&ok, &b, &ok, 0.1), Err(Error::NonFiniteInput));
-        assert_eq!(Linear::new(&ok, &ok, &b, 0.1), Err(Error::NonFiniteInput));
+        assert_eq!(
+            Linear::<f64, _>::new(&b, &ok, &ok, 0.1),
+            Err(Error::NonFiniteInput)
+        );
+        assert_eq!(
+            Linear::<f64, _>::new(&ok, &b, &ok, 0.1),
+            Err(Error::NonFiniteInput)
+        );
+        assert_eq!(
+            Linear::<f64, _>::new(&ok, &ok, &b, 0.1),
+            Err(Error::NonFiniteInput)
+        );
     }
 }
 
@@ -360,32 +366,37 @@ fn new_rejects_bad_time_steps() {
     let one = matrix![1.0];
     for h in [0.0, -0.01, -0.0, f64::NAN, f64::INFINITY] {
         assert_eq!(
-            Linear::new(&one, &one, &one, h),
+            Linear::<f64, _>::new(&one, &one, &one, h),
             Err(Error::InvalidTimeStep),
             "h = {h}"
         );
     }
-    // The smallest positive step is valid (stability at the extremes is issue 5's).
-    assert!(Linear::new(&one, &one, &one, f64::MIN_POSITIVE).is_ok());
+    // A step whose square underflows to zero is refused (the kinematics would lose the
+    // acceleration terms); the smallest step with a normal square is valid.
+    assert_eq!(
+        Linear::<f64, _>::new(&one, &one, &one, f64::MIN_POSITIVE),
+        Err(Error::InvalidTimeStep)
+    );
+    assert!(Linear::<f64, _>::new(&one, &one, &one, 1.5e-154).is_ok());
 }
 
 #[test]
 fn new_rejects_singular_effective_matrix() {
     let z = matrix![0.0, 0.0; 0.0, 0.0];
     assert_eq!(
-        Linear::new(&z, &z, &z, 0.01),
+        Linear::<f64, _>::new(&z, &z, &z, 0.01),
         Err(Error::SingularEffectiveMatrix)
     );
     // Rank one in every term: M_eff = (1 + h/2 + h²/4)·[[1, 1], [1, 1]].
     let r1 = matrix![1.0, 1.0; 1.0, 1.0];
     assert_eq!(
-        Linear::new(&r1, &r1, &r1, 0.01),
+        Linear::<f64, _>::new(&r1, &r1, &r1, 0.01),
         Err(Error::SingularEffectiveMatrix)
     );
     // M = −(h²/4) K cancels exactly.
     let h = 0.5;
     assert_eq!(
-        Linear::new(&matrix![-0.0625], &matrix![0.0], &matrix![1.0], h),
+        Linear::<f64, _>::new(&matrix![-0.0625], &matrix![0.0], &matrix![1.0], h),
         Err(Error::SingularEffectiveMatrix)
     );
 }
@@ -396,7 +407,7 @@ fn singular_mass_needs_a_known_initial_acceleration() {
     let m = matrix![1.0, 0.0; 0.0, 0.0];
     let k = matrix![2.0, -1.0; -1.0, 2.0];
     let c = matrix![0.0, 0.0; 0.0, 0.1];
-    let sys = Linear::new(&m, &c, &k, 0.01).unwrap();
+    let sys = Linear::<f64, _>::new(&m, &c, &k, 0.01).unwrap();
     let (u0, v0, p0) = (vector![1.0, 0.5], vector![0.0, 0.0], vector![0.0, 0.0]);
     assert_eq!(sys.start(&u0, &v0, &p0), Err(Error::SingularMass));
     let mut s = sys
@@ -435,9 +446,10 @@ fn start_rejects_non_finite_initial_values() {
 fn checked_step_keeps_state_bit_identical_on_bad_load() {
     let (m, k, xi, u0, v0, p) = example4();
     let c = ModalExact::new(&m, &k, xi, &u0, &v0, &p).c;
-    for (name, sys) in [("fast", Linear::new(&m, &c, &k, 0.01).unwrap())] {
+    for (name, sys) in [("fast", Linear::<f64, _>::new(&m, &c, &k, 0.01).unwrap())] {
         let aform = sys.a_form();
-        let steppers: [&dyn Stepper<f64, 3>; 2] = [&sys, &aform];
+        let steppers: [&dyn Stepper<f64, 3, Input = SVector<f64, 3>, State = State<f64, 3>>; 2] =
+            [&sys, &aform];
         for st in steppers {
             let mut s = st.start(&u0, &v0, &p).unwrap();
             for _ in 0..10 {
@@ -452,6 +464,7 @@ fn checked_step_keeps_state_bit_identical_on_bad_load() {
                     .map(|x| x.to_bits())
                     .collect::<Vec<_>>()
             };
+            // A non-finite load is refused as input (the same variant in every stepper).
             for bad in [
                 vector![f64::NAN, 0.0, 0.0],
                 vector![0.0, f64::INFINITY, 0.0],
@@ -459,19 +472,29 @@ fn checked_step_keeps_state_bit_identical_on_bad_load() {
             ] {
                 assert_eq!(
                     st.try_step(&mut s, &bad),
-                    Err(Error::NonFiniteState),
+                    Err(Error::NonFiniteInput),
                     "{name}"
                 );
                 assert_eq!(bits(&s), bits(&before));
                 assert_eq!(s.steps(), before.steps());
             }
+            // A finite load whose step overflows: the result is refused as state.
+            let m = SVector::repeat(f64::MAX);
+            let mut huge = State::from_parts(m, m, m, s.steps());
+            let kept = huge;
+            assert_eq!(
+                st.try_step(&mut huge, &vector![f64::MAX, f64::MAX, f64::MAX]),
+                Err(Error::NonFiniteState),
+                "{name}"
+            );
+            assert_eq!(bits(&huge), bits(&kept));
             // The stepper goes on from the kept state.
             st.try_step(&mut s, &p).unwrap();
             assert_eq!(s.steps(), before.steps() + 1);
         }
     }
     // A finite load that overflows the state is refused the same way: G = 1e10 here.
-    let light = Linear::new(&matrix![1e-10], &matrix![0.0], &matrix![0.0], 1.0).unwrap();
+    let light = Linear::<f64, _>::new(&matrix![1e-10], &matrix![0.0], &matrix![0.0], 1.0).unwrap();
     let mut s = light
         .start(&vector![0.0], &vector![0.0], &vector![0.0])
         .unwrap();
@@ -495,7 +518,7 @@ fn checked_step_keeps_state_bit_identical_on_bad_load() {
     let before = s;
     assert_eq!(
         sys.try_step(&mut s, &vector![f32::NAN]),
-        Err(Error::NonFiniteState)
+        Err(Error::NonFiniteInput)
     );
     assert_eq!(s.u()[0].to_bits(), before.u()[0].to_bits());
     assert_eq!(s.v()[0].to_bits(), before.v()[0].to_bits());
@@ -563,23 +586,15 @@ static EX4_F32: Linear<f32, 3> = match Linear::<f32, 3>::from_rows(EX4_M, EX4_C,
 #[test]
 fn const_built_operators_equal_runtime_built_bit_for_bit() {
     let sm = |a: [[f64; 3]; 3]| SMatrix::<f64, 3, 3>::from_fn(|i, j| a[i][j]);
-    let rt64 = Linear::new(&sm(EX4_M), &sm(EX4_C), &sm(EX4_K), 0.01).unwrap();
+    let rt64 = Linear::<f64, _>::new(&sm(EX4_M), &sm(EX4_C), &sm(EX4_K), 0.01).unwrap();
     assert_eq!(rt64, EX4_F64); // PartialEq on every operator entry
     assert_eq!(
         rt64.effective_inverse().map(f64::to_bits),
         EX4_F64.effective_inverse().map(f64::to_bits)
     );
     // f32: computed in f64 from the same (f64) data and rounded once, in both paths.
-    // `Linear::new` takes f32 inputs, so use data that f32 represents exactly.
-    let m32 = [[52.0, 10.0, 20.0], [10.0, 150.0, 30.0], [20.0, 30.0, 441.0]];
-    let c32 = [
-        [34.3125, 28.0, 89.5],
-        [28.0, 172.125, 50.4375],
-        [89.5, 50.4375, 770.3125],
-    ];
-    let from_rows = Linear::<f32, 3>::from_rows(m32, c32, EX4_K, 0.015625).unwrap();
-    let s32 = |a: [[f64; 3]; 3]| SMatrix::<f32, 3, 3>::from_fn(|i, j| a[i][j] as f32);
-    let rt32 = Linear::new(&s32(m32), &s32(c32), &s32(EX4_K), 0.015625f32).unwrap();
+    let from_rows = Linear::<f32, 3>::from_rows(EX4_M, EX4_C, EX4_K, 0.01).unwrap();
+    let rt32 = Linear::<f32, 3>::new(&sm(EX4_M), &sm(EX4_C), &sm(EX4_K), 0.01).unwrap();
     assert_eq!(rt32, from_rows);
     // The compile-time f32 static: `step` and `try_step` give the same bits.
     let p = vector![10.0f32, 10.0, 10.0];

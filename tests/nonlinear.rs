@@ -82,7 +82,7 @@ fn duffing_run<T: Real>(h: f64, t_end: f64, analytic: bool, settings: NewtonSett
     for n in 1..=steps {
         let t = n as f64 * h;
         let rep = stepper
-            .step(&model, &mut s, &vector![r(duffing_load(t))])
+            .try_step(&model, &mut s, &vector![r(duffing_load(t))])
             .unwrap();
         assert!(rep.converged && rep.residual <= settings.tolerance);
         run.max_iterations = run.max_iterations.max(rep.iterations);
@@ -215,7 +215,7 @@ fn linear_force_reproduces_linear() {
         k: rows(&k),
     };
     let h = 0.01;
-    let lin = Linear::new(&model.m, &model.c, &model.k, h).unwrap();
+    let lin = Linear::<f64, _>::new(&model.m, &model.c, &model.k, h).unwrap();
     let nl = Nonlinear::<f64, 5>::new(h, NewtonSettings::default()).unwrap();
     // Storey loads 1e6·sin(3t + i) N, from rest displaced 1 cm at the roof.
     let p = |t: f64| SVector::<f64, 5>::from_fn(|i, _| 1e6 * (3.0 * t + i as f64).sin());
@@ -227,7 +227,7 @@ fn linear_force_reproduces_linear() {
     for n in 1..=2000 {
         let pn = p(n as f64 * h);
         lin.step(&mut a, &pn);
-        let rep = nl.step(&model, &mut b, &pn).unwrap();
+        let rep = nl.try_step(&model, &mut b, &pn).unwrap();
         assert!(rep.converged && rep.iterations <= 1, "{rep:?}");
         dev = dev.max((a.u() - b.u()).amax());
         umax = umax.max(a.u().amax());
@@ -299,7 +299,7 @@ fn assert_step_fails<Mo: Model<f64, N>, const N: usize>(
     want: Error,
 ) {
     let before = bits(s);
-    assert_eq!(st.step(model, s, p), Err(want));
+    assert_eq!(st.try_step(model, s, p), Err(want));
     assert_eq!(bits(s), before, "state changed by a failed step");
 }
 
@@ -330,7 +330,7 @@ fn non_convergence_leaves_state_unchanged() {
     assert_eq!(bits(&s), before);
     // With a budget of 50 the same step converges, and the report says in how many.
     let more = Nonlinear::<f64, 1>::new(0.5, NewtonSettings::up_to(50, 1e-12)).unwrap();
-    let rep = more.step(&model, &mut s, &vector![0.0]).unwrap();
+    let rep = more.try_step(&model, &mut s, &vector![0.0]).unwrap();
     assert!(
         rep.converged && rep.iterations > 1 && rep.residual <= 1e-12,
         "{rep:?}"
@@ -441,7 +441,7 @@ fn non_finite_force_or_load_leaves_state_unchanged() {
     };
     assert_step_fails(&st, &bad_mass, &mut s, &vector![0.0], Error::NonFiniteInput);
     // The good model still steps from the untouched state.
-    st.step(&ok, &mut s, &vector![0.0]).unwrap();
+    st.try_step(&ok, &mut s, &vector![0.0]).unwrap();
     assert_eq!(s.steps(), 1);
 }
 
@@ -647,7 +647,7 @@ fn pendulum_run(h: f64, t_end: f64) -> (f64, f64, f64) {
     let steps = (t_end / h).round() as u64;
     let (mut err, mut de, mut early) = (0.0f64, 0.0f64, 0.0f64);
     for n in 1..=steps {
-        st.step(&Pendulum, &mut s, &vector![0.0]).unwrap();
+        st.try_step(&Pendulum, &mut s, &vector![0.0]).unwrap();
         let t = n as f64 * h;
         err = err.max((s.u()[0] - pendulum_exact(t, th0).0).abs());
         de = de.max((pendulum_energy(s.u()[0], s.v()[0]) - e0).abs());
@@ -756,7 +756,7 @@ fn elastic_run<T: Real>(h: f64, t_end: f64, g: f64, analytic: bool, keep: bool) 
         trajectory: Vec::new(),
     };
     for n in 1..=steps {
-        match st.step(&model, &mut s, &p) {
+        match st.try_step(&model, &mut s, &p) {
             Ok(rep) => run.max_iterations = run.max_iterations.max(rep.iterations),
             Err(e) => {
                 run.error = Some(e);
@@ -1008,7 +1008,7 @@ fn wave_run(h: f64, t_end: f64, analytic: bool) -> (f64, f64, u32) {
     for n in 1..=(t_end / h).round() as u64 {
         let t = n as f64 * h;
         let rep = st
-            .step(&Wave::at(t, analytic), &mut s, &wave_load(t))
+            .try_step(&Wave::at(t, analytic), &mut s, &wave_load(t))
             .unwrap();
         it = it.max(rep.iterations);
         for i in 0..NX {
@@ -1091,10 +1091,10 @@ fn fixed_iteration_mode_does_the_same_work_every_step() {
     let mut dev = 0.0f64;
     for n in 1..=2500 {
         let pn = p(n as f64 * h);
-        let rep = fixed.step(&model, &mut a, &pn).unwrap();
+        let rep = fixed.try_step(&model, &mut a, &pn).unwrap();
         assert_eq!(rep.iterations, 2);
         assert!(rep.converged && rep.residual < 1e-14, "{rep:?}");
-        adaptive.step(&model, &mut b, &pn).unwrap();
+        adaptive.try_step(&model, &mut b, &pn).unwrap();
         dev = dev.max((a.u()[0] - b.u()[0]).abs());
     }
     println!("Duffing, exactly 2 iterations vs adaptive: max |Δu| = {dev:.3e}");
@@ -1111,7 +1111,7 @@ fn fixed_iteration_mode_does_the_same_work_every_step() {
         .unwrap();
     let mut worst = 0.0f32;
     for _ in 0..10_000 {
-        let rep = st.step(&model, &mut s, &pg).unwrap();
+        let rep = st.try_step(&model, &mut s, &pg).unwrap();
         assert!(rep.iterations == 2 && rep.converged);
         worst = worst.max(rep.residual.min(rep.correction));
     }

@@ -2,7 +2,7 @@
 
 mod support;
 
-use aemstep::{Error, Exact, GeneralizedAlpha, Linear, Newmark, Stepper};
+use aemstep::{Error, Exact, GeneralizedAlpha, Linear, Newmark, State, Stepper};
 use nalgebra::{SMatrix, SVector, matrix, vector};
 
 type M3 = SMatrix<f64, 3, 3>;
@@ -45,7 +45,10 @@ impl Example4 {
 }
 
 /// Max over t ≤ 5 of |u − u_exact|∞ for a stepper on Example 4.
-fn ex4_error<S: Stepper<f64, 3>>(sys: &S, ex: &Example4) -> f64 {
+fn ex4_error<S: Stepper<f64, 3, Input = SVector<f64, 3>, State = State<f64, 3>>>(
+    sys: &S,
+    ex: &Example4,
+) -> f64 {
     let h = sys.time_step();
     let p = Example4::load();
     let mut s = sys.start(&Example4::u0(), &Example4::v0(), &p).unwrap();
@@ -72,8 +75,8 @@ fn caughey_damping_matches_the_papers_matrix() {
 fn newmark_average_acceleration_is_bit_identical_to_the_aem() {
     let ex = Example4::new();
     let h = 0.01;
-    let a = Linear::new(&ex.m, &ex.c, &ex.k, h).unwrap();
-    let b = Newmark::average_acceleration(&ex.m, &ex.c, &ex.k, h).unwrap();
+    let a = Linear::<f64, _>::new(&ex.m, &ex.c, &ex.k, h).unwrap();
+    let b = Newmark::<f64, _>::average_acceleration(&ex.m, &ex.c, &ex.k, h).unwrap();
     let p = Example4::load();
     let mut sa = a.start(&Example4::u0(), &Example4::v0(), &p).unwrap();
     let mut sb = b.start(&Example4::u0(), &Example4::v0(), &p).unwrap();
@@ -88,7 +91,7 @@ fn newmark_average_acceleration_is_bit_identical_to_the_aem() {
 fn exact_scheme_matches_the_modal_solution_at_any_step() {
     let ex = Example4::new();
     for h in [0.001, 0.01, 0.1, 0.25] {
-        let sys = Exact::new(&ex.m, &ex.c, &ex.k, h).unwrap();
+        let sys = Exact::<f64, _>::new(&ex.m, &ex.c, &ex.k, h).unwrap();
         let err = ex4_error(&sys, &ex);
         println!("exact scheme, Example 4, h = {h}: max error {err:.2e}");
         // Rounding only: per step ≲ 4ε·‖u‖ with ‖u‖ ≤ 12, accumulating at worst linearly
@@ -106,7 +109,7 @@ fn exact_scheme_is_exact_for_a_ramp_load() {
     // piecewise-linear interpolation is exact: rounding error only.
     let w = 3.0f64;
     let h = 0.37; // more than a sixth of the period
-    let sys = Exact::new(&matrix![1.0], &matrix![0.0], &matrix![w * w], h).unwrap();
+    let sys = Exact::<f64, _>::new(&matrix![1.0], &matrix![0.0], &matrix![w * w], h).unwrap();
     let mut s = sys
         .start(&vector![0.0], &vector![0.0], &vector![0.0])
         .unwrap();
@@ -135,13 +138,13 @@ fn every_scheme_converges_at_second_order_on_example_4() {
     let cases: Vec<Case> = vec![
         (
             "aem",
-            Box::new(|h| ex4_error(&Linear::new(&ex.m, &ex.c, &ex.k, h).unwrap(), &ex)),
+            Box::new(|h| ex4_error(&Linear::<f64, _>::new(&ex.m, &ex.c, &ex.k, h).unwrap(), &ex)),
         ),
         (
             "newmark-la",
             Box::new(|h| {
                 ex4_error(
-                    &Newmark::linear_acceleration(&ex.m, &ex.c, &ex.k, h).unwrap(),
+                    &Newmark::<f64, _>::linear_acceleration(&ex.m, &ex.c, &ex.k, h).unwrap(),
                     &ex,
                 )
             }),
@@ -150,7 +153,7 @@ fn every_scheme_converges_at_second_order_on_example_4() {
             "central-difference",
             Box::new(|h| {
                 ex4_error(
-                    &Newmark::central_difference(&ex.m, &ex.c, &ex.k, h).unwrap(),
+                    &Newmark::<f64, _>::central_difference(&ex.m, &ex.c, &ex.k, h).unwrap(),
                     &ex,
                 )
             }),
@@ -159,7 +162,7 @@ fn every_scheme_converges_at_second_order_on_example_4() {
             "gen-alpha 0.8",
             Box::new(|h| {
                 ex4_error(
-                    &GeneralizedAlpha::new(&ex.m, &ex.c, &ex.k, h, 0.8).unwrap(),
+                    &GeneralizedAlpha::<f64, _>::new(&ex.m, &ex.c, &ex.k, h, 0.8).unwrap(),
                     &ex,
                 )
             }),
@@ -168,7 +171,7 @@ fn every_scheme_converges_at_second_order_on_example_4() {
             "hht -0.1",
             Box::new(|h| {
                 ex4_error(
-                    &GeneralizedAlpha::hht(&ex.m, &ex.c, &ex.k, h, -0.1).unwrap(),
+                    &GeneralizedAlpha::<f64, _>::hht(&ex.m, &ex.c, &ex.k, h, -0.1).unwrap(),
                     &ex,
                 )
             }),
@@ -188,14 +191,14 @@ fn every_scheme_converges_at_second_order_on_example_4() {
 #[test]
 fn generalized_alpha_time_varying_load_orders() {
     // u'' + 2ξω u' + ω² u = sin(2t), exact solution via the exact scheme at a fine step
-    // (independent of generalized-α). `step_with_previous_load` is second order; the
+    // (independent of generalized-α). `step_with_previous_input` is second order; the
     // trait's `step` (previous load taken equal to the current one) is first order.
     let (w, xi) = (4.0f64, 0.02);
     let (m, c, k) = (matrix![1.0], matrix![2.0 * xi * w], matrix![w * w]);
     let t_end = 4.0;
     let reference = {
         let h = 1e-4;
-        let sys = Exact::new(&m, &c, &k, h).unwrap();
+        let sys = Exact::<f64, _>::new(&m, &c, &k, h).unwrap();
         let mut s = sys
             .start(&vector![0.0], &vector![0.0], &vector![0.0])
             .unwrap();
@@ -205,7 +208,7 @@ fn generalized_alpha_time_varying_load_orders() {
         s.u()[0]
     };
     let run = |h: f64, interpolated: bool| {
-        let sys = GeneralizedAlpha::new(&m, &c, &k, h, 0.7).unwrap();
+        let sys = GeneralizedAlpha::<f64, _>::new(&m, &c, &k, h, 0.7).unwrap();
         let mut s = sys
             .start(&vector![0.0], &vector![0.0], &vector![0.0])
             .unwrap();
@@ -213,7 +216,7 @@ fn generalized_alpha_time_varying_load_orders() {
         for n in 1..=(t_end / h).round() as usize {
             let p = vector![(2.0 * n as f64 * h).sin()];
             if interpolated {
-                sys.step_with_previous_load(&mut s, &prev, &p);
+                sys.step_with_previous_input(&mut s, &prev, &p);
             } else {
                 sys.step(&mut s, &p);
             }
@@ -230,13 +233,17 @@ fn generalized_alpha_time_varying_load_orders() {
 
 /// Drives any scheme through the shared interface with a sampled, time-varying load:
 /// the loop a user writes once and reuses for every scheme.
-fn sampled_run(sys: &dyn Stepper<f64, 1>, t_end: f64, load: impl Fn(f64) -> f64) -> f64 {
+fn sampled_run(
+    sys: &dyn Stepper<f64, 1, Input = SVector<f64, 1>, State = State<f64, 1>>,
+    t_end: f64,
+    load: impl Fn(f64) -> f64,
+) -> f64 {
     let h = sys.time_step();
     let mut p_prev = vector![load(0.0)];
     let mut s = sys.start(&vector![0.0], &vector![0.0], &p_prev).unwrap();
     for n in 1..=(t_end / h).round() as usize {
         let p = vector![load(n as f64 * h)];
-        sys.try_step_with_previous_load(&mut s, &p_prev, &p)
+        sys.try_step_with_previous_input(&mut s, &p_prev, &p)
             .unwrap();
         p_prev = p;
     }
@@ -252,18 +259,24 @@ fn every_scheme_is_second_order_through_the_shared_interface() {
     let (m, c, k) = (matrix![1.0], matrix![2.0 * xi * w], matrix![w * w]);
     let load = |t: f64| (2.0 * t).sin() + 0.5 * (3.0 * t).cos();
     let t_end = 4.0;
-    let reference = sampled_run(&Exact::new(&m, &c, &k, 1e-4).unwrap(), t_end, load);
-    type Scheme = Box<dyn Stepper<f64, 1>>;
+    let reference = sampled_run(
+        &Exact::<f64, _>::new(&m, &c, &k, 1e-4).unwrap(),
+        t_end,
+        load,
+    );
+    type Scheme = Box<dyn Stepper<f64, 1, Input = SVector<f64, 1>, State = State<f64, 1>>>;
     let build = |name: &str, h: f64| -> Scheme {
         match name {
-            "AEM" => Box::new(Linear::new(&m, &c, &k, h).unwrap()),
-            "AForm" => Box::new(Linear::new(&m, &c, &k, h).unwrap().a_form()),
-            "Newmark LA" => Box::new(Newmark::linear_acceleration(&m, &c, &k, h).unwrap()),
-            "gen-α 0.7" => Box::new(GeneralizedAlpha::new(&m, &c, &k, h, 0.7).unwrap()),
-            "HHT −0.1" => Box::new(GeneralizedAlpha::hht(&m, &c, &k, h, -0.1).unwrap()),
+            "AEM" => Box::new(Linear::<f64, _>::new(&m, &c, &k, h).unwrap()),
+            "AForm" => Box::new(Linear::<f64, _>::new(&m, &c, &k, h).unwrap().a_form()),
+            "Newmark LA" => {
+                Box::new(Newmark::<f64, _>::linear_acceleration(&m, &c, &k, h).unwrap())
+            }
+            "gen-α 0.7" => Box::new(GeneralizedAlpha::<f64, _>::new(&m, &c, &k, h, 0.7).unwrap()),
+            "HHT −0.1" => Box::new(GeneralizedAlpha::<f64, _>::hht(&m, &c, &k, h, -0.1).unwrap()),
             // Exact for the interpolated load: its whole error is the load's
             // piecewise-linear interpolation, also O(h²).
-            _ => Box::new(Exact::new(&m, &c, &k, h).unwrap()),
+            _ => Box::new(Exact::<f64, _>::new(&m, &c, &k, h).unwrap()),
         }
     };
     for name in [
@@ -289,9 +302,11 @@ fn f32_schemes_track_f64() {
     // h = 0.004 the error against the exact solution must stay below the f64 scheme's
     // own O(h²) error plus 1250 · 6e-8 · ‖u‖ (‖u‖ ≤ 12) ≈ 1e-3.
     let ex = Example4::new();
-    let (m, c, k) = (ex.m.cast::<f32>(), ex.c.cast::<f32>(), ex.k.cast::<f32>());
-    let h = 0.004f32;
-    fn err32<S: Stepper<f32, 3>>(sys: &S, ex: &Example4) -> f64 {
+    let (m, c, k, h) = (ex.m, ex.c, ex.k, 0.004);
+    fn err32<S: Stepper<f32, 3, Input = SVector<f32, 3>, State = State<f32, 3>>>(
+        sys: &S,
+        ex: &Example4,
+    ) -> f64 {
         let p = SVector::<f32, 3>::repeat(10.0);
         let mut s = sys
             .start(&Example4::u0().cast(), &Example4::v0().cast(), &p)
@@ -305,12 +320,18 @@ fn f32_schemes_track_f64() {
         e
     }
     let e64 = ex4_error(
-        &Newmark::linear_acceleration(&ex.m, &ex.c, &ex.k, 0.004).unwrap(),
+        &Newmark::<f64, _>::linear_acceleration(&ex.m, &ex.c, &ex.k, 0.004).unwrap(),
         &ex,
     );
-    let e_nm = err32(&Newmark::linear_acceleration(&m, &c, &k, h).unwrap(), &ex);
-    let e_ex = err32(&Exact::new(&m, &c, &k, h).unwrap(), &ex);
-    let e_ga = err32(&GeneralizedAlpha::new(&m, &c, &k, h, 0.8).unwrap(), &ex);
+    let e_nm = err32(
+        &Newmark::<f32, _>::linear_acceleration(&m, &c, &k, h).unwrap(),
+        &ex,
+    );
+    let e_ex = err32(&Exact::<f32, _>::new(&m, &c, &k, h).unwrap(), &ex);
+    let e_ga = err32(
+        &GeneralizedAlpha::<f32, _>::new(&m, &c, &k, h, 0.8).unwrap(),
+        &ex,
+    );
     println!(
         "f32 errors: newmark-la {e_nm:.3e} (f64 {e64:.3e}), exact {e_ex:.3e}, gen-α {e_ga:.3e}"
     );
@@ -325,43 +346,43 @@ fn f32_schemes_track_f64() {
 fn constructors_reject_bad_input() {
     let (m, c, k) = (matrix![1.0], matrix![0.1], matrix![4.0]);
     assert_eq!(
-        Newmark::new(&m, &c, &k, 0.1, -0.1, 0.5),
+        Newmark::<f64, _>::new(&m, &c, &k, 0.1, -0.1, 0.5),
         Err(Error::InvalidParameter)
     );
     assert_eq!(
-        Newmark::new(&m, &c, &k, 0.1, 0.25, f64::NAN),
+        Newmark::<f64, _>::new(&m, &c, &k, 0.1, 0.25, f64::NAN),
         Err(Error::InvalidParameter)
     );
     assert_eq!(
-        Newmark::new(&m, &c, &k, 0.0, 0.25, 0.5),
+        Newmark::<f64, _>::new(&m, &c, &k, 0.0, 0.25, 0.5),
         Err(Error::InvalidTimeStep)
     );
     assert_eq!(
-        Newmark::central_difference(&matrix![0.0], &matrix![0.0], &k, 0.1),
+        Newmark::<f64, _>::central_difference(&matrix![0.0], &matrix![0.0], &k, 0.1),
         Err(Error::SingularEffectiveMatrix)
     );
     assert_eq!(
-        GeneralizedAlpha::new(&m, &c, &k, 0.1, 1.5),
+        GeneralizedAlpha::<f64, _>::new(&m, &c, &k, 0.1, 1.5),
         Err(Error::InvalidParameter)
     );
     assert_eq!(
-        GeneralizedAlpha::hht(&m, &c, &k, 0.1, -0.5),
+        GeneralizedAlpha::<f64, _>::hht(&m, &c, &k, 0.1, -0.5),
         Err(Error::InvalidParameter)
     );
     assert_eq!(
-        GeneralizedAlpha::new(&m, &c, &k, -1.0, 0.5),
+        GeneralizedAlpha::<f64, _>::new(&m, &c, &k, -1.0, 0.5),
         Err(Error::InvalidTimeStep)
     );
     assert_eq!(
-        Exact::new(&matrix![0.0], &c, &k, 0.1),
+        Exact::<f64, _>::new(&matrix![0.0], &c, &k, 0.1),
         Err(Error::SingularMass)
     );
     assert_eq!(
-        Exact::new(&m, &matrix![f64::INFINITY], &k, 0.1),
+        Exact::<f64, _>::new(&m, &matrix![f64::INFINITY], &k, 0.1),
         Err(Error::NonFiniteInput)
     );
     // A singular M still steps with the implicit Newmark schemes from a known a0.
-    let nm = Newmark::average_acceleration(&matrix![0.0], &c, &k, 0.1).unwrap();
+    let nm = Newmark::<f64, _>::average_acceleration(&matrix![0.0], &c, &k, 0.1).unwrap();
     assert_eq!(
         nm.start(&vector![1.0], &vector![0.0], &vector![0.0]),
         Err(Error::SingularMass)
@@ -373,7 +394,7 @@ fn constructors_reject_bad_input() {
     let before = s;
     assert_eq!(
         nm.try_step(&mut s, &vector![f64::NAN]),
-        Err(Error::NonFiniteState)
+        Err(Error::NonFiniteInput)
     );
     assert_eq!(s, before);
 }
@@ -381,17 +402,17 @@ fn constructors_reject_bad_input() {
 #[test]
 fn checked_two_sample_step_keeps_the_state_on_a_bad_sample() {
     let (m, c, k) = (matrix![1.0], matrix![0.1], matrix![4.0]);
-    let sys = GeneralizedAlpha::new(&m, &c, &k, 0.01, 0.7).unwrap();
+    let sys = GeneralizedAlpha::<f64, _>::new(&m, &c, &k, 0.01, 0.7).unwrap();
     let mut s = sys
         .start(&vector![1.0], &vector![0.0], &vector![0.0])
         .unwrap();
-    sys.try_step_with_previous_load(&mut s, &vector![0.0], &vector![1.0])
+    sys.try_step_with_previous_input(&mut s, &vector![0.0], &vector![1.0])
         .unwrap();
     let before = s;
     // Generalized-α reads p_prev: a NaN there is refused, the state kept bit for bit.
     assert_eq!(
-        sys.try_step_with_previous_load(&mut s, &vector![f64::NAN], &vector![1.0]),
-        Err(Error::NonFiniteState)
+        sys.try_step_with_previous_input(&mut s, &vector![f64::NAN], &vector![1.0]),
+        Err(Error::NonFiniteInput)
     );
     assert_eq!(s.u()[0].to_bits(), before.u()[0].to_bits());
     assert_eq!(s.v()[0].to_bits(), before.v()[0].to_bits());

@@ -13,7 +13,7 @@
 //! real defect (a dropped row, a wrong block) shows as O(1).
 
 use aemstep::models::{Rows, rayleigh, shear_building};
-use aemstep::{AForm, Linear, Stepper};
+use aemstep::{AForm, Linear, State, Stepper};
 use nalgebra::{DMatrix, DVector, SVector};
 
 const H: f64 = 0.01;
@@ -78,7 +78,10 @@ fn check<const N: usize>() -> f64 {
     let scale: [f64; 3] =
         core::array::from_fn(|q| reference.iter().map(|r| r[q].amax()).fold(0.0, f64::max));
     let mut worst: f64 = 0.0;
-    for sys in [&lin as &dyn Stepper<f64, N>, &afm as &dyn Stepper<f64, N>] {
+    for sys in [
+        &lin as &dyn Stepper<f64, N, Input = SVector<f64, N>, State = State<f64, N>>,
+        &afm as &dyn Stepper<f64, N, Input = SVector<f64, N>, State = State<f64, N>>,
+    ] {
         let mut s = sys.start(&u0, &v0, &load(0)).expect("start");
         for (n, [u, v, a]) in reference.iter().enumerate() {
             sys.step(&mut s, &load(n + 1));

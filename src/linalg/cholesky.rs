@@ -77,4 +77,3 @@ pub(crate) const fn lower_transpose_solve<const N: usize>(l: &Rows<N>, b: &Rows<
     }
     x
 }
-

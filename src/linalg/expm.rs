@@ -60,7 +60,6 @@ pub(crate) fn norm1<const N: usize>(a: &Mat<N, N>) -> f64 {
     best
 }
 
-
 /// `exp(X)` in place by scaling and squaring a Taylor polynomial (`X` is overwritten).
 /// `work` and `out` are scratch; the result is left in `out`.
 pub(crate) fn blk_expm<const N: usize>(x: &mut Blk<N>, work: &mut Blk<N>, out: &mut Blk<N>) {
@@ -83,8 +82,9 @@ pub(crate) fn blk_expm<const N: usize>(x: &mut Blk<N>, work: &mut Blk<N>, out: &
     }
     // Horner: E = I + X/1 (I + X/2 (I + … (I + X/d))).
     let z = [[0.0; N]; N];
-    let id: Blk<N> =
-        core::array::from_fn(|i| core::array::from_fn(|j| if i == j { identity::<N>() } else { z }));
+    let id: Blk<N> = core::array::from_fn(|i| {
+        core::array::from_fn(|j| if i == j { identity::<N>() } else { z })
+    });
     *out = id;
     for d in (1..=TAYLOR_DEGREE).rev() {
         blk_mul(x, out, work);

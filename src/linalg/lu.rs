@@ -191,7 +191,10 @@ mod tests {
         let expect = [[-0.5, 0.5], [1.0, -2.0 / 3.0]];
         for i in 0..2 {
             for j in 0..2 {
-                assert!((inv[i][j] - expect[i][j]).abs() <= 2.0 * f64::EPSILON, "{inv:?}");
+                assert!(
+                    (inv[i][j] - expect[i][j]).abs() <= 2.0 * f64::EPSILON,
+                    "{inv:?}"
+                );
             }
         }
     }

@@ -162,9 +162,7 @@ pub(crate) const fn sqrt(x: f64) -> f64 {
 }
 
 /// A `nalgebra` matrix (column-major, any `T`) as row-major `f64` (exact).
-pub(crate) fn rows_f64<T: Real, const R: usize, const C: usize>(
-    a: &SMatrix<T, R, C>,
-) -> Mat<R, C> {
+pub(crate) fn rows_f64<T: Real, const R: usize, const C: usize>(a: &SMatrix<T, R, C>) -> Mat<R, C> {
     core::array::from_fn(|i| core::array::from_fn(|j| a[(i, j)].as_f64()))
 }
 

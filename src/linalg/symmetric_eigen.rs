@@ -113,7 +113,6 @@ pub(crate) const fn jacobi_eigen<const N: usize>(
     Err(Error::EigenNotConverged)
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;

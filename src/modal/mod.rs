@@ -348,11 +348,7 @@ const fn modal_operators<const N: usize, const R: usize, const I: usize, const O
         }
         i += 1;
     }
-    if !(all_finite(m)
-        && all_finite(k)
-        && all_finite(b)
-        && all_finite(y))
-    {
+    if !(all_finite(m) && all_finite(k) && all_finite(b) && all_finite(y)) {
         return Err(Error::NonFiniteInput);
     }
     let kin = match Kinematics::aem(h) {
@@ -479,7 +475,15 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
         modes: [usize; R],
         h: f64,
     ) -> Result<Self, Error> {
-        let op = modal_operators(&rows_f64(m), &rows_f64(k), damping, &rows_f64(b), &rows_f64(y), &modes, h)?;
+        let op = modal_operators(
+            &rows_f64(m),
+            &rows_f64(k),
+            damping,
+            &rows_f64(b),
+            &rows_f64(y),
+            &modes,
+            h,
+        )?;
         Ok(Self {
             kin: op.kin.round(),
             g_gamma: linalg::round_rows(&op.g_gamma),
@@ -671,8 +675,17 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> St
             }
             f - self.c[r] * deta[r] - self.k[r] * eta[r]
         });
-        let s = ModalState { eta, deta, ddeta, n: 0 };
-        if s.is_finite() { Ok(s) } else { Err(Error::NonFiniteState) }
+        let s = ModalState {
+            eta,
+            deta,
+            ddeta,
+            n: 0,
+        };
+        if s.is_finite() {
+            Ok(s)
+        } else {
+            Err(Error::NonFiniteState)
+        }
     }
 
     /// The state at `t = 0` from `u0, v0, a0`, each projected on the kept modes
@@ -692,7 +705,11 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> St
             ddeta: self.project(a0),
             n: 0,
         };
-        if s.is_finite() { Ok(s) } else { Err(Error::NonFiniteState) }
+        if s.is_finite() {
+            Ok(s)
+        } else {
+            Err(Error::NonFiniteState)
+        }
     }
 
     /// Each kept mode takes one scalar AEM step under the input `w_n`.

@@ -38,7 +38,9 @@ use nalgebra::{ComplexField, SMatrix, SVector};
 use crate::kernel::{StartOps, initial_state, start_operators};
 use crate::kinematics::check_time_step;
 use crate::linalg::expm::{Blk, blk_expm, norm1};
-use crate::linalg::{Mat, add_scaled, all_finite, finite_as, identity, round_rows, rows_f64, scaled};
+use crate::linalg::{
+    Mat, add_scaled, all_finite, finite_as, identity, round_rows, rows_f64, scaled,
+};
 use crate::{Error, Real, State, Stepper};
 
 /// `y += A x` for a row-major `A`.
@@ -139,7 +141,10 @@ impl<T: Real, const N: usize> Exact<T, N> {
             // P0 = Γ₁ − Γ₂/h multiplies p_{n−1} = M a + C v + K u; P1 = Γ₂/h multiplies p_n.
             let p0 = add_scaled(&g1, -1.0 / hf, &g2);
             let p1 = scaled(1.0 / hf, &g2);
-            if ![&phi_u, &phi_v, &p0, &p1].iter().all(|x| finite_as(x, T::MAX)) {
+            if ![&phi_u, &phi_v, &p0, &p1]
+                .iter()
+                .all(|x| finite_as(x, T::MAX))
+            {
                 return Err(Error::OperatorOverflow);
             }
             *out = [

@@ -79,9 +79,21 @@ impl<T: Real, const N: usize> Linear<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        let op = newmark_operators(&rows_f64(m), &rows_f64(c), &rows_f64(k), h, 0.25, 0.5, T::MAX)?;
+        let op = newmark_operators(
+            &rows_f64(m),
+            &rows_f64(c),
+            &rows_f64(k),
+            h,
+            0.25,
+            0.5,
+            T::MAX,
+        )?;
         let one = T::one();
-        let (g, gc, gk) = (linalg::round_rows(&op.g), linalg::round_rows(&op.gc), linalg::round_rows(&op.gk));
+        let (g, gc, gk) = (
+            linalg::round_rows(&op.g),
+            linalg::round_rows(&op.gc),
+            linalg::round_rows(&op.gk),
+        );
         Ok(Self {
             ops: interleave([&g, &gc, &gk], [one, -one, -one]),
             kin: op.kin.round(),

@@ -14,7 +14,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, interleave, initial_state, newmark_operators, newmark_step};
+use crate::kernel::{StartOps, initial_state, interleave, newmark_operators, newmark_step};
 use crate::kinematics::Kinematics;
 use crate::linalg::{self, rows_f64};
 use crate::{Error, Real, State, Stepper};
@@ -70,7 +70,15 @@ impl<T: Real, const N: usize> Newmark<T, N> {
         beta: f64,
         gamma: f64,
     ) -> Result<Self, Error> {
-        let op = newmark_operators(&rows_f64(m), &rows_f64(c), &rows_f64(k), h, beta, gamma, T::MAX)?;
+        let op = newmark_operators(
+            &rows_f64(m),
+            &rows_f64(c),
+            &rows_f64(k),
+            h,
+            beta,
+            gamma,
+            T::MAX,
+        )?;
         let one = T::one();
         let (g, gc, gk) = (
             linalg::round_rows(&op.g),
