@@ -108,7 +108,7 @@ mod extra {
 
     /// Steps the nonlinear and the modal model; returns their roof displacements.
     pub fn run() -> (f32, f32) {
-        let nl = match Nonlinear::<f32, 5>::new(H as f32, NewtonSettings::default()) {
+        let nl = match Nonlinear::<f32, 5>::new(H, NewtonSettings::default()) {
             Ok(s) => s,
             Err(e) => fail!("nonlinear: {}", e.as_str()),
         };
@@ -124,14 +124,10 @@ mod extra {
         }
         let (m, c, k) = BUILDING;
         let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-        let modal = match Modal::<f32, 5, 2>::new(
-            &m,
-            &k,
-            &Damping::Matrix(c),
-            &base_excitation(&m),
-            &roof,
-            H,
-        ) {
+        let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
+        let b = SMatrix::<f64, 5, 1>::from_fn(|i, _| base_excitation(&m)[i][0]);
+        let y = SMatrix::<f64, 1, 5>::from_fn(|_, j| roof[0][j]);
+        let modal = match Modal::<f32, 5, 2>::new(&sm(m), &sm(k), &Damping::Matrix(c), &b, &y, H) {
             Ok(s) => s,
             Err(e) => fail!("modal: {}", e.as_str()),
         };

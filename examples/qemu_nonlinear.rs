@@ -74,12 +74,12 @@ fn qemu_nonlinear_step(
     s: &mut State<f32, 1>,
     p: &SVector<f32, 1>,
 ) -> Result<NewtonReport<f32>, Error> {
-    stepper.step(&Duffing, s, p)
+    stepper.try_step(&Duffing, s, p)
 }
 
 #[entry]
 fn main() -> ! {
-    let stepper = match Nonlinear::<f32, 1>::new(H, NewtonSettings::exactly(2, TOL)) {
+    let stepper = match Nonlinear::<f32, 1>::new(H as f64, NewtonSettings::exactly(2, TOL)) {
         Ok(s) => s,
         Err(e) => fail!("settings: {}", e.as_str()),
     };

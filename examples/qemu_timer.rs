@@ -91,9 +91,9 @@ fn stepper() -> &'static Linear<f32, 1> {
     #[cfg(feature = "qemu-runtime-ops")]
     {
         let (c, k) = core::hint::black_box((2.0 * XI * OMEGA, OMEGA * OMEGA));
-        let m = nalgebra::matrix![1.0f32];
-        let (c, k) = (nalgebra::matrix![c as f32], nalgebra::matrix![k as f32]);
-        let sys = match Linear::<f64, _>::new(&m, &c, &k, H as f32) {
+        let m = nalgebra::matrix![1.0];
+        let (c, k) = (nalgebra::matrix![c], nalgebra::matrix![k]);
+        let sys = match Linear::<f32, 1>::new(&m, &c, &k, H) {
             Ok(s) => s,
             Err(e) => fail!("operators: {}", e.as_str()),
         };
