@@ -78,7 +78,7 @@ impl Kinematics<f64> {
     }
 
     /// Rounded once to `f32` (`const`).
-    pub(crate) const fn to_f32(&self) -> Kinematics<f32> {
+    pub(crate) const fn to_f32(self) -> Kinematics<f32> {
         Kinematics {
             h: self.h as f32,
             c_v: self.c_v as f32,
@@ -89,8 +89,8 @@ impl Kinematics<f64> {
     }
 
     /// Itself (`const`; the `f64` twin of [`Kinematics::to_f32`]).
-    pub(crate) const fn to_f64(&self) -> Kinematics<f64> {
-        *self
+    pub(crate) const fn to_f64(self) -> Kinematics<f64> {
+        self
     }
 }
 

@@ -50,7 +50,7 @@ impl<const N: usize> Lu<N> {
                 }
                 r += 1;
             }
-            if !(best > tiny) {
+            if best.is_nan() || best <= tiny {
                 return None; // also rejects NaN
             }
             if piv != col {
