@@ -508,6 +508,13 @@ macro_rules! const_ctor {
             /// it. In a `static`, the compiler solves the eigenproblem and no eigen-solver
             /// code is linked into the firmware.
             ///
+            /// **Size limit at compile time.** The Jacobi sweeps cost about `4N³` flops
+            /// each; measured with rustc 1.95, `Modal<f32, N, 2>` compiles in a `static` up
+            /// to `N = 49` and stops at 50 with the `long_running_const_eval` lint (deny by
+            /// default; the largest size is pinned by `tests/constructors.rs`). Allow the
+            /// lint at the firmware's crate root for larger models, or build at run time
+            /// with [`Modal::new`].
+            ///
             /// Errors: as [`Modal::new`].
             pub const fn from_rows(
                 m: Rows<N>,
