@@ -7,11 +7,130 @@
 
 use nalgebra::SVector;
 
-use crate::kinematics::Kinematics;
+use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics};
 use crate::linalg::lu::Lu;
-use crate::linalg::{Mat, add_scaled, all_finite, finite_as, max_abs, round_rows};
+use crate::linalg::{Mat, add_scaled, all_finite, finite_as, max_abs, round_rows, rows_f64};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
+
+/// The operators of a constant-coefficient Newmark-family stepper, rounded to `T`: the
+/// storage of [`Linear`](crate::Linear) (β = 1/4, γ = 1/2) and
+/// [`Newmark`](crate::Newmark).
+#[derive(Clone, Copy, Debug, PartialEq)]
+// `repr(C)` with `ops` first: the step addresses every operator value as a small
+// immediate offset from `self` (Thumb-2 `vldr` reaches ±1020 bytes).
+#[repr(C)]
+pub(crate) struct Kernel<T, const N: usize, K> {
+    /// `ops[i] = [G[i], −GC[i], −GK[i]]` (negation is exact).
+    pub ops: [[[T; N]; 3]; N],
+    /// [`AemKinematics`] or [`NewmarkKinematics`].
+    pub kin: K,
+    pub start: Option<StartOps<T, N>>,
+}
+
+impl<const N: usize> KernelOps<N> {
+    /// The kernel with every operator rounded once to `T` (run time), with the given
+    /// kinematics (already rounded).
+    pub(crate) fn round<T: Real, K>(&self, kin: K) -> Kernel<T, N, K> {
+        let one = T::one();
+        let (g, gc, gk) = (
+            round_rows(&self.g),
+            round_rows(&self.gc),
+            round_rows(&self.gk),
+        );
+        Kernel {
+            ops: interleave([&g, &gc, &gk], [one, -one, -one]),
+            kin,
+            start: self.start.as_ref().map(|(_, s)| s.round()),
+        }
+    }
+
+    /// The AEM kernel (β = 1/4, γ = 1/2), rounded to `T`.
+    pub(crate) fn round_aem<T: Real>(&self) -> Kernel<T, N, AemKinematics<T>> {
+        self.round(self.aem.round())
+    }
+
+    /// The general Newmark kernel, rounded to `T`.
+    pub(crate) fn round_newmark<T: Real>(&self) -> Kernel<T, N, NewmarkKinematics<T>> {
+        self.round(self.kin.round())
+    }
+}
+
+/// `Kernel::<f32, N, AemKinematics<f32>>::from_ops` (and `f64`): the `const` twin of
+/// [`KernelOps::round_aem`], for the `const fn` constructors (bit-identical to it).
+macro_rules! const_kernel {
+    ($t:ident) => {
+        impl<const N: usize> Kernel<$t, N, AemKinematics<$t>> {
+            pub(crate) const fn from_ops(op: &KernelOps<N>) -> Self {
+                let (g, gc, gk) = (
+                    crate::linalg::const_round!($t, rows op.g),
+                    crate::linalg::const_round!($t, rows op.gc),
+                    crate::linalg::const_round!($t, rows op.gk),
+                );
+                let mut ops = [[[0.0; N]; 3]; N];
+                let mut i = 0;
+                while i < N {
+                    let mut j = 0;
+                    while j < N {
+                        ops[i][0][j] = g[i][j];
+                        ops[i][1][j] = -gc[i][j];
+                        ops[i][2][j] = -gk[i][j];
+                        j += 1;
+                    }
+                    i += 1;
+                }
+                Self {
+                    ops,
+                    kin: crate::linalg::const_round!($t, kin op.aem),
+                    start: match &op.start {
+                        Some((_, s)) => Some(StartOps {
+                            minv: crate::linalg::const_round!($t, rows s.minv),
+                            minv_c: crate::linalg::const_round!($t, rows s.minv_c),
+                            minv_k: crate::linalg::const_round!($t, rows s.minv_k),
+                        }),
+                        None => None,
+                    },
+                }
+            }
+        }
+    };
+}
+const_kernel!(f32);
+const_kernel!(f64);
+
+/// `impl Stepper` for a scheme stored as `{ kernel: Kernel<T, N, K> }`
+/// ([`Linear`](crate::Linear), [`Newmark`](crate::Newmark)).
+macro_rules! kernel_stepper {
+    ($scheme:ident) => {
+        impl<T: $crate::Real, const N: usize> $crate::Stepper<T, N> for $scheme<T, N> {
+            type Input = nalgebra::SVector<T, N>;
+            type State = $crate::State<T, N>;
+
+            #[inline]
+            fn time_step(&self) -> T {
+                $crate::kinematics::Kinematics::h(&self.kernel.kin)
+            }
+
+            /// Cost: `3N²` multiply-adds + `7N` (see [`crate::kernel`]).
+            #[inline]
+            fn step(&self, s: &mut $crate::State<T, N>, p: &nalgebra::SVector<T, N>) {
+                $crate::kernel::newmark_step(&self.kernel.ops, &self.kernel.kin, s, p);
+            }
+
+            fn start(
+                &self,
+                u0: &nalgebra::SVector<T, N>,
+                v0: &nalgebra::SVector<T, N>,
+                p0: &nalgebra::SVector<T, N>,
+            ) -> Result<$crate::State<T, N>, $crate::Error> {
+                $crate::kernel::initial_state(self.kernel.start.as_ref(), u0, v0, p0)
+            }
+
+            $crate::stepper::full_order_state!();
+        }
+    };
+}
+pub(crate) use kernel_stepper;
 
 /// One step of the Newmark family in eliminated form over interleaved operator rows:
 ///
@@ -21,9 +140,9 @@ use crate::{Error, Real, State};
 ///
 /// Cost: `3N²` multiply-adds + `7N`; branch-free, panic-free.
 #[inline(always)]
-pub(crate) fn newmark_step<T: Real, const N: usize>(
+pub(crate) fn newmark_step<T: Real, const N: usize, K: Kinematics<T>>(
     ops: &[[[T; N]; 3]; N],
-    kin: &Kinematics<T>,
+    kin: &K,
     s: &mut State<T, N>,
     p: &SVector<T, N>,
 ) {
@@ -47,10 +166,10 @@ pub(crate) fn newmark_step<T: Real, const N: usize>(
 ///
 /// Cost: `2N² + N·I` multiply-adds + `7N`; branch-free, panic-free.
 #[inline(always)]
-pub(crate) fn input_step<T: Real, const N: usize, const I: usize>(
+pub(crate) fn input_step<T: Real, const N: usize, const I: usize, K: Kinematics<T>>(
     gb: &[[T; I]; N],
     ops: &[[[T; N]; 2]; N],
-    kin: &Kinematics<T>,
+    kin: &K,
     s: &mut State<T, N>,
     w: &SVector<T, I>,
 ) {
@@ -194,7 +313,9 @@ pub(crate) struct KernelOps<const N: usize> {
     pub g: Mat<N, N>,
     pub gc: Mat<N, N>,
     pub gk: Mat<N, N>,
-    pub kin: Kinematics<f64>,
+    /// The kinematics of (β, γ), and of the AEM (used when β = 1/4, γ = 1/2).
+    pub kin: NewmarkKinematics<f64>,
+    pub aem: AemKinematics<f64>,
     /// The factorization of `M_eff`, for further solves (e.g. `G B`).
     pub lu: Lu<N>,
     /// The factorization of `M` (if regular) and the start-up operators.
@@ -248,7 +369,11 @@ pub(crate) const fn newmark_operators<const N: usize>(
     if !(beta.is_finite() && gamma.is_finite() && beta >= 0.0 && gamma >= 0.0) {
         return Err(Error::InvalidParameter);
     }
-    let kin = match Kinematics::newmark(h, beta, gamma) {
+    let kin = match NewmarkKinematics::new(h, beta, gamma) {
+        Ok(kin) => kin,
+        Err(e) => return Err(e),
+    };
+    let aem = match AemKinematics::new(h) {
         Ok(kin) => kin,
         Err(e) => return Err(e),
     };
@@ -274,9 +399,25 @@ pub(crate) const fn newmark_operators<const N: usize>(
         gc,
         gk,
         kin,
+        aem,
         lu,
         start,
     })
+}
+
+/// `M, C, K` as row-major `f64`, checked finite ([`Error::NonFiniteInput`]): the data
+/// check of the schemes built outside [`newmark_operators`].
+pub(crate) fn checked_rows<const N: usize>(
+    m: &nalgebra::SMatrix<f64, N, N>,
+    c: &nalgebra::SMatrix<f64, N, N>,
+    k: &nalgebra::SMatrix<f64, N, N>,
+) -> Result<(Mat<N, N>, Mat<N, N>, Mat<N, N>), Error> {
+    let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+    if all_finite(&m) && all_finite(&c) && all_finite(&k) {
+        Ok((m, c, k))
+    } else {
+        Err(Error::NonFiniteInput)
+    }
 }
 
 /// `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0` and the state at step 0; `ops` is `None` when

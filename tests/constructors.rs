@@ -76,8 +76,16 @@ fn modal_new_equals_from_rows_bit_for_bit() {
     let b32 = Modal::<f32, 4, 2, 1, 2>::from_rows(m, k, d, b, y, H).unwrap();
     assert_eq!(bits(&a32), bits(&b32));
     let ratios = Damping::Ratios([0.07; 4]);
-    let a = Modal::<f32, 4, 2, 1, 2>::with_modes(&sm(&m), &sm(&k), &ratios, &sm(&b), &sm(&y), [3, 1], H)
-        .unwrap();
+    let a = Modal::<f32, 4, 2, 1, 2>::with_modes(
+        &sm(&m),
+        &sm(&k),
+        &ratios,
+        &sm(&b),
+        &sm(&y),
+        [3, 1],
+        H,
+    )
+    .unwrap();
     let b = Modal::<f32, 4, 2, 1, 2>::from_rows_with_modes(m, k, ratios, b, y, [3, 1], H).unwrap();
     assert_eq!(bits(&a), bits(&b));
 }
@@ -134,7 +142,11 @@ mod largest_const_sizes {
     }
 
     fn compare() {
-        let (m, c, k) = (chain::<64>(1.0, 0.0), chain::<64>(0.0, 0.0), chain::<64>(2.0, -1.0));
+        let (m, c, k) = (
+            chain::<64>(1.0, 0.0),
+            chain::<64>(0.0, 0.0),
+            chain::<64>(2.0, -1.0),
+        );
         let rt = Linear::<f32, 64>::new(&sm(&m), &sm(&c), &sm(&k), H).unwrap();
         assert_eq!(bits(&rt), bits(&LINEAR_64));
         let (m, k) = (chain::<49>(1.0, 0.0), chain::<49>(2.0, -1.0));

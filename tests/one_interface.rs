@@ -64,7 +64,13 @@ fn one_generic_function_drives_every_linear_scheme() {
     let h = 0.01;
     let steps = 500; // 5 s
     let load = |_: usize| p;
-    let aem = drive(&Linear::<f64, 3>::new(m, c, k, h).unwrap(), load, &pb.exact, steps).unwrap();
+    let aem = drive(
+        &Linear::<f64, 3>::new(m, c, k, h).unwrap(),
+        load,
+        &pb.exact,
+        steps,
+    )
+    .unwrap();
     // The AEM's error at h = 0.01 is O(h²) (order 2 is measured in tests/linear.rs): of the
     // order of ω_max³ h² t / 24 · |η| for the stiffest mode; here 2.26e-2 (max |u| ≈ 17).
     assert!(aem > 1e-3 && aem < 3e-2, "{aem:e}");
@@ -72,41 +78,86 @@ fn one_generic_function_drives_every_linear_scheme() {
     // (operators formed differently, rounding differences carried over 500 steps:
     // relative differences up to a few 1e-13 measured, bound 1e-12).
     let same_as_aem = |name: &str, e: f64| {
-        eprintln!("{name}: {e:.6e} (AEM {aem:.6e}, relative difference {:.1e})", (e - aem).abs() / aem);
-        assert!((e - aem).abs() <= 1e-12 * aem, "{name}: {e:e} vs AEM {aem:e}");
+        eprintln!(
+            "{name}: {e:.6e} (AEM {aem:.6e}, relative difference {:.1e})",
+            (e - aem).abs() / aem
+        );
+        assert!(
+            (e - aem).abs() <= 1e-12 * aem,
+            "{name}: {e:e} vs AEM {aem:e}"
+        );
     };
     let lin = Linear::<f64, 3>::new(m, c, k, h).unwrap();
-    same_as_aem("AForm", drive(&lin.a_form(), load, &pb.exact, steps).unwrap());
+    same_as_aem(
+        "AForm",
+        drive(&lin.a_form(), load, &pb.exact, steps).unwrap(),
+    );
     same_as_aem(
         "Newmark β = 1/4, γ = 1/2",
-        drive(&Newmark::<f64, 3>::average_acceleration(m, c, k, h).unwrap(), load, &pb.exact, steps)
-            .unwrap(),
+        drive(
+            &Newmark::<f64, 3>::average_acceleration(m, c, k, h).unwrap(),
+            load,
+            &pb.exact,
+            steps,
+        )
+        .unwrap(),
     );
     same_as_aem(
         "generalized-α ρ∞ = 1",
-        drive(&GeneralizedAlpha::<f64, 3>::new(m, c, k, h, 1.0).unwrap(), load, &pb.exact, steps)
-            .unwrap(),
+        drive(
+            &GeneralizedAlpha::<f64, 3>::new(m, c, k, h, 1.0).unwrap(),
+            load,
+            &pb.exact,
+            steps,
+        )
+        .unwrap(),
     );
     // Inputs through B = I (three signals w = p).
     let eye = M3::identity();
     let input = LinearInput::<f64, 3, 3>::new(m, c, k, &eye, h).unwrap();
-    same_as_aem("LinearInput", drive(&input, load, &pb.exact, steps).unwrap());
+    same_as_aem(
+        "LinearInput",
+        drive(&input, load, &pb.exact, steps).unwrap(),
+    );
     // All three modes kept (Caughey damping is classical): the same sequence in modal
     // coordinates, read back through `full_state`.
-    let modal =
-        Modal::<f64, 3, 3, 3, 1>::new(m, k, &Damping::Matrix(rows(c)), &eye, &SMatrix::repeat(1.0), h)
-            .unwrap();
-    same_as_aem("Modal R = N", drive(&modal, load, &pb.exact, steps).unwrap());
+    let modal = Modal::<f64, 3, 3, 3, 1>::new(
+        m,
+        k,
+        &Damping::Matrix(rows(c)),
+        &eye,
+        &SMatrix::repeat(1.0),
+        h,
+    )
+    .unwrap();
+    same_as_aem(
+        "Modal R = N",
+        drive(&modal, load, &pb.exact, steps).unwrap(),
+    );
     // The exact scheme is exact for this (constant) load: rounding only, a few ε·max|u| a
     // step (max |u| ≈ 17; each entry is a sum of four block products); unbiased roundings
     // accumulate like a random walk, √n (measured 1.5e-13 against 3.4e-13 at n = 500).
-    let ex = drive(&Exact::<f64, 3>::new(m, c, k, h).unwrap(), load, &pb.exact, steps).unwrap();
+    let ex = drive(
+        &Exact::<f64, 3>::new(m, c, k, h).unwrap(),
+        load,
+        &pb.exact,
+        steps,
+    )
+    .unwrap();
     eprintln!("Exact: {ex:.3e}");
-    assert!(ex < 4.0 * (steps as f64).sqrt() * f64::EPSILON * 17.0, "Exact: {ex:e}");
+    assert!(
+        ex < 4.0 * (steps as f64).sqrt() * f64::EPSILON * 17.0,
+        "Exact: {ex:e}"
+    );
     // The non-AEM schemes are second order too, with their own constants: bounded by the
     // same O(h²) scale (linear acceleration has half the AEM's period error).
-    let la = drive(&Newmark::<f64, 3>::linear_acceleration(m, c, k, h).unwrap(), load, &pb.exact, steps)
-        .unwrap();
+    let la = drive(
+        &Newmark::<f64, 3>::linear_acceleration(m, c, k, h).unwrap(),
+        load,
+        &pb.exact,
+        steps,
+    )
+    .unwrap();
     eprintln!("Newmark LA: {la:.3e}");
     assert!(la < aem, "Newmark LA {la:e} vs AEM {aem:e}");
 }

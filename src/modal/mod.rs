@@ -23,7 +23,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kinematics::Kinematics;
+use crate::kinematics::{AemKinematics, Kinematics};
 use crate::linalg::cholesky::{cholesky, lower_solve, lower_transpose_solve};
 use crate::linalg::symmetric_eigen::{JACOBI_MAX_SWEEPS, jacobi_eigen};
 use crate::linalg::{self, Rows, all_finite, max_abs, mul, rows_f64, sqrt, transpose};
@@ -142,7 +142,7 @@ pub const fn lowest_modes<const R: usize>() -> [usize; R] {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Modal<T, const N: usize, const R: usize, const I: usize = 1, const O: usize = 1> {
-    kin: Kinematics<T>,
+    kin: AemKinematics<T>,
     /// `g_r Γ_r`: input projection times the modal effective inverse, `R×I`.
     g_gamma: [[T; I]; R],
     /// `g_r · 2ξ_r ω_r`.
@@ -308,7 +308,7 @@ const fn modal_damping<const N: usize>(
 
 /// Every operator of a [`Modal`], in `f64`.
 struct ModalOps<const N: usize, const R: usize, const I: usize, const O: usize> {
-    kin: Kinematics<f64>,
+    kin: AemKinematics<f64>,
     g_gamma: [[f64; I]; R],
     g_c: [f64; R],
     g_k: [f64; R],
@@ -351,7 +351,7 @@ const fn modal_operators<const N: usize, const R: usize, const I: usize, const O
     if !(all_finite(m) && all_finite(k) && all_finite(b) && all_finite(y)) {
         return Err(Error::NonFiniteInput);
     }
-    let kin = match Kinematics::aem(h) {
+    let kin = match AemKinematics::new(h) {
         Ok(kin) => kin,
         Err(e) => return Err(e),
     };
@@ -379,7 +379,7 @@ const fn modal_operators<const N: usize, const R: usize, const I: usize, const O
     while r < R {
         let mode = modes[r];
         let (c, lam) = (c_all[mode], lam[mode]);
-        let meff = 1.0 + kin.gamma_h * c + kin.beta_h2 * lam;
+        let meff = 1.0 + kin.half_h * c + kin.quarter_h2 * lam;
         if !(meff.is_finite() && meff > f64::EPSILON) {
             return Err(Error::SingularEffectiveMatrix);
         }

@@ -24,7 +24,7 @@ use core::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kinematics::Kinematics;
+use crate::kinematics::{AemKinematics, Kinematics};
 use crate::linalg::lu::solve_in_place;
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
@@ -202,7 +202,7 @@ pub struct NewtonReport<T> {
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Nonlinear<T, const N: usize> {
-    kin: Kinematics<T>,
+    kin: AemKinematics<T>,
     settings: NewtonSettings<T>,
     _n: PhantomData<[T; N]>,
 }
@@ -215,7 +215,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
     /// [`Error::InvalidNewtonSettings`] (zero iterations, or a tolerance that is negative
     /// or not finite). Cost: O(1).
     pub fn new(h: f64, settings: NewtonSettings<T>) -> Result<Self, Error> {
-        let kin = Kinematics::aem(h)?.round();
+        let kin = AemKinematics::new(h)?.round();
         let budget = match settings.iterations {
             Iterations::UpTo(k) | Iterations::Exactly(k) => k,
         };
@@ -321,7 +321,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         if !m.iter().all(|x| x.is_finite()) {
             return Err(Error::NonFiniteInput);
         }
-        let (b, c) = (self.kin.gamma_h, self.kin.beta_h2);
+        let (b, c) = (self.kin.half_h, self.kin.quarter_h2);
         let (vh, uh) = self.kin.predict_all(&state.u, &state.v, &state.a);
         let (budget, fixed) = match self.settings.iterations {
             Iterations::UpTo(k) => (k, false),

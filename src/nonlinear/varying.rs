@@ -18,7 +18,7 @@ use core::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kinematics::Kinematics;
+use crate::kinematics::{AemKinematics, Kinematics};
 use crate::linalg::lu::solve_in_place;
 use crate::nonlinear::initial_from_equation;
 use crate::scalar::initial_inputs_finite;
@@ -82,7 +82,7 @@ impl<T: Real, const N: usize, F: Fn(T) -> Coefficients<T, N>> TimeVarying<T, N> 
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Varying<T, const N: usize> {
-    kin: Kinematics<T>,
+    kin: AemKinematics<T>,
     _n: PhantomData<[T; N]>,
 }
 
@@ -100,7 +100,7 @@ impl<T: Real, const N: usize> Varying<T, N> {
     /// Errors: [`Error::InvalidTimeStep`] (`h` not finite or `≤ 0`). Cost: O(1).
     pub fn new(h: f64) -> Result<Self, Error> {
         Ok(Self {
-            kin: Kinematics::aem(h)?.round(),
+            kin: AemKinematics::new(h)?.round(),
             _n: PhantomData,
         })
     }
@@ -164,7 +164,7 @@ impl<T: Real, const N: usize> Varying<T, N> {
         if !(finite_coefficients(&k) && p.iter().all(|x| x.is_finite())) {
             return Err(Error::NonFiniteInput);
         }
-        let (b, c) = (self.kin.gamma_h, self.kin.beta_h2);
+        let (b, c) = (self.kin.half_h, self.kin.quarter_h2);
         let (vh, uh) = self.kin.predict_all(&state.u, &state.v, &state.a);
         let mut meff = k.mass + k.damping * b + k.stiffness * c;
         let scale = k

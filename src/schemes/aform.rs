@@ -18,8 +18,8 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, initial_state, mat_vec_blocked};
-use crate::{Error, Real, State, Stepper};
+use crate::kernel::{StartOps, mat_vec_blocked};
+use crate::{Real, State, Stepper};
 
 /// The amplification operator `A` and load operator `b` of the linear AEM step, as
 /// `N×N` blocks; a [`Stepper`] in its own right (`12N²` multiply-adds a step).
@@ -101,16 +101,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for AForm<T, N> {
         self.h
     }
 
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        initial_state(self.start.as_ref(), u0, v0, p0)
-    }
-
-    crate::stepper::full_order_state!();
+    crate::stepper::full_order_state!(start);
 
     /// Cost: `12N²` multiply-adds.
     #[inline]

@@ -35,12 +35,10 @@
 
 use nalgebra::{ComplexField, SMatrix, SVector};
 
-use crate::kernel::{StartOps, initial_state, start_operators};
+use crate::kernel::{StartOps, checked_rows, start_operators};
 use crate::kinematics::check_time_step;
 use crate::linalg::expm::{Blk, blk_expm, norm1};
-use crate::linalg::{
-    Mat, add_scaled, all_finite, finite_as, identity, round_rows, rows_f64, scaled,
-};
+use crate::linalg::{Mat, add_scaled, finite_as, identity, round_rows, scaled};
 use crate::{Error, Real, State, Stepper};
 
 /// `y += A x` for a row-major `A`.
@@ -82,8 +80,8 @@ pub struct Exact<T, const N: usize> {
     av: [[[T; N]; N]; 4],
     /// `M, C, K` (the previous load of a one-sample step).
     mck: [[[T; N]; N]; 3],
-    /// `M⁻¹, M⁻¹C, M⁻¹K` (equation of motion, and start-up).
-    eom: StartOps<T, N>,
+    /// `M⁻¹, M⁻¹C, M⁻¹K` (equation of motion, and start-up; always `Some`).
+    start: Option<StartOps<T, N>>,
 }
 
 impl<T: Real, const N: usize> Exact<T, N> {
@@ -102,10 +100,7 @@ impl<T: Real, const N: usize> Exact<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
-        if !(all_finite(&m) && all_finite(&c) && all_finite(&k)) {
-            return Err(Error::NonFiniteInput);
-        }
+        let (m, c, k) = checked_rows(m, c, k)?;
         let hf = check_time_step(h)?;
         let (_, st) = start_operators(&m, &c, &k, T::MAX)?.ok_or(Error::SingularMass)?;
         let (mi, mic, mik) = (&st.minv, &st.minv_c, &st.minv_k);
@@ -162,7 +157,7 @@ impl<T: Real, const N: usize> Exact<T, N> {
             au,
             av,
             mck: [round_rows(&m), round_rows(&c), round_rows(&k)],
-            eom: st.round(),
+            start: Some(st.round()),
         })
     }
 }
@@ -176,16 +171,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for Exact<T, N> {
         self.h
     }
 
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        initial_state(Some(&self.eom), u0, v0, p0)
-    }
-
-    crate::stepper::full_order_state!();
+    crate::stepper::full_order_state!(start);
 
     /// The step with `p_{n−1} = M a + C v + K u` recovered from the state (see the module
     /// docs). Cost: `14N²` multiply-adds.
@@ -215,12 +201,15 @@ impl<T: Real, const N: usize> Stepper<T, N> for Exact<T, N> {
             mac(&mut u, &self.au[b], &x[b]);
             mac(&mut v, &self.av[b], &x[b]);
         }
+        let Some(eom) = &self.start else {
+            return; // unreachable: `Exact::new` always sets it
+        };
         let mut a = [T::zero(); N];
-        mac(&mut a, &self.eom.minv, &x[3]);
+        mac(&mut a, &eom.minv, &x[3]);
         for i in 0..N {
             let mut acc = a[i];
             for j in 0..N {
-                acc -= self.eom.minv_c[i][j] * v[j] + self.eom.minv_k[i][j] * u[j];
+                acc -= eom.minv_c[i][j] * v[j] + eom.minv_k[i][j] * u[j];
             }
             a[i] = acc;
         }

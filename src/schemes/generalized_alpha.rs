@@ -24,10 +24,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, initial_state, start_operators, terms_scale};
-use crate::kinematics::{Kinematics, check_time_step};
+use crate::kernel::{StartOps, checked_rows, start_operators, terms_scale};
+use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step};
 use crate::linalg::lu::Lu;
-use crate::linalg::{add_scaled, all_finite, finite_as, round_rows, rows_f64, scaled};
+use crate::linalg::{add_scaled, all_finite, finite_as, round_rows, scaled};
 use crate::{Error, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
@@ -102,7 +102,7 @@ pub struct GeneralizedAlpha<T, const N: usize> {
     /// `1 − α_f`, `α_f`.
     w1: T,
     w0: T,
-    kin: Kinematics<T>,
+    kin: NewmarkKinematics<T>,
     /// `a_n = G p̄ − GK u_{n−1} + Av v_{n−1} + Aa a_{n−1}`.
     g: [[T; N]; N],
     gk: [[T; N]; N],
@@ -155,10 +155,7 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
         h: f64,
         p: AlphaParameters,
     ) -> Result<Self, Error> {
-        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
-        if !(all_finite(&m) && all_finite(&c) && all_finite(&k)) {
-            return Err(Error::NonFiniteInput);
-        }
+        let (m, c, k) = checked_rows(m, c, k)?;
         let hf = check_time_step(h)?;
         let AlphaParameters {
             alpha_m,
@@ -198,7 +195,7 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
             params: p,
             w1: T::from_f64_rounded(f1),
             w0: T::from_f64_rounded(alpha_f),
-            kin: Kinematics::newmark(hf, beta, gamma)?.round(),
+            kin: NewmarkKinematics::new(hf, beta, gamma)?.round(),
             g: round_rows(&g),
             gk: round_rows(&gk),
             av: round_rows(&av),
@@ -240,20 +237,11 @@ impl<T: Real, const N: usize> Stepper<T, N> for GeneralizedAlpha<T, N> {
     type Input = SVector<T, N>;
     type State = State<T, N>;
 
-    crate::stepper::full_order_state!();
+    crate::stepper::full_order_state!(start);
 
     #[inline]
     fn time_step(&self) -> T {
         self.kin.h
-    }
-
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        initial_state(self.start.as_ref(), u0, v0, p0)
     }
 
     /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration and

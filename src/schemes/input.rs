@@ -16,7 +16,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::kernel::{StartOps, input_step, interleave, newmark_operators};
-use crate::kinematics::Kinematics;
+use crate::kinematics::AemKinematics;
 use crate::linalg::{self, Mat, Rows, all_finite, finite_as, rows_f64};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State, Stepper};
@@ -51,7 +51,7 @@ pub struct LinearInput<T, const N: usize, const I: usize> {
     ops: [[[T; N]; 2]; N],
     /// `G·B`, row-major `N×I`.
     gb: [[T; I]; N],
-    kin: Kinematics<T>,
+    kin: AemKinematics<T>,
     start: Option<InputStart<T, N, I>>,
 }
 
@@ -67,7 +67,7 @@ struct InputOps<const N: usize, const I: usize> {
     gb: Mat<N, I>,
     gc: Mat<N, N>,
     gk: Mat<N, N>,
-    kin: Kinematics<f64>,
+    kin: AemKinematics<f64>,
     start: Option<(Mat<N, I>, StartOps<f64, N>)>,
 }
 
@@ -103,7 +103,7 @@ const fn input_operators<const N: usize, const I: usize>(
         gb,
         gc: op.gc,
         gk: op.gk,
-        kin: op.kin,
+        kin: op.aem,
         start,
     })
 }

@@ -14,12 +14,12 @@
 //! ([`crate::kinematics`]). The same numbers, in the paper's literal
 //! `U_n = A U_{n−1} + b p_n` form, come from [`Linear::a_form`].
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 
-use crate::kernel::{StartOps, initial_state, interleave, newmark_operators, newmark_step};
-use crate::kinematics::Kinematics;
-use crate::linalg::{self, Rows, rows_f64};
-use crate::{AForm, Error, Real, State, Stepper};
+use crate::kernel::{Kernel, kernel_stepper, newmark_operators};
+use crate::kinematics::AemKinematics;
+use crate::linalg::{Rows, rows_f64};
+use crate::{AForm, Error, Real};
 
 /// The linear constant-coefficient AEM stepper (paper Algorithm 1, eliminated form).
 ///
@@ -45,17 +45,11 @@ use crate::{AForm, Error, Real, State, Stepper};
 /// # Ok::<(), aemstep::Error>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
-// `repr(C)` with `ops` first: the step addresses every operator value as a small
-// immediate offset from `self` (Thumb-2 `vldr` reaches ±1020 bytes).
-#[repr(C)]
+#[repr(transparent)]
 pub struct Linear<T, const N: usize> {
-    /// The step operators, interleaved by row so that row `i` of all three is one
-    /// contiguous run of `3N` values: `ops[i] = [G[i], −(GC)[i], −(GK)[i]]`
-    /// (`G = M_eff⁻¹`). `q_i` is then a single multiply-accumulate chain over that run
-    /// (negation is exact, so the values are those of `G`, `GC`, `GK`).
-    ops: [[[T; N]; 3]; N],
-    kin: Kinematics<T>,
-    start: Option<StartOps<T, N>>,
+    /// `G, GC, GK` interleaved by row (`[G[i], −GC[i], −GK[i]]`, `G = M_eff⁻¹`): `q_i` is a
+    /// single multiply-accumulate chain over one contiguous run of `3N` values.
+    kernel: Kernel<T, N, AemKinematics<T>>,
 }
 
 impl<T: Real, const N: usize> Linear<T, N> {
@@ -79,41 +73,26 @@ impl<T: Real, const N: usize> Linear<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        let op = newmark_operators(
-            &rows_f64(m),
-            &rows_f64(c),
-            &rows_f64(k),
-            h,
-            0.25,
-            0.5,
-            T::MAX,
-        )?;
-        let one = T::one();
-        let (g, gc, gk) = (
-            linalg::round_rows(&op.g),
-            linalg::round_rows(&op.gc),
-            linalg::round_rows(&op.gk),
-        );
+        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+        let op = newmark_operators(&m, &c, &k, h, 0.25, 0.5, T::MAX)?;
         Ok(Self {
-            ops: interleave([&g, &gc, &gk], [one, -one, -one]),
-            kin: op.kin.round(),
-            start: op.start.map(|(_, s)| s.round()),
+            kernel: op.round_aem(),
         })
     }
 
     /// `G = (M + (h/2) C + (h²/4) K)⁻¹`.
     pub fn effective_inverse(&self) -> SMatrix<T, N, N> {
-        SMatrix::from_fn(|i, j| self.ops[i][0][j])
+        SMatrix::from_fn(|i, j| self.kernel.ops[i][0][j])
     }
 
     /// The paper's literal form `U_n = A U_{n−1} + b p_n` of this stepper (`12N²`
     /// multiply-adds a step): the reference the fast form is tested against, and a way to
     /// inspect the amplification operator. Cost to build: about `6N³` flops in `T`.
     pub fn a_form(&self) -> AForm<T, N> {
-        let block = |b: usize, sign: T| self.ops.map(|row| row[b].map(|x| sign * x));
+        let block = |b: usize, sign: T| self.kernel.ops.map(|row| row[b].map(|x| sign * x));
         let one = T::one();
         let (g, gc, gk) = (block(0, one), block(1, -one), block(2, -one));
-        AForm::from_operators(self.kin.h, &g, &gc, &gk, self.start)
+        AForm::from_operators(self.kernel.kin.h, &g, &gc, &gk, self.kernel.start)
     }
 }
 
@@ -158,40 +137,14 @@ macro_rules! const_ctor {
                     Ok(op) => op,
                     Err(e) => return Err(e),
                 };
-                let (g, gc, gk) = (
-                    linalg::const_round!($t, rows op.g),
-                    linalg::const_round!($t, rows op.gc),
-                    linalg::const_round!($t, rows op.gk),
-                );
-                let mut ops = [[[0.0; N]; 3]; N];
-                let mut i = 0;
-                while i < N {
-                    let mut j = 0;
-                    while j < N {
-                        ops[i][0][j] = g[i][j];
-                        ops[i][1][j] = -gc[i][j];
-                        ops[i][2][j] = -gk[i][j];
-                        j += 1;
-                    }
-                    i += 1;
-                }
                 Ok(Self {
-                    ops,
-                    kin: linalg::const_round!($t, kin op.kin),
-                    start: match op.start {
-                        Some((_, s)) => Some(StartOps {
-                            minv: linalg::const_round!($t, rows s.minv),
-                            minv_c: linalg::const_round!($t, rows s.minv_c),
-                            minv_k: linalg::const_round!($t, rows s.minv_k),
-                        }),
-                        None => None,
-                    },
+                    kernel: Kernel::<$t, N, AemKinematics<$t>>::from_ops(&op),
                 })
             }
 
             /// The time step `h` (s), in `const` contexts.
             pub const fn time_step_const(&self) -> $t {
-                self.kin.h
+                self.kernel.kin.h
             }
         }
     };
@@ -199,29 +152,4 @@ macro_rules! const_ctor {
 const_ctor!(f32);
 const_ctor!(f64);
 
-impl<T: Real, const N: usize> Stepper<T, N> for Linear<T, N> {
-    type Input = SVector<T, N>;
-    type State = State<T, N>;
-
-    #[inline]
-    fn time_step(&self) -> T {
-        self.kin.h
-    }
-
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        initial_state(self.start.as_ref(), u0, v0, p0)
-    }
-
-    crate::stepper::full_order_state!();
-
-    /// Cost: `3N²` multiply-adds + `7N` (see the module docs for the recurrence).
-    #[inline]
-    fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
-        newmark_step(&self.ops, &self.kin, s, p);
-    }
-}
+kernel_stepper!(Linear);

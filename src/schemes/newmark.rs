@@ -12,12 +12,12 @@
 //! `ωh ≤ 1/√(γ/2 − β)` (undamped), e.g. `ωh ≤ 2` for central difference, `ωh ≤ 2√3` for
 //! linear acceleration. β = 1/4, γ = 1/2 is the AEM step itself.
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 
-use crate::kernel::{StartOps, initial_state, interleave, newmark_operators, newmark_step};
-use crate::kinematics::Kinematics;
-use crate::linalg::{self, rows_f64};
-use crate::{Error, Real, State, Stepper};
+use crate::kernel::{Kernel, kernel_stepper, newmark_operators};
+use crate::kinematics::NewmarkKinematics;
+use crate::linalg::rows_f64;
+use crate::{Error, Real};
 
 /// A Newmark-family stepper (β, γ) for constant `M, C, K`.
 ///
@@ -41,13 +41,10 @@ use crate::{Error, Real, State, Stepper};
 ///
 /// Size: `6N² + 5` values of `T`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-// `repr(C)` with `ops` first, as `Linear` (short load offsets on Thumb-2).
-#[repr(C)]
+#[repr(transparent)]
 pub struct Newmark<T, const N: usize> {
-    /// `[G[i], −GC[i], −GK[i]]` for every row `i`, as in `Linear`.
-    ops: [[[T; N]; 3]; N],
-    kin: Kinematics<T>,
-    start: Option<StartOps<T, N>>,
+    /// The operators in `Linear`'s layout, `G = (M + γh C + βh² K)⁻¹`.
+    kernel: Kernel<T, N, NewmarkKinematics<T>>,
 }
 
 impl<T: Real, const N: usize> Newmark<T, N> {
@@ -70,25 +67,10 @@ impl<T: Real, const N: usize> Newmark<T, N> {
         beta: f64,
         gamma: f64,
     ) -> Result<Self, Error> {
-        let op = newmark_operators(
-            &rows_f64(m),
-            &rows_f64(c),
-            &rows_f64(k),
-            h,
-            beta,
-            gamma,
-            T::MAX,
-        )?;
-        let one = T::one();
-        let (g, gc, gk) = (
-            linalg::round_rows(&op.g),
-            linalg::round_rows(&op.gc),
-            linalg::round_rows(&op.gk),
-        );
+        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+        let op = newmark_operators(&m, &c, &k, h, beta, gamma, T::MAX)?;
         Ok(Self {
-            ops: interleave([&g, &gc, &gk], [one, -one, -one]),
-            kin: op.kin.round(),
-            start: op.start.map(|(_, s)| s.round()),
+            kernel: op.round_newmark(),
         })
     }
 
@@ -126,29 +108,4 @@ impl<T: Real, const N: usize> Newmark<T, N> {
     }
 }
 
-impl<T: Real, const N: usize> Stepper<T, N> for Newmark<T, N> {
-    type Input = SVector<T, N>;
-    type State = State<T, N>;
-
-    #[inline]
-    fn time_step(&self) -> T {
-        self.kin.h
-    }
-
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        initial_state(self.start.as_ref(), u0, v0, p0)
-    }
-
-    /// Cost: `3N²` multiply-adds + `7N` (the kernel [`Linear`](crate::Linear) steps with).
-    #[inline]
-    fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
-        newmark_step(&self.ops, &self.kin, s, p);
-    }
-
-    crate::stepper::full_order_state!();
-}
+kernel_stepper!(Newmark);
