@@ -130,8 +130,12 @@ fn base_excitation_f32_matches_linear() {
         peak = peak.max(sl.u().amax());
     }
     let rel = (diff / peak) as f64;
-    // Measured 6.0e-7 (≈ 5 ε_f32) against the worst-case bound 1.9e-2.
-    let bound = 8.0 * ag.len() as f64 * 5.0 * f32::EPSILON as f64;
+    // The two f32 steppers differ by the rounding of their operators (`G B` formed once vs
+    // `G·(B a_g)` each step: a few ε_f32 relative) and of each step. The building is damped
+    // (ξ = 5 %): a rounding error fades within about 1/(ξ ω₁ h) = 1/(0.05 · 9 · 0.02) ≈ 111
+    // steps, so at most ~111 steps of rounding (each ≤ N ε for the N = 5 terms of a row)
+    // accumulate: bound 111 · 5 · ε_f32 = 6.6e-5. Measured 4.0e-7.
+    let bound = 111.0 * 5.0 * f32::EPSILON as f64;
     eprintln!("El Centro, f32: relative difference {rel:e} (bound {bound:e})");
     assert!(rel <= bound, "{rel:e} > {bound:e}");
     // …and the f32 run is a real run: peak roof drift of order centimetres.

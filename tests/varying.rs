@@ -94,7 +94,8 @@ fn example3_error_and_order() {
     let order = (e1 / e2).log2();
     println!("Example 3 (T = 20): max error h=0.01: {e1:.3e}, h=0.005: {e2:.3e}, order {order:.3}");
     // Measured 3.132e-5 and 7.831e-6, order 2.000: error = C h² with C = 0.313 at both
-    // steps. Bounds: order within ±0.05 of 2; C at most 10 % above the measured one.
+    // steps. Verification: order within ±0.05 of 2 against the exact solution. Regression
+    // pin: C at most 10 % above the measured one.
     assert!((order - 2.0).abs() < 0.05, "{order}");
     assert!(e1 < 0.345 * 0.01 * 0.01, "{e1}");
     assert!(e2 < 0.345 * 0.005 * 0.005, "{e2}");
