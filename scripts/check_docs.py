@@ -103,7 +103,7 @@ HOST_TIMING = {"docs/benchmarks.md"}
 
 SUP = "⁰¹²³⁴⁵⁶⁷⁸⁹"
 NUM_RE = re.compile(
-    r"(?<![\w.])"
+    r"(?<![\w.])(?<!\w[-−])"
     r"(?P<sign>[-−]?)"
     r"(?:"
     r"10(?P<pow>⁻?[" + SUP + r"]+)"  # 10⁵, 10⁻⁴
@@ -216,15 +216,20 @@ def read(root, path):
         return f.read()
 
 
-def check_generated():
+def check_generated(root=ROOT, only=None):
+    """Regenerates the generated pages and compares them with the ones committed under `root`."""
     errs = []
     with tempfile.TemporaryDirectory() as tmp:
         for path, spec in GENERATED.items():
+            if only is not None and path not in only:
+                continue
             new = run_generator(path, spec, tmp)
-            if not os.path.exists(os.path.join(ROOT, path)):
+            if not os.path.exists(os.path.join(root, path)):
                 errs.append(f"{path}: missing (run python3 scripts/check_docs.py --write)")
                 continue
-            errs += compare_pages(path, read(ROOT, path), new, rtol=spec.get("rtol", 0.0))
+            errs += compare_pages(path, read(root, path), new, rtol=spec.get("rtol", 0.0))
+    if only is not None:
+        return errs
     for path, spec in IN_PLACE.items():
         res = subprocess.run(["git", "show", f":{path}"], cwd=ROOT, capture_output=True, text=True)
         if res.returncode != 0:
@@ -314,6 +319,20 @@ def check_pages(root):
     return errs
 
 
+def check_pages_with_readme(root, text):
+    """check_pages with README.md replaced by `text` (restored afterwards)."""
+    path = os.path.join(root, "README.md")
+    with open(path, encoding="utf-8") as f:
+        keep = f.read()
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+    try:
+        return check_pages(root)
+    finally:
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(keep)
+
+
 def write():
     for path, spec in GENERATED.items():
         outdir = os.path.join(ROOT, os.path.dirname(path))
@@ -323,10 +342,11 @@ def write():
         print(f"  wrote {path}")
 
 
-def nudge(line, units, pick=lambda n, m: True):
-    """The line with the last mantissa digit of its first number that `pick` accepts moved
-    by `units` (down instead of up where that would carry), or None."""
-    for m in NUM_RE.finditer(line):
+def nudge(line, units, pick=lambda n, m: True, last=False):
+    """The line with the last mantissa digit of its first (or last) number that `pick`
+    accepts moved by `units` (down instead of up where that would carry), or None."""
+    found = list(NUM_RE.finditer(line))
+    for m in reversed(found) if last else found:
         if m.group("int") is None or not pick(Num(m), m):
             continue
         end = m.end("frac") if m.group("frac") else m.end("int")
@@ -352,31 +372,55 @@ def self_test():
         shutil.copytree(os.path.join(ROOT, "docs"), os.path.join(tmp, "docs"))
         readme = read(tmp, "README.md")
         expect("the committed README and docs", check_quotes(tmp) + check_pages(tmp), False)
+        expect("README.md over the size limit", check_pages_with_readme(tmp, readme + "x" * README_LIMIT), True)
 
-        def with_readme(text, what, fail=True):
-            with open(os.path.join(tmp, "README.md"), "w", encoding="utf-8") as f:
+        def with_page(page, text, what, fail=True):
+            with open(os.path.join(tmp, page), "w", encoding="utf-8") as f:
                 f.write(text)
             expect(what, check_quotes(tmp), fail)
 
-        lines = readme.splitlines()
-        sources = "\n".join(read(tmp, p) for p in list(GENERATED) + list(IN_PLACE)).splitlines()
-        verb = [i for i, l in enumerate(lines) if l.strip() in {s.strip() for s in sources} and "." in l and numbers(l)]
-        marked = [i for i, l in enumerate(lines) if FROM.search(l)]
-        if not verb or not marked:
-            failures.append("README has no verbatim-quoted table line or no <!-- from --> line to perturb")
-        for idx, kind in [(verb, "a number in a table line quoted verbatim"), (marked, "a number on a <!-- from --> line")]:
-            if not idx:
-                continue
-            i = idx[0]
-            bare_spans = [(m.start(), m.end()) for m in CODE_SPAN.finditer(lines[i])] + \
-                         [(m.start(), m.end()) for m in COMMENT.finditer(lines[i])]
-            new = nudge(lines[i], 3, lambda n, m: n.measured_looking and not any(a <= m.start() < b for a, b in bare_spans))
-            with_readme("\n".join(lines[:i] + [new] + lines[i + 1:]) + "\n",
-                        f"README.md:{i + 1} with {kind} perturbed")
-        with_readme(readme + "\nThe error is 3.3e-5 today.\n", "an unmarked new number in README.md")
-        with_readme(readme, "README.md restored", fail=False)
+        sources = {l.strip() for p in list(GENERATED) + list(IN_PLACE) for l in read(tmp, p).splitlines()}
 
-        # The comparison of a generated page with its regeneration.
+        def first(pred):
+            """(page, line index) of the first line of a quoting page that `pred` accepts."""
+            for page in quoting_pages(tmp):
+                for i, l in enumerate(read(tmp, page).splitlines()):
+                    if pred(page, l):
+                        return page, i
+            return None
+
+        verbatim = first(lambda p, l: p == "README.md" and l.strip() in sources
+                         and any(n.measured_looking for n in numbers(l)))
+        marked = first(lambda p, l: bool(FROM.search(l)))
+        if not verbatim or not marked:
+            failures.append("no verbatim-quoted README line or no <!-- from --> line to perturb")
+        for found, kind in [(verbatim, "a table line quoted verbatim"), (marked, "a <!-- from --> line")]:
+            if not found:
+                continue
+            page, i = found
+            text = read(tmp, page)
+            lines = text.splitlines()
+            skip = [(m.start(), m.end()) for r in (CODE_SPAN, COMMENT) for m in r.finditer(lines[i])]
+            new = nudge(lines[i], 3, lambda n, m: n.measured_looking and not any(a <= m.start() < b for a, b in skip),
+                        last=True)
+            with_page(page, "\n".join(lines[:i] + [new] + lines[i + 1:]) + "\n",
+                      f"{page}:{i + 1}, {kind}, with its last measured number moved by 3 units")
+            with_page(page, text, f"{page} restored", fail=False)
+        with_page("README.md", readme + "\nThe error is 3.3e-5 today.\n", "an unmarked new number in README.md")
+        with_page("README.md", readme, "README.md restored", fail=False)
+
+        # A committed generated page against its regeneration (runs the generator).
+        page = "docs/verification.md"
+        text = read(tmp, page)
+        lines = text.splitlines()
+        i = next(k for k, l in enumerate(lines) if l.startswith("| Example 2 (ii)"))
+        expect(f"{page} against its regeneration", check_generated(tmp, only=[page]), False)
+        with open(os.path.join(tmp, page), "w", encoding="utf-8") as f:
+            f.write("\n".join(lines[:i] + [nudge(lines[i], 2, last=True)] + lines[i + 1:]) + "\n")
+        expect(f"{page}:{i + 1} (the f32 Example 2 figure) moved by 2 units, against its regeneration",
+               check_generated(tmp, only=[page]), True)
+
+        # The comparison rules on a page with host timings.
         page = read(tmp, "docs/tradeoff.md").splitlines()
         row = next(i for i, l in enumerate(page) if l.startswith("| AEM Linear | f64 |"))
         hdr = cells(page[next(i for i in range(row, -1, -1) if page[i].startswith("| scheme"))])
