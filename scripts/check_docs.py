@@ -333,6 +333,15 @@ def check_pages_with_readme(root, text):
             f.write(keep)
 
 
+def warn_uncompiled_code():
+    """Code blocks of docs pages are doctests only where src/lib.rs includes the page."""
+    lib = read(ROOT, "src/lib.rs")
+    for page in quoting_pages(ROOT)[1:]:
+        if re.search(r"^```rust\s*$", read(ROOT, page), re.M) and f"../{page}" not in lib:
+            print(f"  warning: the `rust` code blocks of {page} are not compiled: add "
+                  f'`#[cfg(doctest)] #[doc = include_str!("../{page}")]` on a struct in src/lib.rs')
+
+
 def write():
     for path, spec in GENERATED.items():
         outdir = os.path.join(ROOT, os.path.dirname(path))
@@ -458,6 +467,7 @@ def main(argv):
         errs += check_generated()
     print("==> quoted numbers and pages", flush=True)
     errs += check_quotes(ROOT) + check_pages(ROOT)
+    warn_uncompiled_code()
     if errs:
         print("\n".join(errs), file=sys.stderr)
         raise SystemExit(f"FAILED: {len(errs)} docs check(s) (python3 scripts/check_docs.py)")
