@@ -4,7 +4,10 @@
 Usage (from anywhere; paths are relative to the repository root):
 
   python3 scripts/check_docs.py            check everything (a stage of scripts/test.sh)
-  python3 scripts/check_docs.py --write    regenerate the generated pages in docs/
+  python3 scripts/check_docs.py --write    regenerate the generated pages in docs/ and
+                                           update the lines README.md and docs/ quote from them
+  python3 scripts/check_docs.py --refresh-quotes   only update the quoted lines (after
+                                           scripts/qemu.sh rewrote docs/cortex-m4-cost.md)
   python3 scripts/check_docs.py --quotes   only check the quotes (scripts/qemu.sh, after it
                                            rewrote docs/cortex-m4-cost.md)
   python3 scripts/check_docs.py --self-test  show that a perturbed number fails the check
@@ -342,13 +345,53 @@ def warn_uncompiled_code():
                   f'`#[cfg(doctest)] #[doc = include_str!("../{page}")]` on a struct in src/lib.rs')
 
 
+def committed(path):
+    """The page as in git's HEAD, or None outside a git checkout."""
+    res = subprocess.run(["git", "show", f"HEAD:{path}"], cwd=ROOT, capture_output=True, text=True)
+    return res.stdout if res.returncode == 0 else None
+
+
+def refresh_quotes(old_pages):
+    """Rewrites the lines of README.md and docs/ that quote a generated page verbatim, where
+    that page changed: a quoted line of the old page is replaced by the line the new page has
+    in its place (lines aligned on their text with the numbers left out). Lines marked
+    <!-- from ... --> are prose and left to the author: check_quotes reports them."""
+    import difflib
+
+    moves = {}
+    for path, old in old_pages.items():
+        if old is None or not os.path.exists(os.path.join(ROOT, path)):
+            continue
+        ol, nl = old.splitlines(), read(ROOT, path).splitlines()
+        sm = difflib.SequenceMatcher(None, [skeleton(x) for x in ol], [skeleton(x) for x in nl], autojunk=False)
+        for a, b, n in sm.get_matching_blocks():
+            for k in range(n):
+                if ol[a + k].strip() != nl[b + k].strip() and numbers(ol[a + k]):
+                    moves.setdefault(ol[a + k].strip(), set()).add(nl[b + k].strip())
+    for page in quoting_pages(ROOT):
+        text = read(ROOT, page)
+        lines = text.splitlines()
+        changed = 0
+        for i, l in enumerate(lines):
+            new = moves.get(l.strip())
+            if new and len(new) == 1:
+                lines[i] = next(iter(new))
+                changed += 1
+        if changed:
+            with open(os.path.join(ROOT, page), "w", encoding="utf-8") as f:
+                f.write("\n".join(lines) + ("\n" if text.endswith("\n") else ""))
+            print(f"  {page}: {changed} quoted line(s) updated")
+
+
 def write():
+    old = {p: committed(p) for p in list(GENERATED) + list(IN_PLACE)}
     for path, spec in GENERATED.items():
         outdir = os.path.join(ROOT, os.path.dirname(path))
         text = run_generator(path, spec, outdir)
         with open(os.path.join(ROOT, path), "w", encoding="utf-8") as f:
             f.write(text)
         print(f"  wrote {path}")
+    refresh_quotes(old)
 
 
 def nudge(line, units, pick=lambda n, m: True, last=False):
@@ -460,6 +503,9 @@ def main(argv):
         return
     if "--write" in argv:
         write()
+        return
+    if "--refresh-quotes" in argv:
+        refresh_quotes({p: committed(p) for p in list(GENERATED) + list(IN_PLACE)})
         return
     errs = []
     if "--quotes" not in argv:
