@@ -279,17 +279,9 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     done
 } >"$COST_DOC"
 cat "$COST_DOC"
-# README.md quotes these tables; say so (without failing: a new compiler may move counts)
-# when the quote has gone stale.
-stale=$(grep '^| ' "$COST_DOC" | while IFS= read -r line; do
-    grep -qxF -- "$line" README.md || echo "$line"
-done)
-if [[ -n $stale ]]; then
-    printf '
-WARNING: README.md does not quote these lines of %s (copy the tables over):
-%s
-' \
-        "$COST_DOC" "$stale"
-fi
+# README.md and docs/ quote these tables verbatim (scripts/check_docs.py checks every quoted
+# number): fail when a quote has gone stale.
+python3 scripts/check_docs.py --quotes ||
+    fail "README.md or docs/ quote numbers that $COST_DOC no longer has (copy the new lines over)"
 
 printf '\nqemu: all firmware checks passed\n'

@@ -38,6 +38,12 @@ cargo check --lib --target thumbv7em-none-eabihf --features defmt || fail "defmt
 step "firmware on QEMU (Cortex-M4F): run every example, broken variants must fail, cost table"
 bash scripts/qemu.sh || fail "firmware (scripts/qemu.sh)"
 
+step "docs: every quoted number from its generator (scripts/check_docs.py)"
+# Its self-test first: a perturbed number in a copy of the docs must fail the check.
+python3 scripts/check_docs.py --self-test || fail "scripts/check_docs.py --self-test"
+python3 scripts/check_docs.py ||
+    fail "docs: a quoted number drifted (python3 scripts/check_docs.py --write regenerates the pages)"
+
 step "docs build without warnings"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps || fail "rustdoc"
 
