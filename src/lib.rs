@@ -79,3 +79,18 @@ pub use stepper::{StepInput, StepState, Stepper};
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
+
+/// The code blocks of the docs pages, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/modal.md")]
+pub struct ModalDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/nonlinear.md")]
+pub struct NonlinearDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/schemes.md")]
+pub struct SchemesDocDoctests;
