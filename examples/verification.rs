@@ -139,7 +139,11 @@ fn example4_error<T: Build>(h: f64) -> (f64, f64) {
 
 // ------------------------------------------------------------------ linear: cross-checks
 
-fn trajectory<T: Real, const N: usize, S: Stepper<T, N, Input = SVector<T, N>, State = State<T, N>>>(
+fn trajectory<
+    T: Real,
+    const N: usize,
+    S: Stepper<T, N, Input = SVector<T, N>, State = State<T, N>>,
+>(
     sys: &S,
     steps: usize,
 ) -> Vec<State<f64, N>> {

@@ -6,11 +6,13 @@
 //! (`f32`/`f64`) in-place solve of the per-step systems of the nonlinear and
 //! time-varying steppers.
 //!
-//! **Singular to working precision.** A pivot at or below `N·ε·scale` rejects the matrix,
-//! where `scale` is the size of the *terms* the matrix was assembled from (for
-//! `M + (h/2) C + (h²/4) K`, the largest `|M_ij| + (h/2)|C_ij| + (h²/4)|K_ij|`), not of
-//! the assembled entries: a sum that cancels to rounding noise is singular, however its
-//! noise is scaled.
+//! **Singular to working precision**, judged row by row. Each row `i` has a scale `s_i`:
+//! the size of the *terms* it was assembled from (for `M + (h/2) C + (h²/4) K`, the
+//! largest `|M_ij| + (h/2)|C_ij| + (h²/4)|K_ij|` of the row), not of the assembled entries.
+//! Pivots are chosen by scaled partial pivoting (largest `|a_rc| / s_r`), and a pivot with
+//! `|a_rc| ≤ N·ε·s_r` rejects the matrix. So a sum that cancels to rounding noise is
+//! singular however its noise is scaled, while an exactly invertible but badly scaled
+//! matrix (`diag(1e16, 1)`) is not: scaling a row scales its terms alike.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -26,32 +28,39 @@ pub(crate) struct Lu<const N: usize> {
 }
 
 impl<const N: usize> Lu<N> {
-    /// Factorize `a`; `None` when a pivot is at most `N·ε·scale` (singular to working
-    /// precision against the size `scale` of the terms `a` was assembled from; pass
-    /// `max|a_ij|` when `a` is data). Inputs must be finite. Cost: `N³/3` multiply-adds.
-    pub(crate) const fn new(a: &Mat<N, N>, scale: f64) -> Option<Self> {
-        let tiny = (N as f64) * f64::EPSILON * scale;
+    /// Factorize `a` with the row scales `scales` (the size of the terms each row was
+    /// assembled from; [`row_scales`] for data). `None` when the matrix is singular to
+    /// working precision (see the module docs), or a scale is zero or not finite. Inputs
+    /// must be finite. Cost: `N³/3` multiply-adds.
+    pub(crate) const fn new(a: &Mat<N, N>, scales: &[f64; N]) -> Option<Self> {
+        let tiny = (N as f64) * f64::EPSILON;
         let mut lu = *a;
+        let mut s = *scales;
         let mut perm = [0usize; N];
         let mut i = 0;
         while i < N {
+            if !(s[i].is_finite() && s[i] > 0.0) {
+                return None;
+            }
             perm[i] = i;
             i += 1;
         }
         let mut col = 0;
         while col < N {
+            // Scaled partial pivoting: the largest |a_rc| / s_r at or below the diagonal.
             let mut piv = col;
-            let mut best = lu[col][col].abs();
+            let mut best = lu[col][col].abs() / s[col];
             let mut r = col + 1;
             while r < N {
-                if lu[r][col].abs() > best {
-                    best = lu[r][col].abs();
+                let x = lu[r][col].abs() / s[r];
+                if x > best {
+                    best = x;
                     piv = r;
                 }
                 r += 1;
             }
             if best.is_nan() || best <= tiny {
-                return None; // also rejects NaN
+                return None;
             }
             if piv != col {
                 let t = lu[piv];
@@ -60,6 +69,9 @@ impl<const N: usize> Lu<N> {
                 let t = perm[piv];
                 perm[piv] = perm[col];
                 perm[col] = t;
+                let t = s[piv];
+                s[piv] = s[col];
+                s[col] = t;
             }
             let d = lu[col][col];
             r = col + 1;
@@ -119,6 +131,53 @@ impl<const N: usize> Lu<N> {
     pub(crate) const fn inverse(&self) -> Mat<N, N> {
         self.solve(&identity())
     }
+}
+
+/// The largest `|a_ij|` of each row: the row scales of a matrix that is data (not
+/// assembled from terms).
+pub(crate) const fn row_scales<const N: usize>(a: &Mat<N, N>) -> [f64; N] {
+    let mut s = [0.0; N];
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < N {
+            if a[i][j].abs() > s[i] {
+                s[i] = a[i][j].abs();
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    s
+}
+
+/// `κ₁` of the row-equilibrated matrix, `‖D⁻¹A‖₁ ‖A⁻¹D‖₁` with `D = diag(scales)`, from
+/// `A` and its inverse: how close to singular the matrix is at the precision its rows
+/// were assembled in (`1/κ` is the relative distance to a singular matrix). `O(N²)`.
+pub(crate) const fn condition<const N: usize>(
+    a: &Mat<N, N>,
+    inv: &Mat<N, N>,
+    scales: &[f64; N],
+) -> f64 {
+    let (mut na, mut ni) = (0.0f64, 0.0f64);
+    let mut j = 0;
+    while j < N {
+        let (mut ca, mut ci) = (0.0, 0.0);
+        let mut i = 0;
+        while i < N {
+            ca += a[i][j].abs() / scales[i];
+            ci += inv[i][j].abs() * scales[j];
+            i += 1;
+        }
+        if ca > na {
+            na = ca;
+        }
+        if ci > ni {
+            ni = ci;
+        }
+        j += 1;
+    }
+    na * ni
 }
 
 /// Solve `A x = b` in place (`b` becomes `x`) by Gaussian elimination with partial
@@ -182,12 +241,12 @@ pub(crate) fn solve_in_place<T: Real, const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::linalg::{max_abs, mul};
+    use crate::linalg::mul;
 
     #[test]
     fn inverse_of_known_matrix() {
         let a = [[4.0, 3.0], [6.0, 3.0]];
-        let inv = Lu::new(&a, max_abs(&a)).unwrap().inverse();
+        let inv = Lu::new(&a, &row_scales(&a)).unwrap().inverse();
         let expect = [[-0.5, 0.5], [1.0, -2.0 / 3.0]];
         for i in 0..2 {
             for j in 0..2 {
@@ -203,7 +262,7 @@ mod tests {
     fn solve_needs_pivoting_and_detects_singularity() {
         // Zero leading entry: needs a row swap.
         let a = [[0.0, 1.0, 2.0], [1.0, 0.0, 3.0], [4.0, -3.0, 8.0]];
-        let inv = Lu::new(&a, max_abs(&a)).unwrap().inverse();
+        let inv = Lu::new(&a, &row_scales(&a)).unwrap().inverse();
         let id = mul(&a, &inv);
         for i in 0..3 {
             for j in 0..3 {
@@ -214,18 +273,23 @@ mod tests {
         }
         // Rank 2: third row is the sum of the first two.
         let s = [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [5.0, 7.0, 9.0]];
-        assert!(Lu::new(&s, max_abs(&s)).is_none());
-        assert!(Lu::new(&[[0.0; 2]; 2], 0.0).is_none());
+        assert!(Lu::new(&s, &row_scales(&s)).is_none());
+        assert!(Lu::new(&[[0.0; 2]; 2], &[0.0; 2]).is_none());
         // Cancellation judged against the terms: 1 + (−1 + 1e-17) is zero to rounding.
-        assert!(Lu::new(&[[1e-17]], 1.0).is_none());
-        assert!(Lu::new(&[[1e-17]], 1e-17).is_some());
+        assert!(Lu::new(&[[1e-17]], &[1.0]).is_none());
+        assert!(Lu::new(&[[1e-17]], &[1e-17]).is_some());
+        // Badly scaled but exactly invertible: not singular, and solved exactly.
+        let d = [[1e16, 0.0], [0.0, 1.0]];
+        let lu = Lu::new(&d, &row_scales(&d)).unwrap();
+        assert_eq!(lu.inverse(), [[1e-16, 0.0], [0.0, 1.0]]);
+        assert_eq!(condition(&d, &lu.inverse(), &row_scales(&d)), 1.0);
     }
 
     #[test]
     fn const_and_generic_solves_agree() {
         let a = [[2.0, 0.3, 0.1], [0.3, 1.0, -0.2], [0.1, -0.2, 3.0]];
         let b = [[1.0], [2.0], [3.0]];
-        let x = Lu::new(&a, max_abs(&a)).unwrap().solve(&b);
+        let x = Lu::new(&a, &row_scales(&a)).unwrap().solve(&b);
         let mut am = SMatrix::<f64, 3, 3>::from_fn(|i, j| a[i][j]);
         let mut bv = SVector::<f64, 3>::new(1.0, 2.0, 3.0);
         assert!(solve_in_place(&mut am, &mut bv, 3.0));

@@ -26,7 +26,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::kinematics::{AemKinematics, Kinematics};
 use crate::linalg::cholesky::{cholesky, lower_solve, lower_transpose_solve};
 use crate::linalg::symmetric_eigen::{JACOBI_MAX_SWEEPS, jacobi_eigen};
-use crate::linalg::{self, Rows, all_finite, max_abs, mul, rows_f64, sqrt, transpose};
+use crate::linalg::{self, Rows, all_finite, finite_as, max_abs, mul, rows_f64, sqrt, transpose};
 use crate::{Error, Real, State, StepState, Stepper};
 
 /// Relative tolerance below which `M`, `K` count as symmetric: `|a_ij − a_ji| ≤
@@ -186,6 +186,11 @@ const fn is_symmetric<const N: usize>(a: &Rows<N>) -> bool {
 
 /// `(ω², Φ)` of `K φ = ω² M φ`, ascending, `Φᵀ M Φ = I` (`Φ` row-major, column `r` is
 /// mode `r`): Cholesky `M = L Lᵀ`, Jacobi on `L⁻¹ K L⁻ᵀ = Q Λ Qᵀ`, `Φ = L⁻ᵀ Q`.
+///
+/// `M` and `K` are first scaled by powers of two (exact) to entries of order one, so the
+/// sums of squares inside Cholesky and Jacobi neither overflow nor underflow for any
+/// finite data (`s = 1e±300` gives the modes of `s = 1`); the scales are undone on `ω²`
+/// and `Φ` at the end. [`Error::OperatorOverflow`] if `ω²` or `Φ` then overflows `f64`.
 const fn modes_of<const N: usize>(m: &Rows<N>, k: &Rows<N>) -> Result<([f64; N], Rows<N>), Error> {
     if !is_symmetric(m) {
         return Err(Error::MassNotSpd);
@@ -193,6 +198,11 @@ const fn modes_of<const N: usize>(m: &Rows<N>, k: &Rows<N>) -> Result<([f64; N],
     if !is_symmetric(k) {
         return Err(Error::StiffnessNotSymmetric);
     }
+    // M' = M 2^−em (em even, so √(2^em) is exact), K' = K 2^−ek.
+    let em = 2 * (exponent(max_abs(m)) / 2);
+    let ek = exponent(max_abs(k));
+    let m = &scaled_pow2(m, -em);
+    let k = &scaled_pow2(k, -ek);
     let l = match cholesky(m) {
         Some(l) => l,
         None => return Err(Error::MassNotSpd),
@@ -240,7 +250,59 @@ const fn modes_of<const N: usize>(m: &Rows<N>, k: &Rows<N>) -> Result<([f64; N],
         }
         j += 1;
     }
-    Ok((ls, lower_transpose_solve(&l, &qs)))
+    // K φ = ω² M φ with ω² = ω'² 2^(ek − em); Φᵀ M Φ = I with Φ = Φ' 2^(−em/2).
+    let mut r = 0;
+    while r < N {
+        ls[r] = times_pow2(ls[r], ek - em);
+        if !ls[r].is_finite() {
+            return Err(Error::OperatorOverflow);
+        }
+        r += 1;
+    }
+    let phi = scaled_pow2(&lower_transpose_solve(&l, &qs), -em / 2);
+    if !all_finite(&phi) {
+        return Err(Error::OperatorOverflow);
+    }
+    Ok((ls, phi))
+}
+
+/// The binary exponent `e` of a positive finite `x` (`2^e ≤ x < 2^(e+1)`; subnormals and
+/// zero give −1022).
+const fn exponent(x: f64) -> i32 {
+    let e = ((x.to_bits() >> 52) & 0x7ff) as i32;
+    if e == 0 { -1022 } else { e - 1023 }
+}
+
+/// `x · 2^e`, exact unless it overflows or underflows (applied in steps within the normal
+/// range of the factor).
+const fn times_pow2(mut x: f64, mut e: i32) -> f64 {
+    while e != 0 {
+        let step = if e > 1000 {
+            1000
+        } else if e < -1000 {
+            -1000
+        } else {
+            e
+        };
+        x *= f64::from_bits(((step + 1023) as u64) << 52);
+        e -= step;
+    }
+    x
+}
+
+/// `a · 2^e` entrywise.
+const fn scaled_pow2<const N: usize>(a: &Rows<N>, e: i32) -> Rows<N> {
+    let mut r = *a;
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < N {
+            r[i][j] = times_pow2(r[i][j], e);
+            j += 1;
+        }
+        i += 1;
+    }
+    r
 }
 
 /// `2ξ_r ω_r` of every mode for the given damping.
@@ -322,6 +384,9 @@ struct ModalOps<const N: usize, const R: usize, const I: usize, const O: usize> 
 
 /// Check the data and build every operator (shared by `with_modes` and the `const`
 /// constructors).
+// The model's matrices, the mode selection, the step and the target type's range: one
+// `const fn` serves both constructors, so its arguments are the constructors' arguments.
+#[allow(clippy::too_many_arguments)]
 const fn modal_operators<const N: usize, const R: usize, const I: usize, const O: usize>(
     m: &Rows<N>,
     k: &Rows<N>,
@@ -330,6 +395,7 @@ const fn modal_operators<const N: usize, const R: usize, const I: usize, const O
     y: &[[f64; N]; O],
     modes: &[usize; R],
     h: f64,
+    max: f64,
 ) -> Result<ModalOps<N, R, I, O>, Error> {
     if R == 0 || R > N {
         return Err(Error::InvalidModeSelection);
@@ -425,6 +491,17 @@ const fn modal_operators<const N: usize, const R: usize, const I: usize, const O
         }
         r += 1;
     }
+    // Every operator must fit the scalar type it will be rounded to (`max`: its largest
+    // finite value), else it would round to ∞.
+    let fits = finite_as(&op.g_gamma, max)
+        && finite_as(&[op.g_c, op.g_k, op.c, op.k], max)
+        && finite_as(&op.gamma, max)
+        && finite_as(&op.out, max)
+        && finite_as(&op.phi, max)
+        && finite_as(&op.proj, max);
+    if !fits {
+        return Err(Error::OperatorOverflow);
+    }
     Ok(op)
 }
 
@@ -483,6 +560,7 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
             &rows_f64(y),
             &modes,
             h,
+            T::MAX,
         )?;
         Ok(Self {
             kin: op.kin.round(),
@@ -539,7 +617,7 @@ macro_rules! const_ctor {
                 modes: [usize; R],
                 h: f64,
             ) -> Result<Self, Error> {
-                let op = match modal_operators(&m, &k, &damping, &b, &y, &modes, h) {
+                let op = match modal_operators(&m, &k, &damping, &b, &y, &modes, h, $t::MAX as f64) {
                     Ok(op) => op,
                     Err(e) => return Err(e),
                 };

@@ -24,9 +24,9 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, checked_rows, start_operators, terms_scale};
+use crate::kernel::{StartOps, checked_rows, start_operators, terms_scales};
 use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step};
-use crate::linalg::lu::Lu;
+use crate::linalg::lu::{Lu, condition};
 use crate::linalg::{add_scaled, all_finite, finite_as, round_rows, scaled};
 use crate::{Error, Real, State, Stepper};
 
@@ -109,6 +109,7 @@ pub struct GeneralizedAlpha<T, const N: usize> {
     av: [[T; N]; N],
     aa: [[T; N]; N],
     start: Option<StartOps<T, N>>,
+    condition: f64,
 }
 
 impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
@@ -172,11 +173,11 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
         let f1 = 1.0 - alpha_f;
         let (wm, wc, wk) = (1.0 - alpha_m, f1 * gamma * hf, f1 * beta * hf * hf);
         let meff = add_scaled(&add_scaled(&scaled(wm, &m), wc, &c), wk, &k);
-        let scale = terms_scale(&scaled(wm, &m), &c, &k, wc, wk);
+        let scales = terms_scales(&scaled(wm, &m), &c, &k, wc, wk);
         if !all_finite(&meff) {
             return Err(Error::OperatorOverflow);
         }
-        let lu = Lu::new(&meff, scale).ok_or(Error::SingularEffectiveMatrix)?;
+        let lu = Lu::new(&meff, &scales).ok_or(Error::SingularEffectiveMatrix)?;
         let (g, gc, gk, gm) = (lu.inverse(), lu.solve(&c), lu.solve(&k), lu.solve(&m));
         // a_n = G p̄ − α_m GM a − (1−α_f) GC v̂ − (1−α_f) GK û − α_f (GC v + GK u), with
         // v̂ = v + (1−γ)h a, û = u + h v + (1/2−β)h² a, collected on (u, v, a).
@@ -201,7 +202,16 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
             av: round_rows(&av),
             aa: round_rows(&aa),
             start: start.map(|(_, s)| s.round()),
+            condition: condition(&meff, &g, &scales),
         })
+    }
+
+    /// How close the effective matrix is to singular: `κ₁` of the row-equilibrated
+    /// effective matrix (each row divided by the size of the terms it was assembled from),
+    /// computed once in `f64`; see [`Linear::condition`](crate::Linear::condition). Cost:
+    /// O(1).
+    pub fn condition(&self) -> f64 {
+        self.condition
     }
 
     /// The scheme's parameters.

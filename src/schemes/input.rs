@@ -53,6 +53,7 @@ pub struct LinearInput<T, const N: usize, const I: usize> {
     gb: [[T; I]; N],
     kin: AemKinematics<T>,
     start: Option<InputStart<T, N, I>>,
+    condition: f64,
 }
 
 /// Start-up operators `M⁻¹B` and `M⁻¹C`, `M⁻¹K` for `q0 = M⁻¹(B w0 − C v0 − K u0)`.
@@ -69,6 +70,7 @@ struct InputOps<const N: usize, const I: usize> {
     gk: Mat<N, N>,
     kin: AemKinematics<f64>,
     start: Option<(Mat<N, I>, StartOps<f64, N>)>,
+    condition: f64,
 }
 
 /// Check `B` and build every operator in `f64` (`const`, shared by both constructors).
@@ -105,6 +107,7 @@ const fn input_operators<const N: usize, const I: usize>(
         gk: op.gk,
         kin: op.aem,
         start,
+        condition: op.condition,
     })
 }
 
@@ -143,7 +146,16 @@ impl<T: Real, const N: usize, const I: usize> LinearInput<T, N, I> {
                 minv_b: linalg::round_rows(&mb),
                 ops: s.round(),
             }),
+            condition: op.condition,
         })
+    }
+
+    /// How close the effective matrix is to singular: `κ₁` of the row-equilibrated
+    /// effective matrix (each row divided by the size of the terms it was assembled from),
+    /// computed once in `f64`; see [`Linear::condition`](crate::Linear::condition). Cost:
+    /// O(1).
+    pub fn condition(&self) -> f64 {
+        self.condition
     }
 
     /// `G·B = (M + (h/2) C + (h²/4) K)⁻¹ B`, `N×I`.
@@ -209,6 +221,7 @@ macro_rules! const_ctor {
                         }),
                         None => None,
                     },
+                    condition: op.condition,
                 })
             }
         }

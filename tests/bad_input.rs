@@ -1,0 +1,216 @@
+//! Bad input found by trying the crate as a new user would (issue 10): each case is a named
+//! regression test. Every one got `Ok` with garbage before; each now gets a typed error, or
+//! the right answer where the input was in fact fine.
+
+use aemstep::nalgebra::{SMatrix, matrix, vector};
+use aemstep::{
+    Damping, Error, Exact, GeneralizedAlpha, Linear, LinearInput, Modal, Newmark, Stepper,
+};
+
+type M2 = SMatrix<f64, 2, 2>;
+
+/// An effective matrix that is zero up to rounding: `K = −4M/h²` cancels `M` in
+/// `M + (h²/4) K`. Judged against the size of its terms, not of the cancelled result, it
+/// is singular for every constant-coefficient scheme (as `Varying` already judged it).
+#[test]
+fn effective_matrix_cancelled_to_rounding_is_singular() {
+    let m = matrix![2.0, 0.3; 0.3, 1.0];
+    let h = 0.011;
+    let k = m * (-4.0 / (h * h));
+    let c = M2::zeros();
+    let want: Result<(), _> = Err(Error::SingularEffectiveMatrix);
+    assert_eq!(Linear::<f64, 2>::new(&m, &c, &k, h).err(), want.err());
+    assert_eq!(Linear::<f32, 2>::new(&m, &c, &k, h).err(), want.err());
+    assert_eq!(
+        Newmark::<f64, 2>::average_acceleration(&m, &c, &k, h).err(),
+        want.err()
+    );
+    assert_eq!(
+        GeneralizedAlpha::<f64, 2>::new(&m, &c, &k, h, 1.0).err(),
+        want.err()
+    );
+    assert_eq!(
+        LinearInput::<f64, 2, 2>::new(&m, &c, &k, &M2::identity(), h).err(),
+        want.err()
+    );
+    let rows = |a: M2| [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]];
+    assert_eq!(
+        Linear::<f64, 2>::from_rows(rows(m), rows(c), rows(k), h).err(),
+        want.err()
+    );
+}
+
+/// The eigen-solver with very large and very small stiffness: `K = s [[2, −1], [−1, 2]]`,
+/// `M = I` has `ω² = (s, 3s)` for every `s`; at `s = 1e160` the sums of squares overflowed
+/// and at `s = 1e-165` they underflowed, and the solver returned `(2s, 2s)` with identity
+/// modes. With power-of-two scaling every finite SPD pair gets its modes (to a few ulps)
+/// or a typed error.
+#[test]
+fn eigen_solver_scales_large_and_small_stiffness() {
+    for s in [1e160, 1e-165, 1e300, 1e-300, 1.0] {
+        let k = matrix![2.0, -1.0; -1.0, 2.0] * s;
+        let sys = Modal::<f64, 2, 2, 1, 1>::new(
+            &M2::identity(),
+            &k,
+            &Damping::None,
+            &SMatrix::repeat(1.0),
+            &SMatrix::repeat(1.0),
+            0.01,
+        )
+        .unwrap();
+        let w2 = sys.frequencies().map(|w| w * w / s);
+        assert!(
+            (w2[0] - 1.0).abs() < 8.0 * f64::EPSILON,
+            "s = {s:e}: {w2:?}"
+        );
+        assert!(
+            (w2[1] - 3.0).abs() < 24.0 * f64::EPSILON,
+            "s = {s:e}: {w2:?}"
+        );
+        // The modes are (1, 1)/√2 and (1, −1)/√2, not the identity.
+        let phi = sys.mode_shapes();
+        let r = core::f64::consts::FRAC_1_SQRT_2;
+        assert!((phi[(0, 0)].abs() - r).abs() < 4.0 * f64::EPSILON, "{phi}");
+        assert!((phi[(1, 1)].abs() - r).abs() < 4.0 * f64::EPSILON, "{phi}");
+    }
+    // In f32, ω² = 3e160 does not fit: a typed error, not ∞.
+    let k = matrix![2.0, -1.0; -1.0, 2.0] * 1e160;
+    assert_eq!(
+        Modal::<f32, 2, 2, 1, 1>::new(
+            &M2::identity(),
+            &k,
+            &Damping::None,
+            &SMatrix::repeat(1.0),
+            &SMatrix::repeat(1.0),
+            0.01
+        )
+        .err(),
+        Some(Error::OperatorOverflow)
+    );
+}
+
+/// Operators that overflow when rounded to `f32`: `M = 1e-39` gives `G = 1e39 > f32::MAX`.
+/// Checked after rounding to `T`, in every constructor.
+#[test]
+fn f32_operators_that_overflow_are_rejected() {
+    let (m, z) = (matrix![1e-39], matrix![0.0]);
+    let want = Some(Error::OperatorOverflow);
+    assert_eq!(Linear::<f32, 1>::new(&m, &z, &z, 0.01).err(), want);
+    assert_eq!(
+        Linear::<f32, 1>::from_rows([[1e-39]], [[0.0]], [[0.0]], 0.01).err(),
+        want
+    );
+    assert_eq!(
+        LinearInput::<f32, 1, 1>::new(&m, &z, &z, &matrix![1.0], 0.01).err(),
+        want
+    );
+    assert_eq!(
+        Newmark::<f32, 1>::average_acceleration(&m, &z, &z, 0.01).err(),
+        want
+    );
+    assert_eq!(
+        GeneralizedAlpha::<f32, 1>::new(&m, &z, &z, 0.01, 0.8).err(),
+        want
+    );
+    // `Exact` reports its overflow as overflow (it used to say NonFiniteInput).
+    assert_eq!(
+        Exact::<f32, 1>::new(&m, &z, &matrix![1.0], 0.01).err(),
+        want
+    );
+    // The same data is fine in f64.
+    assert!(Linear::<f64, 1>::new(&m, &z, &z, 0.01).is_ok());
+}
+
+/// An exactly invertible but badly scaled `M = diag(1e16, 1)` is not singular: pivots are
+/// judged row by row against the terms of the row.
+#[test]
+fn badly_scaled_but_regular_mass_is_not_singular() {
+    let m = matrix![1e16, 0.0; 0.0, 1.0];
+    let (c, k) = (M2::zeros(), M2::identity());
+    let sys = Linear::<f64, 2>::new(&m, &c, &k, 0.01).unwrap();
+    // Row-equilibrated: perfectly conditioned.
+    assert!(sys.condition() < 1.0 + 1e-12, "{}", sys.condition());
+    let s = sys
+        .start(&vector![0.0, 0.0], &vector![0.0, 0.0], &vector![1.0, 1.0])
+        .unwrap();
+    assert_eq!(*s.a(), vector![1e-16, 1.0]);
+}
+
+/// The condition number the stepper reports grows as the effective matrix nears
+/// singularity: for `M = [[1, 1], [1, 1 + δ]]`, `C = K = 0`, `κ₁ = 4(1 + δ)/δ` of the
+/// row-equilibrated matrix; it is rejected once `δ` reaches rounding.
+#[test]
+fn condition_estimate_tracks_the_distance_to_singularity() {
+    let z = M2::zeros();
+    for d in [1e-2, 1e-6, 1e-10, 1e-14] {
+        let m = matrix![1.0, 1.0; 1.0, 1.0 + d];
+        let sys = Linear::<f64, 2>::new(&m, &z, &z, 0.01).unwrap();
+        let k = sys.condition();
+        // Exact, with D = diag(1, 1 + δ) (the row scales): ‖D⁻¹A‖₁ = 2 and
+        // A⁻¹D = [[1 + δ, −(1 + δ)], [−1, 1 + δ]]/δ, ‖A⁻¹D‖₁ = (2 + 2δ)/δ: κ = 4(1 + δ)/δ.
+        let exact = 4.0 * (1.0 + d) / d;
+        // The computed inverse is accurate to about κ ε relative, so κ is too.
+        let rel = (k / exact - 1.0).abs();
+        eprintln!("δ = {d:e}: κ {k:e}, relative error {rel:e}");
+        assert!(
+            rel < 4.0 * f64::EPSILON * exact,
+            "δ = {d:e}: {k:e} vs {exact:e}"
+        );
+    }
+    let m = matrix![1.0, 1.0; 1.0, 1.0 + 1e-17];
+    assert_eq!(
+        Linear::<f64, 2>::new(&m, &z, &z, 0.01).err(),
+        Some(Error::SingularEffectiveMatrix)
+    );
+}
+
+/// A NaN load is `NonFiniteInput` from every stepper's checked step, and the state is
+/// kept bit for bit.
+#[test]
+fn nan_load_is_the_same_error_everywhere() {
+    let (m, c, k, h) = (matrix![1.0], matrix![0.1], matrix![4.0], 0.01);
+    let nan = vector![f64::NAN];
+    fn check<S: Stepper<f64, 1>>(sys: &S, w0: S::Input, bad: S::Input) {
+        let z = vector![0.0];
+        let mut s = sys.start(&vector![1.0], &z, &w0).unwrap();
+        let before = format!("{:?}", sys.full_state(&s));
+        assert_eq!(sys.try_step(&mut s, &bad), Err(Error::NonFiniteInput));
+        assert_eq!(format!("{:?}", sys.full_state(&s)), before);
+    }
+    check(
+        &Linear::<f64, 1>::new(&m, &c, &k, h).unwrap(),
+        vector![0.0],
+        nan,
+    );
+    check(
+        &Linear::<f64, 1>::new(&m, &c, &k, h).unwrap().a_form(),
+        vector![0.0],
+        nan,
+    );
+    check(
+        &Newmark::<f64, 1>::average_acceleration(&m, &c, &k, h).unwrap(),
+        vector![0.0],
+        nan,
+    );
+    check(
+        &GeneralizedAlpha::<f64, 1>::new(&m, &c, &k, h, 0.8).unwrap(),
+        vector![0.0],
+        nan,
+    );
+    check(
+        &Exact::<f64, 1>::new(&m, &c, &k, h).unwrap(),
+        vector![0.0],
+        nan,
+    );
+    check(
+        &LinearInput::<f64, 1, 1>::new(&m, &c, &k, &matrix![1.0], h).unwrap(),
+        vector![0.0],
+        nan,
+    );
+    check(
+        &Modal::<f64, 1, 1, 1, 1>::new(&m, &k, &Damping::None, &matrix![1.0], &matrix![1.0], h)
+            .unwrap(),
+        vector![0.0],
+        nan,
+    );
+}
