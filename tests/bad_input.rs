@@ -4,7 +4,8 @@
 
 use aemstep::nalgebra::{SMatrix, matrix, vector};
 use aemstep::{
-    Damping, Error, Exact, GeneralizedAlpha, Linear, LinearInput, Modal, Newmark, Stepper,
+    Coefficients, Damping, Error, Exact, GeneralizedAlpha, Linear, LinearInput, Modal, Newmark,
+    Stepper, Varying,
 };
 
 type M2 = SMatrix<f64, 2, 2>;
@@ -134,6 +135,43 @@ fn badly_scaled_but_regular_mass_is_not_singular() {
         .start(&vector![0.0, 0.0], &vector![0.0, 0.0], &vector![1.0, 1.0])
         .unwrap();
     assert_eq!(*s.a(), vector![1e-16, 1.0]);
+    // The time-varying stepper judges its per-step matrix the same way.
+    let coeffs = move |_t: f64| Coefficients {
+        mass: m,
+        damping: c,
+        stiffness: k,
+    };
+    let st = Varying::<f64, 2>::new(0.01).unwrap();
+    let mut s = st
+        .start(
+            &coeffs,
+            &vector![0.0, 0.0],
+            &vector![0.0, 0.0],
+            &vector![1.0, 1.0],
+        )
+        .unwrap();
+    st.try_step(&coeffs, &mut s, &vector![1.0, 1.0]).unwrap();
+    // …and a cancelled one as singular, at the step it happens.
+    let h = 0.011;
+    let mm = matrix![2.0, 0.3; 0.3, 1.0];
+    let cancel = move |_t: f64| Coefficients {
+        mass: mm,
+        damping: M2::zeros(),
+        stiffness: mm * (-4.0 / (h * h)),
+    };
+    let st = Varying::<f64, 2>::new(h).unwrap();
+    let mut s = st
+        .start(
+            &cancel,
+            &vector![0.0, 0.0],
+            &vector![0.0, 0.0],
+            &vector![1.0, 1.0],
+        )
+        .unwrap();
+    assert_eq!(
+        st.try_step(&cancel, &mut s, &vector![1.0, 1.0]),
+        Err(Error::SingularEffectiveMatrixAtStep { step: 1 })
+    );
 }
 
 /// The condition number the stepper reports grows as the effective matrix nears

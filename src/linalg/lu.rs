@@ -190,22 +190,34 @@ pub(crate) fn solve_in_place<T: Real, const N: usize>(
     b: &mut SVector<T, N>,
     scale: T,
 ) -> bool {
-    let tiny = T::from_f64_rounded(N as f64) * T::default_epsilon() * scale;
+    solve_in_place_scaled(a, b, &SVector::repeat(scale))
+}
+
+/// [`solve_in_place`] with a scale per row (scaled partial pivoting, as [`Lu::new`]): the
+/// pivot of row `r` must exceed `N·ε·scales[r]`, the size of the terms the row was
+/// assembled from. Cost: `N³/3 + N²` multiply-adds; no allocation, no panic.
+pub(crate) fn solve_in_place_scaled<T: Real, const N: usize>(
+    a: &mut SMatrix<T, N, N>,
+    b: &mut SVector<T, N>,
+    scales: &SVector<T, N>,
+) -> bool {
+    let tiny = T::from_f64_rounded(N as f64) * T::default_epsilon();
     // Column-major storage, `a[c][r]` = A(r, c); plain array indexing with loop-bounded
     // indices, which the compiler proves in bounds (no panic path in the binary).
     let a = &mut a.data.0;
     let x = &mut b.data.0[0];
+    let mut s = scales.data.0[0];
     for col in 0..N {
         let mut piv = col;
-        let mut best = a[col][col].abs();
+        let mut best = a[col][col].abs() / s[col];
         for r in col + 1..N {
-            let e = a[col][r].abs();
+            let e = a[col][r].abs() / s[r];
             if e > best {
                 best = e;
                 piv = r;
             }
         }
-        // A NaN or infinite pivot is rejected too.
+        // A NaN or infinite pivot (or scale) is rejected too.
         if !best.is_finite() || best <= tiny {
             return false;
         }
@@ -214,6 +226,7 @@ pub(crate) fn solve_in_place<T: Real, const N: usize>(
                 column.swap(piv, col);
             }
             x.swap(piv, col);
+            s.swap(piv, col);
         }
         let d = a[col][col];
         for r in col + 1..N {
@@ -229,11 +242,11 @@ pub(crate) fn solve_in_place<T: Real, const N: usize>(
         }
     }
     for col in (0..N).rev() {
-        let mut s = x[col];
+        let mut t = x[col];
         for k in col + 1..N {
-            s -= a[k][col] * x[k];
+            t -= a[k][col] * x[k];
         }
-        x[col] = s / a[col][col];
+        x[col] = t / a[col][col];
     }
     true
 }

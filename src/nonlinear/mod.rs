@@ -25,7 +25,7 @@ use core::marker::PhantomData;
 use nalgebra::{SMatrix, SVector};
 
 use crate::kinematics::{AemKinematics, Kinematics};
-use crate::linalg::lu::solve_in_place;
+use crate::linalg::lu::{solve_in_place, solve_in_place_scaled};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
@@ -467,8 +467,8 @@ fn finite_difference_jacobian<T: Real, const N: usize, Mo: Model<T, N> + ?Sized>
 }
 
 /// The state at step 0 with the acceleration from the equation of motion,
-/// `a0 = M⁻¹ r` (`r = p0 − F(u0, v0)`, or `p0 − C v0 − K u0`), solved by
-/// [`solve_in_place`] with the pivot threshold scaled by `max|M_ij|`.
+/// `a0 = M⁻¹ r` (`r = p0 − F(u0, v0)`, or `p0 − C v0 − K u0`), solved with pivots
+/// judged against the row scales of `M`.
 ///
 /// Errors: [`Error::SingularMass`], [`Error::NonFiniteState`]. Cost: `N³/3 + N²`.
 pub(crate) fn initial_from_equation<T: Real, const N: usize>(
@@ -477,9 +477,11 @@ pub(crate) fn initial_from_equation<T: Real, const N: usize>(
     m: &SMatrix<T, N, N>,
     mut r: SVector<T, N>,
 ) -> Result<State<T, N>, Error> {
-    let scale = m.iter().fold(T::zero(), |s, x| s.max(x.abs()));
+    // Row scales of M (pivots judged row by row, as every operator build).
+    let scales =
+        SVector::<T, N>::from_fn(|i, _| m.row(i).iter().fold(T::zero(), |s, x| s.max(x.abs())));
     let mut lu = *m;
-    if !solve_in_place(&mut lu, &mut r, scale) {
+    if !solve_in_place_scaled(&mut lu, &mut r, &scales) {
         return Err(Error::SingularMass);
     }
     State::initial_computed(u0, v0, r)

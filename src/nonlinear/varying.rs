@@ -19,7 +19,7 @@ use core::marker::PhantomData;
 use nalgebra::{SMatrix, SVector};
 
 use crate::kinematics::{AemKinematics, Kinematics};
-use crate::linalg::lu::solve_in_place;
+use crate::linalg::lu::solve_in_place_scaled;
 use crate::nonlinear::initial_from_equation;
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
@@ -167,16 +167,19 @@ impl<T: Real, const N: usize> Varying<T, N> {
         let (b, c) = (self.kin.half_h, self.kin.quarter_h2);
         let (vh, uh) = self.kin.predict_all(&state.u, &state.v, &state.a);
         let mut meff = k.mass + k.damping * b + k.stiffness * c;
-        let scale = k
-            .mass
-            .iter()
-            .zip(k.damping.iter())
-            .zip(k.stiffness.iter())
-            .fold(T::zero(), |s, ((m, d), st)| {
-                s.max(m.abs() + b * d.abs() + c * st.abs())
-            });
+        // Row scales: the size of the terms each row of M + (h/2) C + (h²/4) K is
+        // assembled from (a row that cancels to rounding is singular).
+        // (Column-major arrays with loop-bounded indices: no bounds-check panic path.)
+        let (ma, da, ka) = (&k.mass.data.0, &k.damping.data.0, &k.stiffness.data.0);
+        let mut scales = SVector::<T, N>::zeros();
+        for j in 0..N {
+            for i in 0..N {
+                let t = ma[j][i].abs() + b * da[j][i].abs() + c * ka[j][i].abs();
+                scales.data.0[0][i] = scales.data.0[0][i].max(t);
+            }
+        }
         let mut q = p - k.damping * vh - k.stiffness * uh;
-        if !solve_in_place(&mut meff, &mut q, scale) {
+        if !solve_in_place_scaled(&mut meff, &mut q, &scales) {
             return Err(Error::SingularEffectiveMatrixAtStep { step: n });
         }
         let (v, u) = self.kin.correct_all(&vh, &uh, &q);
