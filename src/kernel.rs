@@ -121,16 +121,7 @@ macro_rules! kernel_stepper {
                 $crate::kernel::newmark_step(&self.kernel.ops, &self.kernel.kin, s, p);
             }
 
-            fn start(
-                &self,
-                u0: &nalgebra::SVector<T, N>,
-                v0: &nalgebra::SVector<T, N>,
-                p0: &nalgebra::SVector<T, N>,
-            ) -> Result<$crate::State<T, N>, $crate::Error> {
-                $crate::kernel::initial_state(self.kernel.start.as_ref(), u0, v0, p0)
-            }
-
-            $crate::stepper::full_order_state!();
+            $crate::stepper::full_order_state!(kernel.start);
         }
 
         impl<T: $crate::Real, const N: usize> $scheme<T, N> {

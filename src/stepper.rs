@@ -183,19 +183,19 @@ pub(crate) fn commit_if_finite<S: StepState>(
 }
 
 /// The [`Stepper`] methods every full-order scheme (state [`State<T, N>`]) shares, for a
-/// scheme whose start-up operators are in the field `$start` (an
+/// scheme whose start-up operators are in the field (path) `$start` (an
 /// `Option<StartOps<T, N>>`): `start` (`a0` from the equation of motion),
 /// `start_with_acceleration` (the given `u0, v0, a0`, checked finite) and `full_state` (a
 /// copy). Expands inside an `impl Stepper<T, N> for …` block.
 macro_rules! full_order_state {
-    ($start:ident) => {
+    ($($start:ident).+) => {
         fn start(
             &self,
             u0: &nalgebra::SVector<T, N>,
             v0: &nalgebra::SVector<T, N>,
             p0: &nalgebra::SVector<T, N>,
         ) -> Result<$crate::State<T, N>, $crate::Error> {
-            $crate::kernel::initial_state(self.$start.as_ref(), u0, v0, p0)
+            $crate::kernel::initial_state(self.$($start).+.as_ref(), u0, v0, p0)
         }
 
         $crate::stepper::full_order_state!();
