@@ -204,12 +204,14 @@ fn ten_million_undamped_steps_f64_and_f32() {
     // n·φ ≈ 6e5 rad → 6e5 · 16ε/… ≈ 1e-7·…): bound 1e-6 on u.
     assert!(e64 <= n as f64 * 2.0 * EPS, "{e64:e}");
     assert!(u64 <= 1e-6, "{u64:e}");
-    // f32: the same reasoning with ε₃₂: energy ≤ 10⁷ · 2 ε₃₂ = 2.4 (vacuous), so the
-    // bound is the measured drift's order of magnitude derived from a random walk,
-    // √n · 2ε₃₂ ≈ 7.5e-4, times 10 for a non-random share. The phase bound is loose
-    // (|u − cos| ≤ 2 always); we require the phase to remain within 1 rad: |Δu| ≤ 1.
-    assert!(e32 <= 10.0 * (n as f64).sqrt() * 2.0 * EPS32, "{e32:e}");
-    assert!(u32_ <= 1.0, "{u32_:e}");
+    // f32: the same reasoning with ε₃₂: energy ≤ 10⁷ · 2 ε₃₂ = 2.4 (vacuous) in the worst
+    // case; unbiased roundings make a random walk, √n · 2ε₃₂ ≈ 7.5e-4 (measured 1.2e-4).
+    // The phase is not a random walk: the f32 rounding of the state is biased and the
+    // phase drifts systematically (measured |Δu| 9.4e-3 after 10⁷ steps; issue 10's
+    // drift study measures it per 10⁸ steps). Its worst-case bound is vacuous, so the
+    // check is a regression pin at twice the measured value.
+    assert!(e32 <= (n as f64).sqrt() * 2.0 * EPS32, "{e32:e}");
+    assert!(u32_ <= 2e-2, "{u32_:e} (regression pin)");
 }
 
 /// Rotation by θ: the modal matrix used to make the extreme systems fully populated.
@@ -282,7 +284,11 @@ fn stiff_system_frequency_ratio_1e6() {
         "stiff AEM: mode-1 error vs η1(0)cos(nφ) {e1:e} (bound {bound1:e}), modal energy error {e2:e}"
     );
     assert!(e1 < bound1, "{e1:e}");
-    assert!(e2 < 6e-2, "{e2:e}");
+    // Measured 8.7e-7 and 1.0e-8: both far inside the worst-case bounds above, which
+    // assume every rounding adds up; regression pins at 10× the measured values catch a
+    // change that lets the stiff mode's rounding leak into the soft one.
+    assert!(e1 < 1e-5, "{e1:e} (regression pin)");
+    assert!(e2 < 1e-7, "{e2:e} (regression pin)");
     // Against the true cos(ω1 t): the period error s1²/12 gives a phase lag ω1 t s1²/12.
     let lag = w1 * t * (w1 * h).powi(2) / 12.0;
     assert!((eu[0] - eta0[0] * (w1 * t).cos()).abs() <= lag * 1.01 + bound1);
