@@ -527,7 +527,11 @@ fn rotd_against_rotated_records_and_closed_form() {
         }
     }
     let (sdx, ..) = run(&b, &rec, 0);
-    assert_eq!(r.x().sd(), &sdx);
+    // the component's own peaks: RotD walks every sub-step, the bank steps whole intervals
+    // (the exact map over dt): equal up to the composition's rounding
+    for p in 0..Q {
+        assert!(rel(r.x().sd()[p], sdx[p]) < 1e-11);
+    }
     let mut r0 = rot.at_rest(&b);
     for &ax in &rec {
         rot.step(&b, &mut r0, ax, 0.0);
@@ -540,8 +544,11 @@ fn rotd_against_rotated_records_and_closed_form() {
     c.sort_by(f64::total_cmp);
     let med = 0.5 * (c[K / 2 - 1] + c[K / 2]);
     for p in 0..Q {
-        assert!(rel(r100[p], sdx[p]) < 1e-15, "{} {}", r100[p], sdx[p]);
-        assert!(rel(r50[p], sdx[p] * med) < 1e-14);
+        // same sub-step values as the x component's own peak: equal but for the
+        // multiplication by cos θ_j, sin θ_j (rounded `const fn` values) and the median's mean
+        let sx = r0.x().sd()[p];
+        assert!(rel(r100[p], sx) < 1e-15, "{} {}", r100[p], sx);
+        assert!(rel(r50[p], sx * med) < 1e-15);
     }
 }
 

@@ -13,14 +13,21 @@ use core::f64::consts::TAU;
 /// damping ratios are fixed when the bank is built ([`Bank::new`], a `const fn`: in a
 /// `static`, the compiler computes the operators into flash).
 ///
-/// Layout: structure of arrays, one `[T; P]` per operator coefficient, so one sub-step of
-/// all oscillators is a loop over `p` the compiler vectorizes. Periods must be given in
-/// non-decreasing order: sub-step counts then fall along the bank, and the oscillators
-/// still sub-stepping at sub-step `k` are a prefix of the bank.
+/// Each sample interval is one step of every oscillator by its whole-interval operator
+/// (for the exact scheme the exact map over `dt`; for the AEM the composition of its `n_p`
+/// sub-steps), a loop over `p` on a structure of arrays (one `[T; P]` per coefficient) that
+/// the compiler vectorizes. The sub-steps only locate peaks between samples: they are
+/// walked, from the interval's start, only for the oscillators whose peak could rise inside
+/// the interval (see [`Bank::step`]). Periods must be given in non-decreasing order
+/// (oscillators with sub-steps are then a prefix of the bank).
 ///
-/// Size: `11P` values of `T` plus `2P` bytes and a few scalars.
+/// Size: `21P` values of `T`, `2P` bytes and `2P + 3` `f64`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bank<T, const P: usize> {
+    /// Whole-interval map, on `(u0, v0, a0, d = a1 − a0)`.
+    pub(super) su: [[T; P]; 4],
+    pub(super) sv: [[T; P]; 4],
+    /// Sub-step map, on `(u, v, g, δ = d/n)`.
     pub(super) uu: [T; P],
     pub(super) uv: [T; P],
     pub(super) ug: [T; P],
@@ -33,22 +40,31 @@ pub struct Bank<T, const P: usize> {
     pub(super) w2: [T; P],
     /// `2ζω` (1/s).
     pub(super) c2: [T; P],
+    /// `ω` (1/s).
+    pub(super) w: [T; P],
+    /// `1/(ω √(1 + 4ζ²))` (s): `|ω²u + 2ζωv| ≤ √(ω²u² + v²) / ka`.
+    pub(super) ka: [T; P],
     /// `1/n_p`.
     pub(super) inv_n: [T; P],
     /// Sub-steps per sample `n_p` (non-increasing along the bank).
     pub(super) n: [u16; P],
+    /// Oscillators with `n_p > 1` (a prefix).
+    pub(super) m1: usize,
     /// Periods (s), as given.
     pub(super) period: [f64; P],
     /// Damping ratios, as given.
     pub(super) damping: [f64; P],
     /// Sample interval (s).
     pub(super) dt: f64,
+    pub(super) dt_t: T,
     pub(super) scheme: Scheme,
 }
 
 /// The validated `f64` operators of a bank, before rounding to `T`.
 pub(super) struct OpsF64<const P: usize> {
     pub ops: [SdofOps; P],
+    pub whole: [SdofOps; P],
+    pub ka: [f64; P],
     pub w2: [f64; P],
     pub c2: [f64; P],
     pub n: [u16; P],
@@ -104,6 +120,8 @@ pub(super) const fn build_f64<const P: usize>(
     };
     let mut out = OpsF64 {
         ops: [zero; P],
+        whole: [zero; P],
+        ka: [0.0; P],
         w2: [0.0; P],
         c2: [0.0; P],
         n: [1; P],
@@ -129,6 +147,21 @@ pub(super) const fn build_f64<const P: usize>(
             Scheme::Exact => operators::exact(w, 2.0 * z * w, h),
             Scheme::Aem => operators::aem(w * w, 2.0 * z * w, h),
         };
+        out.whole[p] = match scheme {
+            // exact over dt directly (composing n exact sub-steps agrees to rounding)
+            Scheme::Exact => operators::exact(w, 2.0 * z * w, dt),
+            Scheme::Aem => operators::compose(&out.ops[p], n),
+        };
+        // 1/(ω√(1 + 4ζ²)) without a square root: √(1 + x) by 6 Newton steps from 1 + x/2
+        // (x = 4ζ² < 4; converged to rounding)
+        let x = 4.0 * z * z;
+        let mut r = 1.0 + 0.5 * x;
+        let mut it = 0;
+        while it < 6 {
+            r = 0.5 * (r + (1.0 + x) / r);
+            it += 1;
+        }
+        out.ka[p] = 1.0 / (w * r);
         p += 1;
     }
     Ok(out)
@@ -168,6 +201,8 @@ macro_rules! bank_ctor {
                     Err(e) => return Err(e),
                 };
                 let mut b = Bank {
+                    su: [[0.0; P]; 4],
+                    sv: [[0.0; P]; 4],
                     uu: [0.0; P],
                     uv: [0.0; P],
                     ug: [0.0; P],
@@ -178,11 +213,15 @@ macro_rules! bank_ctor {
                     vd: [0.0; P],
                     w2: [0.0; P],
                     c2: [0.0; P],
+                    w: [0.0; P],
+                    ka: [0.0; P],
                     inv_n: [0.0; P],
                     n: o.n,
+                    m1: 0,
                     period,
                     damping,
                     dt,
+                    dt_t: dt as $t,
                     scheme,
                 };
                 let mut p = 0;
@@ -196,9 +235,23 @@ macro_rules! bank_ctor {
                     b.vv[p] = op.vv as $t;
                     b.vg[p] = op.vg as $t;
                     b.vd[p] = op.vd as $t;
+                    let wh = &o.whole[p];
+                    b.su[0][p] = wh.uu as $t;
+                    b.su[1][p] = wh.uv as $t;
+                    b.su[2][p] = wh.ug as $t;
+                    b.su[3][p] = wh.ud as $t;
+                    b.sv[0][p] = wh.vu as $t;
+                    b.sv[1][p] = wh.vv as $t;
+                    b.sv[2][p] = wh.vg as $t;
+                    b.sv[3][p] = wh.vd as $t;
                     b.w2[p] = o.w2[p] as $t;
                     b.c2[p] = o.c2[p] as $t;
+                    b.w[p] = (core::f64::consts::TAU / period[p]) as $t;
+                    b.ka[p] = o.ka[p] as $t;
                     b.inv_n[p] = (1.0 / o.n[p] as f64) as $t;
+                    if o.n[p] > 1 {
+                        b.m1 = p + 1;
+                    }
                     p += 1;
                 }
                 Ok(b)
@@ -292,15 +345,24 @@ impl<T: Real, const P: usize> Bank<T, P> {
     /// Feed the next ground-acceleration sample `ag` (m/s² or any unit; the response is in
     /// the same unit system). Sample 0 is the ground acceleration at `t = 0`, with every
     /// oscillator at rest; each later sample advances time by `dt`, the load linear
-    /// between samples, in `n_p` sub-steps for oscillator `p` (peaks taken at every
-    /// sub-step end).
+    /// between samples. Peaks are taken at the samples and, for oscillator `p`, at the ends
+    /// of its `n_p` sub-steps in between.
+    ///
+    /// The sub-steps are walked only where the peak could rise inside the interval: with
+    /// `z = (ωu, v)`, `d|z|/dt ≤ |a_g|` (the damping only takes energy out), so inside the
+    /// interval `|z| ≤ |z₀| + dt·max(|a₀|, |a₁|)`, and `|u| ≤ |z|/ω`, `|v| ≤ |z|`,
+    /// `|ω²u + 2ζωv| ≤ ω√(1 + 4ζ²)|z|`; when that bound is below all three peaks so far
+    /// nothing between the samples can raise them and the walk is skipped. The peaks are
+    /// those of walking every interval (to rounding).
     ///
     /// A non-finite sample (NaN, ±∞) is skipped and counted ([`Response::skipped`]): time
     /// still advances by `dt`, with the last finite sample held in its place, so later
     /// samples stay on their times; the peaks so far are kept.
     ///
-    /// Cost: `Σ_p n_p` oscillator sub-steps of 10 multiply-adds, 3 absolute values and 3
-    /// comparisons each, vectorized over the oscillators; no allocation, no panic.
+    /// Cost: `P` whole-interval steps (10 multiply-adds, 3 absolute values and 3
+    /// comparisons each, vectorized over the oscillators), a bound check (about 10 flops)
+    /// for each oscillator with `n_p > 1`, and `n_p − 1` sub-steps for each oscillator
+    /// whose bound fails; no allocation, no panic.
     pub fn step(&self, r: &mut Response<T, P>, ag: T) {
         let a1 = if super::finite(ag) {
             ag
@@ -357,59 +419,69 @@ impl<T: Real, const P: usize> Bank<T, P> {
         }
     }
 
-    /// One sample interval `a0 → a1`: sub-step `k` steps the prefix of oscillators with
-    /// `n_p > k` (periods ascending, so `n_p` non-increasing).
+    /// One sample interval `a0 → a1`: the peak search between the samples where needed,
+    /// then the whole-interval step of every oscillator.
     #[inline(always)]
     fn advance(&self, r: &mut Response<T, P>, a0: T, a1: T) {
         let d = a1 - a0;
-        let mut g = [a0; P];
-        let mut delta = [d; P];
-        for (dl, inv) in delta.iter_mut().zip(self.inv_n.iter()) {
-            *dl = d * *inv;
+        let reach = if abs(a0) > abs(a1) { abs(a0) } else { abs(a1) } * self.dt_t;
+        let m1 = if self.m1 < P { self.m1 } else { P };
+        for i in 0..m1 {
+            let (u, v) = (r.u[i], r.v[i]);
+            let mut s = self.w[i] * r.sd[i];
+            if r.sv[i] < s {
+                s = r.sv[i];
+            }
+            let sa = self.ka[i] * r.sa[i];
+            if sa < s {
+                s = sa;
+            }
+            let room = s - reach;
+            let z2 = self.w2[i] * u * u + v * v;
+            if !(room > T::from_f64_rounded(0.0) && z2 <= room * room) {
+                self.walk(r, i, a0, d);
+            }
         }
-        let mut m = P;
-        let mut k: u16 = 0;
-        loop {
-            while let Some(&n) = self.n.get(m.wrapping_sub(1)) {
-                if n > k {
-                    break;
-                }
-                m -= 1;
-            }
-            if m == 0 {
-                break;
-            }
-            self.substep(r, &mut g, &delta, m);
-            k = k.wrapping_add(1);
+        let [su0, su1, su2, su3] = &self.su;
+        let [sv0, sv1, sv2, sv3] = &self.sv;
+        for i in 0..P {
+            let (u0, v0) = (r.u[i], r.v[i]);
+            let u1 = su0[i] * u0 + su1[i] * v0 + su2[i] * a0 + su3[i] * d;
+            let v1 = sv0[i] * u0 + sv1[i] * v0 + sv2[i] * a0 + sv3[i] * d;
+            r.u[i] = u1;
+            r.v[i] = v1;
+            let acc = self.w2[i] * u1 + self.c2[i] * v1;
+            keep_max(&mut r.sd[i], abs(u1));
+            keep_max(&mut r.sv[i], abs(v1));
+            keep_max(&mut r.sa[i], abs(acc));
         }
     }
 
-    /// One sub-step of oscillators `0..m`.
-    #[inline(always)]
-    fn substep(&self, r: &mut Response<T, P>, g: &mut [T; P], delta: &[T; P], m: usize) {
-        macro_rules! pre {
-            ($($a:expr),*) => { ($(match $a.get(..m) { Some(s) => s, None => return }),*) };
+    /// The peaks of oscillator `i` at its `n − 1` sub-step ends inside the interval
+    /// (the state is not changed: the whole-interval step follows).
+    #[inline(never)]
+    fn walk(&self, r: &mut Response<T, P>, i: usize, a0: T, d: T) {
+        let (Some(&n), Some(&inv)) = (self.n.get(i), self.inv_n.get(i)) else {
+            return;
+        };
+        let (uu, uv, ug, ud) = (self.uu[i], self.uv[i], self.ug[i], self.ud[i]);
+        let (vu, vv, vg, vd) = (self.vu[i], self.vv[i], self.vg[i], self.vd[i]);
+        let (w2, c2) = (self.w2[i], self.c2[i]);
+        let dl = d * inv;
+        let (mut u, mut v, mut g) = (r.u[i], r.v[i], a0);
+        let (mut pd, mut pv, mut pa) = (r.sd[i], r.sv[i], r.sa[i]);
+        for _ in 1..n {
+            let u1 = uu * u + uv * v + ug * g + ud * dl;
+            v = vu * u + vv * v + vg * g + vd * dl;
+            u = u1;
+            g += dl;
+            keep_max(&mut pd, abs(u));
+            keep_max(&mut pv, abs(v));
+            keep_max(&mut pa, abs(w2 * u + c2 * v));
         }
-        macro_rules! pre_mut {
-            ($($a:expr),*) => { ($(match $a.get_mut(..m) { Some(s) => s, None => return }),*) };
-        }
-        let (uu, uv, ug, ud, vu, vv, vg, vd) = pre!(
-            self.uu, self.uv, self.ug, self.ud, self.vu, self.vv, self.vg, self.vd
-        );
-        let (w2, c2, dl) = pre!(self.w2, self.c2, delta);
-        let (u, v, gg, sd, sv, sa) = pre_mut!(r.u, r.v, g, r.sd, r.sv, r.sa);
-        for i in 0..m {
-            let (u0, v0, g0, d0) = (u[i], v[i], gg[i], dl[i]);
-            let u1 = uu[i] * u0 + uv[i] * v0 + ug[i] * g0 + ud[i] * d0;
-            let v1 = vu[i] * u0 + vv[i] * v0 + vg[i] * g0 + vd[i] * d0;
-            u[i] = u1;
-            v[i] = v1;
-            gg[i] = g0 + d0;
-            let acc = w2[i] * u1 + c2[i] * v1;
-            keep_max(&mut sd[i], abs(u1));
-            keep_max(&mut sv[i], abs(v1));
-            keep_max(&mut sa[i], abs(acc));
-        }
+        r.sd[i] = pd;
+        r.sv[i] = pv;
+        r.sa[i] = pa;
     }
 
     /// Periods (s), as given. Cost: none.
