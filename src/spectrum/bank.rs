@@ -278,6 +278,7 @@ macro_rules! bank_ctor {
                     last: 0.0,
                     samples: 0,
                     skipped: 0,
+                    walks: 0,
                 }
             }
         }
@@ -302,6 +303,7 @@ pub struct Response<T, const P: usize> {
     pub(super) last: T,
     pub(super) samples: u64,
     pub(super) skipped: u64,
+    pub(super) walks: u64,
 }
 
 impl<T: Real, const P: usize> Response<T, P> {
@@ -334,6 +336,12 @@ impl<T: Real, const P: usize> Response<T, P> {
     /// Non-finite samples skipped so far (see [`Bank::step`]). Cost: none.
     pub fn skipped(&self) -> u64 {
         self.skipped
+    }
+    /// Sub-step walks taken so far (one per oscillator and interval whose peak could rise
+    /// inside it; see [`Bank::step`]): the part of the cost that depends on the record.
+    /// Cost: none.
+    pub fn walks(&self) -> u64 {
+        self.walks
     }
 }
 
@@ -508,6 +516,7 @@ impl<T: Real, const P: usize> Bank<T, P> {
         r.sd[i] = pd;
         r.sv[i] = pv;
         r.sa[i] = pa;
+        r.walks += 1;
     }
 
     /// Periods (s), as given. Cost: none.

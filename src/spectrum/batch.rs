@@ -81,5 +81,6 @@ fn zero_response<T: Real, const P: usize>(_bank: &Bank<T, P>) -> Response<T, P> 
         last: z,
         samples: 0,
         skipped: 0,
+        walks: 0,
     }
 }
