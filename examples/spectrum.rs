@@ -14,6 +14,11 @@
 //! (`spectrum::batch`). Writes `<out>/spectrum-<record>.csv` (T, ζ, Sd, Sv, Sa, PSV, PSA in
 //! m, m/s, m/s²) and `<out>/spectrum.svg` (PSA against T).
 //!
+//! `--linear-sd` prints El Centro's Sd (m) at 100 periods spaced linearly from 0.01 s to
+//! 10 s (those `sdof.spectrum` takes on its C path), one line per scheme: the AEM without
+//! sub-steps, then the exact scheme with the default rule (`scripts/bench_spectrum.py`
+//! compares them with `sdof`).
+//!
 //! `--tables` prints, for El Centro: the peak error against the sub-step count, the
 //! sub-step rule's error and cost, the free vibration after the record, and the schemes and
 //! `f32` against the converged spectrum (every number computed here).
@@ -122,6 +127,9 @@ fn main() -> Res<()> {
     };
     if args.iter().any(|a| a == "--tables") {
         return tables();
+    }
+    if args.iter().any(|a| a == "--linear-sd") {
+        return linear_sd();
     }
     let (input, out) = (
         PathBuf::from(arg("--in", "data")),
@@ -244,6 +252,27 @@ fn plot(
         .border_style(BLACK)
         .draw()?;
     root.present()?;
+    Ok(())
+}
+
+fn linear_sd() -> Res<()> {
+    let rec = elcentro()?;
+    let per: [f64; P] = core::array::from_fn(|i| 0.01 + (10.0 - 0.01) * i as f64 / (P - 1) as f64);
+    for (s, n) in [
+        (Scheme::Aem, Substeps::Fixed(1)),
+        (Scheme::Exact, Substeps::AUTO),
+    ] {
+        let b = Bank::<f64, P>::with(per, [ZETA; P], rec.dt, s, n)?;
+        let r = run(&b, &rec.ag, 0);
+        println!(
+            "{}",
+            r.sd()
+                .iter()
+                .map(|x| format!("{x:e}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+    }
     Ok(())
 }
 
