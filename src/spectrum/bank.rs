@@ -50,7 +50,6 @@ pub struct Bank<T, const P: usize> {
     pub(super) inv_w: [T; P],
     /// `2ζ/ω²` (s²).
     pub(super) k2: [T; P],
-
     /// `1/n_p`.
     pub(super) inv_n: [T; P],
     /// Sub-steps per sample `n_p` (non-increasing along the bank).
