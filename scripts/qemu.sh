@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
-EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes)
+EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum)
 # Broken on purpose: "example feature" pairs that must exit with failure (status 1).
 BROKEN=("qemu_timer qemu-inject-nan" "qemu_timer qemu-tight-bound" "qemu_nonlinear qemu-inject-nan"
     "qemu_modal qemu-modal-tight-bound" "qemu_schemes qemu-inject-nan")
@@ -86,6 +86,20 @@ for pair in "${BROKEN[@]}"; do
     [[ $RC -eq 1 ]] || fail "$ex with --features $feat exited $RC, expected the failure status 1"
     grep -q '^FAIL: ' "$OUT/$ex-$feat.log" || fail "$ex ($feat) failed without saying why"
     echo "ok: $ex with --features $feat failed as it must (exit 1)"
+done
+# Broken through `--cfg aemstep_broken="<what>"` (RUSTFLAGS replaces the target's, so the
+# link script is repeated; own target dir, so the main build is not invalidated).
+for pair in "qemu_spectrum spectrum-tight-bound"; do
+    read -r ex cfg <<<"$pair"
+    set +e
+    # shellcheck disable=SC2046
+    RUSTFLAGS="--cfg aemstep_broken=\"$cfg\" -C link-arg=-Tlink.x" CARGO_TARGET_DIR="$TARGET_DIR/broken" \
+        timeout "$RUN_TIMEOUT" cargo run -q $(example_args "$ex" qemu) >"$OUT/$ex-$cfg.log" 2>&1
+    RC=$?
+    set -e
+    cat "$OUT/$ex-$cfg.log"
+    [[ $RC -eq 1 ]] && grep -q '^FAIL: ' "$OUT/$ex-$cfg.log" || fail "$ex with cfg $cfg exited $RC, expected 1 with a FAIL line"
+    echo "ok: $ex with --cfg aemstep_broken=\"$cfg\" failed as it must (exit 1)"
 done
 
 step "qemu: no operator inversion code in the compile-time-operator firmware"
@@ -247,6 +261,15 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     grep '^COST ' "$OUT/qemu_modal-qemu.log" | while read -r _ what instr madds; do
         echo "| \`$what\` | $instr | $madds |"
     done
+    echo
+    echo "## Response spectrum (\`examples/qemu_spectrum.rs\`)"
+    echo
+    echo "\`Bank<f32, P>\` (5 %, exact scheme, default sub-steps) fed El Centro: instructions per incoming sample,"
+    echo "averaged over the record (sub-step walks included); multiply-adds of the whole-interval steps (10P)."
+    echo
+    echo "| bank | instructions / sample | multiply-adds |"
+    echo "|---|---:|---:|"
+    grep '^COST spectrum' "$OUT/qemu_spectrum-qemu.log" | while read -r _ what instr madds; do echo "| \`$what\` | $instr | $madds |"; done
     echo
     echo "## Footprint (\`examples/qemu_footprint.rs\`)"
     echo

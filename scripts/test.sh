@@ -20,11 +20,11 @@ cargo clippy --all-targets -- -D warnings || fail "clippy"
 cargo clippy --all-targets --features std -- -D warnings || fail "clippy (std)"
 
 step "host tests (debug: overflow checks on)"
-tests cargo test --all-targets || fail "host tests"
-tests cargo test --doc || fail "doctests"
+tests cargo test --all-targets --features std || fail "host tests (with the host-only std feature)"
+tests cargo test --doc --features std || fail "doctests"
 
 step "long host tests (release)"
-tests cargo test --release --all-targets -- --ignored || fail "long tests"
+tests cargo test --release --all-targets --features std -- --ignored || fail "long tests"
 
 step "energy behaviour of the nonlinear stepper (numbers quoted in README.md)"
 cargo run --release --example energy || fail "energy example"

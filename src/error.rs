@@ -61,6 +61,11 @@ pub enum Error {
     /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) is not finite or is
     /// outside its documented range.
     InvalidParameter,
+    /// A response-spectrum period is not finite and strictly positive, or the periods of
+    /// a bank are not in non-decreasing order (`spectrum::Bank`).
+    InvalidPeriod,
+    /// A damping ratio is NaN or outside `[0, 1)` (`spectrum::Bank`).
+    InvalidDamping,
 }
 
 impl Error {
@@ -103,6 +108,10 @@ impl Error {
             Error::EigenNotConverged => "the symmetric eigen-solver did not converge",
             Error::InvalidParameter => "a scheme parameter is not finite or out of range",
             Error::OperatorOverflow => "an operator overflows the scalar type",
+            Error::InvalidPeriod => {
+                "a period is not finite and > 0, or the periods are not in non-decreasing order"
+            }
+            Error::InvalidDamping => "a damping ratio is NaN or outside [0, 1)",
         }
     }
 }

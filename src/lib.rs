@@ -25,6 +25,9 @@
 //!   (ρ∞, HHT-α), [`Exact`] (matrix-exponential discretization, piecewise-linear load).
 //! - [`analysis`]: amplification matrix, spectral radius, period elongation and amplitude
 //!   decay of any scheme on the 1-DOF oscillator.
+//! - [`spectrum`]: response spectra: a bank of damped oscillators fed one
+//!   ground-acceleration sample at a time, RotD50/RotD100, and (feature `std`) many
+//!   records in parallel on the host.
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
 //!
@@ -45,6 +48,7 @@ pub use nalgebra;
 // The state and the interface every scheme shares.
 mod error;
 mod scalar;
+pub mod spectrum;
 mod state;
 mod stepper;
 
