@@ -35,6 +35,8 @@ step "cores: thumb targets"
 rustup target add thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf thumbv8m.main-none-eabihf
 command -v qemu-system-arm >/dev/null || fail "qemu-system-arm not found (scripts/qemu.sh installs it)"
 mkdir -p "$OUT" docs
+cargo clippy -q --release --target thumbv7em-none-eabihf --features qemu --example qemu_cores -- -D warnings ||
+    fail "clippy (qemu_cores)"
 
 for core in "${CORES[@]}"; do
     read -r name target machine cpu extra <<<"$core"
