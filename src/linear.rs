@@ -339,37 +339,40 @@ pub(crate) fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
     for r in 0..R {
         q[r] = rows[r][0][0] * x[0][0];
     }
-    for b in 0..K {
-        let first = if b == 0 { 1 } else { 0 };
-        if CHUNK == 1 {
+    if CHUNK == 1 {
+        for b in 0..K {
+            let first = if b == 0 { 1 } else { 0 };
             for j in first..N {
                 let xj = x[b][j];
                 for r in 0..R {
                     q[r] += rows[r][b][j] * xj;
                 }
             }
-            continue;
         }
-        // `CHUNK` columns at a time: loaded together, added one after the other.
-        let mut j = first;
-        while j + CHUNK <= N {
-            let xs: [T; CHUNK] = core::array::from_fn(|c| x[b][j + c]);
-            let rs: [[T; CHUNK]; R] =
-                core::array::from_fn(|r| core::array::from_fn(|c| rows[r][b][j + c]));
-            for c in 0..CHUNK {
-                for r in 0..R {
-                    q[r] += rs[r][c] * xs[c];
-                }
-            }
-            j += CHUNK;
-        }
-        // The last `N mod CHUNK` columns.
-        while j < N {
+        return q;
+    }
+    // `CHUNK` columns at a time over each row's whole run of `K·N` values (the same order:
+    // block by block, column by column): loaded together, added one after the other.
+    let xf = x.as_flattened();
+    let rf: [&[T]; R] = core::array::from_fn(|r| rows[r].as_flattened());
+    let len = K * N;
+    let mut j = 1;
+    while j + CHUNK <= len {
+        let xs: [T; CHUNK] = core::array::from_fn(|c| xf[j + c]);
+        let rs: [[T; CHUNK]; R] = core::array::from_fn(|r| core::array::from_fn(|c| rf[r][j + c]));
+        for c in 0..CHUNK {
             for r in 0..R {
-                q[r] += rows[r][b][j] * x[b][j];
+                q[r] += rs[r][c] * xs[c];
             }
-            j += 1;
         }
+        j += CHUNK;
+    }
+    // The last `(K·N − 1) mod CHUNK` columns.
+    while j < len {
+        for r in 0..R {
+            q[r] += rf[r][j] * xf[j];
+        }
+        j += 1;
     }
     q
 }
