@@ -420,23 +420,24 @@ pub(crate) fn initial_state<T: Real, const N: usize>(
 #[cfg(test)]
 mod block_tests {
     use super::mat_vec_blocked;
+    use crate::Real;
 
     /// Row `i` of `rows · x` as one serial chain, first product first: the order every
     /// block shape must keep.
-    fn serial<const N: usize, const K: usize>(
-        rows: &[[[f64; N]; K]; N],
-        x: &[[f64; N]; K],
-    ) -> [f64; N] {
+    fn serial<T: Real, const N: usize, const K: usize>(
+        rows: &[[[T; N]; K]; N],
+        x: &[[T; N]; K],
+    ) -> [T; N] {
         core::array::from_fn(|i| {
             let (r, x) = (rows[i].as_flattened(), x.as_flattened());
             r[1..]
                 .iter()
                 .zip(&x[1..])
-                .fold(r[0] * x[0], |q, (a, b)| q + a * b)
+                .fold(r[0] * x[0], |q, (&a, &b)| q + a * b)
         })
     }
 
-    fn check<const N: usize>() {
+    fn check<T: Real, const N: usize>() {
         let mut s = 0x2545_f491_4f6c_dd1d_u64 ^ N as u64;
         let mut next = || {
             s ^= s << 13;
@@ -444,14 +445,19 @@ mod block_tests {
             s ^= s << 17;
             (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
         };
-        let rows: [[[f64; N]; 3]; N] =
+        let mut next = || T::from_f64_rounded(next());
+        let rows: [[[T; N]; 3]; N] =
             core::array::from_fn(|_| core::array::from_fn(|_| core::array::from_fn(|_| next())));
-        let x: [[f64; N]; 3] = core::array::from_fn(|_| core::array::from_fn(|_| next() * 1e3));
-        let mut out = [0.0; N];
+        let x: [[T; N]; 3] = core::array::from_fn(|_| core::array::from_fn(|_| next()));
+        let mut out = [T::zero(); N];
         mat_vec_blocked(&rows, &x, &mut out);
         let want = serial(&rows, &x);
         for i in 0..N {
-            assert_eq!(out[i].to_bits(), want[i].to_bits(), "N = {N}, row {i}");
+            assert_eq!(
+                out[i].as_f64().to_bits(),
+                want[i].as_f64().to_bits(),
+                "N = {N}, row {i}"
+            );
         }
     }
 
@@ -459,7 +465,7 @@ mod block_tests {
     /// and Cortex-M therefore agree bit for bit: same chains, same order).
     #[test]
     fn blocked_rows_sum_in_serial_order() {
-        macro_rules! sizes { ($($n:literal)*) => { $( check::<$n>(); )* } }
+        macro_rules! sizes { ($($n:literal)*) => { $( check::<f64, $n>(); check::<f32, $n>(); )* } }
         sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 25 50 99 100);
     }
 }
