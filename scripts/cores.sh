@@ -100,7 +100,9 @@ cell() { # <core> <form> <T> <N>: "instructions (per multiply-add)"
     echo "multiply-add in brackets). \`Linear\`: the N-storey shear building, \`3N²\` multiply-adds"
     echo "(the \`7N\` of the kinematics not counted). \`Modal\`: the benchmark 5-storey building, 2 of 5"
     echo "modes, one step and the roof-drift output (18 multiply-adds). Duffing: \`Nonlinear<T, 1>\` on"
-    echo "paper Example 5 with exactly 2 Newton iterations (analytic tangent)."
+    echo "paper Example 5 with exactly 2 Newton iterations (analytic tangent). \`Modal\` here takes the load by"
+    echo "reference and stores the output (58 M4F instructions); \`examples/qemu_modal.rs\` passes both in"
+    echo "registers (51, \`docs/cortex-m4-cost.md\`)."
     echo
     printf '| case | T | N | multiply-adds |'
     for core in "${CORES[@]}"; do read -r name _ <<<"$core"; printf ' %s |' "$name"; done
