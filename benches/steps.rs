@@ -5,6 +5,15 @@
 //! `python3 scripts/bench_table.py` turns `target/criterion/**/estimates.json` into the
 //! README tables. Filter with e.g. `cargo bench --bench steps -- step/f64`.
 //!
+//! Beside every stepper, the same run times two references (see `docs/performance.md`):
+//! - `nalgebra-dmatrix`: a plain Newmark average-acceleration loop on `nalgebra::DMatrix`
+//!   (heap matrices, in place, three `gemv`s a step), the comparator a user would write;
+//! - `floor-read`: one pass reading as many bytes as the step's operators (`3N²` values),
+//!   the memory floor of a step on this machine at that size.
+//!
+//! Throughput is multiply-adds (criterion prints it as `Gelem/s` = multiply-adds per ns);
+//! `scripts/bench_table.py` also prints the share of the floor.
+//!
 //! Systems are random, symmetric, fully populated and positive definite (M, K), with
 //! C = 0.01 M + 0.001 K, built by a fixed-seed generator, so every run times the same
 //! matrices. Steppers live on the heap (`Box`), and the whole run happens on a thread
@@ -16,8 +25,8 @@ use std::time::Duration;
 
 use aemstep::{Exact, GeneralizedAlpha, Linear, Newmark, Real, State, Stepper};
 use criterion::measurement::WallTime;
-use criterion::{BenchmarkGroup, BenchmarkId, Criterion};
-use nalgebra::{SMatrix, SVector};
+use criterion::{BenchmarkGroup, BenchmarkId, Criterion, Throughput};
+use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
 /// Fixed-seed xorshift generator in [−1, 1).
 struct Rng(u64);
@@ -60,10 +69,12 @@ fn bench_stepper<
     g: &mut BenchmarkGroup<'_, WallTime>,
     name: &str,
     sys: &S,
+    madds: usize,
 ) {
     let p = SVector::<T, N>::from_element(T::from_f64_rounded(1.0));
     let z = SVector::<T, N>::zeros();
     let mut s = sys.start(&z, &z, &p).expect("start");
+    g.throughput(Throughput::Elements(madds as u64));
     g.bench_with_input(BenchmarkId::new(name, N), &N, |b, _| {
         b.iter(|| sys.step(black_box(&mut s), black_box(&p)))
     });
@@ -78,18 +89,132 @@ fn per_step<T: Real, const N: usize>(c: &mut Criterion, ty: &str) {
         .measurement_time(Duration::from_millis(700))
         .sample_size(20);
     let lin = Box::new(Linear::<T, N>::new(m, cc, k, h).expect("linear"));
-    bench_stepper(&mut g, "aem", &*lin);
+    bench_stepper(&mut g, "aem", &*lin, 3 * N * N + 7 * N);
     let af = Box::new(lin.a_form());
-    bench_stepper(&mut g, "aem-aform", &*af);
+    bench_stepper(&mut g, "aem-aform", &*af, 12 * N * N);
     drop(af);
     let nm = Box::new(Newmark::<T, N>::linear_acceleration(m, cc, k, h).expect("newmark"));
-    bench_stepper(&mut g, "newmark", &*nm);
+    bench_stepper(&mut g, "newmark", &*nm, 3 * N * N + 7 * N);
     drop(nm);
     let ga = Box::new(GeneralizedAlpha::<T, N>::new(m, cc, k, h, 0.8).expect("gen-alpha"));
-    bench_stepper(&mut g, "gen-alpha", &*ga);
+    bench_stepper(&mut g, "gen-alpha", &*ga, 4 * N * N + 10 * N);
     drop(ga);
     let ex = Box::new(Exact::<T, N>::new(m, cc, k, h).expect("exact"));
-    bench_stepper(&mut g, "exact", &*ex);
+    bench_stepper(&mut g, "exact", &*ex, 11 * N * N);
+    bench_references::<T, N>(&mut g, &sys, 0.01);
+    g.finish();
+}
+
+/// The plain nalgebra Newmark average-acceleration loop a user would write: `DMatrix`
+/// operators `G = (M + (h/2) C + (h²/4) K)⁻¹`, `GC`, `GK` (computed in `f64`, rounded
+/// once to `T`, as the crate does) and three `gemv`s a step, everything in place.
+struct DMatrixNewmark<T: Real> {
+    g: DMatrix<T>,
+    gc: DMatrix<T>,
+    gk: DMatrix<T>,
+    h: T,
+    half_h: T,
+    quarter_h2: T,
+    u: DVector<T>,
+    v: DVector<T>,
+    a: DVector<T>,
+    vh: DVector<T>,
+    uh: DVector<T>,
+}
+
+impl<T: Real> DMatrixNewmark<T> {
+    fn new(m: &DMatrix<f64>, c: &DMatrix<f64>, k: &DMatrix<f64>, h: f64) -> Self {
+        let g = (m + c * (h / 2.0) + k * (h * h / 4.0))
+            .try_inverse()
+            .expect("M_eff regular");
+        let (gc, gk) = (&g * c, &g * k);
+        let r = |a: &DMatrix<f64>| a.map(T::from_f64_rounded);
+        let n = m.nrows();
+        Self {
+            g: r(&g),
+            gc: r(&gc),
+            gk: r(&gk),
+            h: T::from_f64_rounded(h),
+            half_h: T::from_f64_rounded(h / 2.0),
+            quarter_h2: T::from_f64_rounded(h * h / 4.0),
+            u: DVector::zeros(n),
+            v: DVector::zeros(n),
+            a: DVector::zeros(n),
+            vh: DVector::zeros(n),
+            uh: DVector::zeros(n),
+        }
+    }
+
+    /// `v̂ = v + (h/2) a`, `û = u + h v + (h²/4) a`, `a = G p − GC v̂ − GK û`,
+    /// `v = v̂ + (h/2) a`, `u = û + (h²/4) a`: `3N²` multiply-adds + `7N`.
+    fn step(&mut self, p: &DVector<T>) {
+        let one = T::one();
+        self.vh.copy_from(&self.v);
+        self.vh.axpy(self.half_h, &self.a, one);
+        self.uh.copy_from(&self.u);
+        self.uh.axpy(self.h, &self.v, one);
+        self.uh.axpy(self.quarter_h2, &self.a, one);
+        self.a.gemv(one, &self.g, p, T::zero());
+        self.a.gemv(-one, &self.gc, &self.vh, one);
+        self.a.gemv(-one, &self.gk, &self.uh, one);
+        self.v.copy_from(&self.vh);
+        self.v.axpy(self.half_h, &self.a, one);
+        self.u.copy_from(&self.uh);
+        self.u.axpy(self.quarter_h2, &self.a, one);
+    }
+}
+
+/// The two references of a size, in the same group as the steppers: the nalgebra
+/// `DMatrix` loop, and one read of the step's operator bytes (`3N²` values of `T`).
+fn bench_references<T: Real, const N: usize>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    sys: &(SMatrix<f64, N, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>),
+    h: f64,
+) {
+    let d = |a: &SMatrix<f64, N, N>| DMatrix::from_fn(N, N, |i, j| a[(i, j)]);
+    let mut nm = DMatrixNewmark::<T>::new(&d(&sys.0), &d(&sys.1), &d(&sys.2), h);
+    let p = DVector::<T>::from_element(N, T::from_f64_rounded(1.0));
+    g.throughput(Throughput::Elements((3 * N * N + 7 * N) as u64));
+    g.bench_with_input(BenchmarkId::new("nalgebra-dmatrix", N), &N, |b, _| {
+        b.iter(|| nm.step(black_box(&p)))
+    });
+    // The floor: stream the operator bytes once (integer sum: the compiler may reorder
+    // and vectorize it freely, so it runs at the cache's bandwidth).
+    let bytes = 3 * N * N * core::mem::size_of::<T>();
+    let words = vec![1u64; bytes.div_ceil(8)];
+    g.throughput(Throughput::Bytes(bytes as u64));
+    g.bench_with_input(BenchmarkId::new("floor-read", N), &N, |b, _| {
+        b.iter(|| {
+            black_box(&words)
+                .iter()
+                .fold(0u64, |s, &w| s.wrapping_add(w))
+        })
+    });
+}
+
+/// The compute floor: 12 independent chains of packed multiply-then-add (no fusing, as
+/// the steppers), `MACS` multiply-adds a call; the rate the cores' multiply and add pipes
+/// sustain in this build.
+fn floor_compute<T: Real>(c: &mut Criterion, ty: &str) {
+    const LANES: usize = 48;
+    const ROUNDS: usize = 256;
+    let mut g = c.benchmark_group("floor");
+    g.warm_up_time(Duration::from_millis(200))
+        .measurement_time(Duration::from_millis(700))
+        .sample_size(20)
+        .throughput(Throughput::Elements((LANES * ROUNDS) as u64));
+    let (m, k) = (T::from_f64_rounded(0.999), T::from_f64_rounded(1e-3));
+    g.bench_function(format!("compute-{ty}"), |b| {
+        b.iter(|| {
+            let mut acc = [T::one(); LANES];
+            for _ in 0..ROUNDS {
+                for a in acc.iter_mut() {
+                    *a = *a * m + k;
+                }
+            }
+            black_box(acc)
+        })
+    });
     g.finish();
 }
 
@@ -171,6 +296,8 @@ fn main() {
             // N = 100 operators take minutes to build in a debug build.
             let full = std::env::args().any(|a| a == "--bench");
             let mut c = Criterion::default().configure_from_args();
+            floor_compute::<f64>(&mut c, "f64");
+            floor_compute::<f32>(&mut c, "f32");
             per_step_all(&mut c, full);
             if full {
                 example10(&mut c);

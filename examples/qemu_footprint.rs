@@ -1,9 +1,9 @@
 //! Firmware: flash footprint — a scene pays only for the capabilities it uses.
 //!
 //! Default build: only `Linear<f32, 5>` (operators a compiler-built `static`), stepping the
-//! benchmark building under a synthetic ground motion. With feature `qemu-footprint-modal`
+//! benchmark building under a synthetic ground motion. With `--cfg aemstep_control="footprint-modal"`
 //! it also steps `Modal<f32, 5, 2>` whose modes the compiler solved (`static`,
-//! `Modal::from_rows`). With feature `qemu-footprint-all` it also steps the nonlinear
+//! `Modal::from_rows`). With `--cfg aemstep_control="footprint-all"` it also steps the nonlinear
 //! stepper (`Nonlinear<f32, 5>`, the building with hardening storey springs, Newton) and a
 //! `Modal<f32, 5, 2>` built at start-up (`Modal::new`: the eigen-solver runs on target).
 //! `scripts/qemu.sh` builds and runs all three, compares their flash (`llvm-size`) and
@@ -44,7 +44,7 @@ fn load(n: u32) -> SVector<f32, 5> {
     SVector::from_element(-1.0e5 * ground(n))
 }
 
-#[cfg(feature = "qemu-footprint-modal")]
+#[cfg(aemstep_control = "footprint-modal")]
 mod flash_modal {
     //! A modal model whose operators the compiler computed.
     use super::*;
@@ -76,7 +76,7 @@ mod flash_modal {
     }
 }
 
-#[cfg(feature = "qemu-footprint-all")]
+#[cfg(aemstep_control = "footprint-all")]
 mod extra {
     //! The capabilities only the full build uses.
     use super::*;
@@ -156,7 +156,7 @@ fn main() -> ! {
         fail!("linear state not finite");
     }
     hprintln!("qemu_footprint: Linear<f32, 5> roof {:e} m", s.u()[4]);
-    #[cfg(feature = "qemu-footprint-modal")]
+    #[cfg(aemstep_control = "footprint-modal")]
     {
         let modal = flash_modal::run();
         if !modal.is_finite() {
@@ -164,7 +164,7 @@ fn main() -> ! {
         }
         hprintln!("qemu_footprint: Modal(R = 2, static) roof {:e} m", modal);
     }
-    #[cfg(feature = "qemu-footprint-all")]
+    #[cfg(aemstep_control = "footprint-all")]
     {
         let (nl, modal) = extra::run();
         if !(nl.is_finite() && modal.is_finite()) {

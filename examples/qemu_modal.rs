@@ -19,7 +19,7 @@
 //!
 //! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_modal`
 //! (or `bash scripts/qemu.sh`). Broken variant that must fail: feature
-//! `qemu-modal-tight-bound` (bound 100× tighter than the measured truncation).
+//! `--cfg aemstep_broken="modal-tight-bound"` (bound 100× tighter than the measured truncation).
 #![no_std]
 #![no_main]
 
@@ -53,10 +53,10 @@ const STEPS: u32 = (elcentro::SAMPLES - 1) as u32;
 const TICKS_PER_STEP: u32 = (25_000_000.0 * H) as u32;
 
 /// Max |roof drift − full-model roof drift| (m): measured and derived on the host.
-#[cfg(not(feature = "qemu-modal-tight-bound"))]
+#[cfg(not(aemstep_broken = "modal-tight-bound"))]
 const BOUND: f64 = reference::BOUND;
 /// Broken on purpose: 100× tighter than the truncation of 2 modes allows; must fail.
-#[cfg(feature = "qemu-modal-tight-bound")]
+#[cfg(aemstep_broken = "modal-tight-bound")]
 const BOUND: f64 = reference::BOUND / 100.0;
 
 const BUILDING: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();

@@ -9,7 +9,7 @@
 //! first (`tests/firmware_duffing.rs`, same data, same bound).
 //!
 //! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_nonlinear`
-//! (or `bash scripts/qemu.sh`). Broken variant that must fail: feature `qemu-inject-nan`
+//! (or `bash scripts/qemu.sh`). Broken variant that must fail: `--cfg aemstep_broken="inject-nan"`
 //! (a NaN load sample at step 1000).
 #![no_std]
 #![no_main]
@@ -57,7 +57,7 @@ fn exact(t: f64) -> f64 {
 
 /// The load sample `p(t_n)` for the exact solution (the sensor in a real system).
 fn load_sample(n: u32) -> f32 {
-    if cfg!(feature = "qemu-inject-nan") && n == 1000 {
+    if cfg!(aemstep_broken = "inject-nan") && n == 1000 {
         return f32::NAN;
     }
     let t = n as f64 * H as f64;

@@ -18,7 +18,7 @@
 //!   scheme bug shows as an error of 1e-2 or more.
 //!
 //! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_schemes`
-//! (or `bash scripts/qemu.sh`). Broken variant that must fail: feature `qemu-inject-nan`
+//! (or `bash scripts/qemu.sh`). Broken variant that must fail: `--cfg aemstep_broken="inject-nan"`
 //! (a NaN load sample at step 1000, refused by `try_step`).
 #![no_std]
 #![no_main]
@@ -57,7 +57,7 @@ fn exact(t: f64) -> f64 {
 
 /// The load sample at step `n` (a step load).
 fn load<T: Real>(n: u32) -> SVector<T, 1> {
-    if cfg!(feature = "qemu-inject-nan") && n == 1000 {
+    if cfg!(aemstep_broken = "inject-nan") && n == 1000 {
         return vector![T::from_f64_rounded(f64::NAN)];
     }
     vector![T::from_f64_rounded(P)]

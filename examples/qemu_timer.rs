@@ -12,7 +12,7 @@
 //!
 //! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_timer`
 //! (or `bash scripts/qemu.sh`). Broken variants that must fail: features
-//! `qemu-inject-nan` (a NaN load sample at step 5000) and `qemu-tight-bound`.
+//! `--cfg aemstep_broken="inject-nan"` (a NaN load sample at step 5000) and `--cfg aemstep_broken="tight-bound"`.
 #![no_std]
 #![no_main]
 
@@ -42,17 +42,17 @@ const STEPS: u32 = 12_500; // T = 25 s
 /// Max |u_n − u(t_n)| allowed: `FIRMWARE_BOUND` of `tests/firmware_example2.rs`, where it
 /// is derived (method error + f32 rounding); the measured f32 error is the `qemu_timer` row
 /// of `docs/verification.md` (generated, checked by `scripts/check_docs.py`).
-#[cfg(not(feature = "qemu-tight-bound"))]
+#[cfg(not(aemstep_broken = "tight-bound"))]
 const BOUND: f64 = 1.2e-4;
 /// Broken on purpose: 1000× tighter than the measured error allows; must fail.
-#[cfg(feature = "qemu-tight-bound")]
+#[cfg(aemstep_broken = "tight-bound")]
 const BOUND: f64 = 1.2e-7;
 
 /// SysTick reload for one step per h on the 25 MHz core clock.
 const TICKS_PER_STEP: u32 = (25_000_000.0 * H) as u32;
 
 /// The operators, computed by the compiler (in f64, rounded once to f32) into flash.
-#[cfg_attr(feature = "qemu-runtime-ops", allow(dead_code))]
+#[cfg_attr(aemstep_control = "runtime-ops", allow(dead_code))]
 static SYS: Linear<f32, 1> =
     match Linear::<f32, 1>::from_rows([[1.0]], [[2.0 * XI * OMEGA]], [[OMEGA * OMEGA]], H) {
         Ok(s) => s,
@@ -70,7 +70,7 @@ enum Msg {
 
 /// The load sample p(t_n) = 10 H(t) (the sensor in a real system).
 fn load_sample(n: u32) -> f32 {
-    if cfg!(feature = "qemu-inject-nan") && n == 5000 {
+    if cfg!(aemstep_broken = "inject-nan") && n == 5000 {
         return f32::NAN;
     }
     P as f32
@@ -86,10 +86,10 @@ fn exact(t: f64) -> f64 {
 }
 
 /// The operators the firmware steps with: the compile-time `static`, or (control variant
-/// `qemu-runtime-ops` only) the same operators built at run time, which links the
+/// `--cfg aemstep_control="runtime-ops"` only) the same operators built at run time, which links the
 /// inversion code the symbol check looks for.
 fn stepper() -> &'static Linear<f32, 1> {
-    #[cfg(feature = "qemu-runtime-ops")]
+    #[cfg(aemstep_control = "runtime-ops")]
     {
         let (c, k) = core::hint::black_box((2.0 * XI * OMEGA, OMEGA * OMEGA));
         let m = nalgebra::matrix![1.0];
@@ -103,7 +103,7 @@ fn stepper() -> &'static Linear<f32, 1> {
             None => fail!("operators built twice"),
         }
     }
-    #[cfg(not(feature = "qemu-runtime-ops"))]
+    #[cfg(not(aemstep_control = "runtime-ops"))]
     &SYS
 }
 

@@ -3,7 +3,9 @@
 # (mps2-an386), fails if any exits non-zero or times out, runs the deliberately broken
 # variants and requires them to FAIL, checks that no inversion code is linked into the
 # compile-time-operator firmware, and writes the cost and memory tables to
-# docs/cortex-m4-cost.md (quoted by README.md).
+# docs/cortex-m4-cost.md (quoted by README.md). Last, scripts/cores.sh: the cost table
+# across Cortex-M cores (docs/cortex-m-cores.md), which fails if the M4F's f32 step
+# exceeds 3 instructions per multiply-add at N >= 6.
 #
 # Installs what it needs (thumb target, llvm-tools, qemu-system-arm). Called by
 # scripts/test.sh; runs alone too: `bash scripts/qemu.sh`.
@@ -14,9 +16,10 @@ TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
 EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum)
-# Broken on purpose: "example feature" pairs that must exit with failure (status 1).
-BROKEN=("qemu_timer qemu-inject-nan" "qemu_timer qemu-tight-bound" "qemu_nonlinear qemu-inject-nan"
-    "qemu_modal qemu-modal-tight-bound" "qemu_schemes qemu-inject-nan")
+# Broken on purpose: "example variant" pairs that must exit with failure (status 1); the
+# variant is `--cfg aemstep_broken="<variant>"` (not a public feature, see Cargo.toml).
+BROKEN=("qemu_timer inject-nan" "qemu_timer tight-bound" "qemu_nonlinear inject-nan"
+    "qemu_modal modal-tight-bound" "qemu_schemes inject-nan" "qemu_spectrum spectrum-tight-bound")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
 TARGET_DIR=${CARGO_TARGET_DIR:-target}
 OUT=$TARGET_DIR/qemu
@@ -42,19 +45,25 @@ fi
 qemu-system-arm --version | sed -n 1p
 
 mkdir -p "$OUT" docs
-example_args() { # <example> <features>
-    echo "--release --target $TARGET --features $2 --example $1"
-}
-build() { # <example> <features>: builds and keeps a copy of the ELF as $OUT/<example>-<features>
-    # shellcheck disable=SC2046
-    cargo build -q $(example_args "$1" "$2") || fail "build $1 ($2)"
+# The QEMU command of .cargo/config.toml for $TARGET (one place for it).
+read -r -a RUNNER < <(sed -n "/^\[target.$TARGET\]/,/^\[/ s/^runner = \"\(.*\)\"/\1/p" .cargo/config.toml)
+[[ ${#RUNNER[@]} -gt 0 ]] || fail "no runner for $TARGET in .cargo/config.toml"
+# A variant is `qemu` (the example as shipped) or `<kind>:<value>`, built with
+# `--cfg aemstep_<kind>="<value>"` (kind: broken, control). The cfg goes to the example
+# crate only (`cargo rustc`), so the library and dependencies are not rebuilt.
+build() { # <example> <variant>: builds and keeps a copy of the ELF as $OUT/<example>-<variant>
+    local args=(-q --release --target "$TARGET" --features qemu --example "$1")
+    if [[ $2 == qemu ]]; then
+        cargo build "${args[@]}" || fail "build $1"
+    else
+        cargo rustc "${args[@]}" -- --cfg "aemstep_${2%%:*}=\"${2#*:}\"" || fail "build $1 ($2)"
+    fi
     cp "$TARGET_DIR/$TARGET/release/examples/$1" "$OUT/$1-$2"
 }
-run() { # <example> <features>: runs it under QEMU (the runner of .cargo/config.toml); sets RC
+run() { # <example> <variant>: runs the ELF `build` kept under QEMU; sets RC
     local log="$OUT/$1-$2.log"
     set +e
-    # shellcheck disable=SC2046
-    timeout "$RUN_TIMEOUT" cargo run -q $(example_args "$1" "$2") >"$log" 2>&1
+    timeout "$RUN_TIMEOUT" "${RUNNER[@]}" "$OUT/$1-$2" >"$log" 2>&1
     RC=$?
     set -e
     cat "$log"
@@ -66,9 +75,9 @@ ex_flags=()
 for ex in "${EXAMPLES[@]}"; do ex_flags+=(--example "$ex"); done
 cargo clippy --release --target "$TARGET" --features qemu "${ex_flags[@]}" -- -D warnings ||
     fail "clippy (firmware examples)"
-for feat in qemu-footprint-modal qemu-footprint-all; do
-    cargo clippy --release --target "$TARGET" --features "$feat" --example qemu_footprint \
-        -- -D warnings || fail "clippy (qemu_footprint, $feat)"
+for variant in footprint-modal footprint-all; do
+    cargo clippy --release --target "$TARGET" --features qemu --example qemu_footprint \
+        -- -D warnings --cfg "aemstep_control=\"$variant\"" || fail "clippy (qemu_footprint, $variant)"
 done
 
 step "qemu: run every example (must exit 0)"
@@ -81,39 +90,26 @@ done
 
 step "qemu: deliberately broken variants (must exit 1)"
 for pair in "${BROKEN[@]}"; do
-    read -r ex feat <<<"$pair"
-    run "$ex" "$feat"
-    [[ $RC -eq 1 ]] || fail "$ex with --features $feat exited $RC, expected the failure status 1"
-    grep -q '^FAIL: ' "$OUT/$ex-$feat.log" || fail "$ex ($feat) failed without saying why"
-    echo "ok: $ex with --features $feat failed as it must (exit 1)"
-done
-# Broken through `--cfg aemstep_broken="<what>"` (RUSTFLAGS replaces the target's, so the
-# link script is repeated; own target dir, so the main build is not invalidated).
-for pair in "qemu_spectrum spectrum-tight-bound"; do
-    read -r ex cfg <<<"$pair"
-    set +e
-    # shellcheck disable=SC2046
-    RUSTFLAGS="--cfg aemstep_broken=\"$cfg\" -C link-arg=-Tlink.x" CARGO_TARGET_DIR="$TARGET_DIR/broken" \
-        timeout "$RUN_TIMEOUT" cargo run -q $(example_args "$ex" qemu) >"$OUT/$ex-$cfg.log" 2>&1
-    RC=$?
-    set -e
-    cat "$OUT/$ex-$cfg.log"
-    [[ $RC -eq 1 ]] && grep -q '^FAIL: ' "$OUT/$ex-$cfg.log" || fail "$ex with cfg $cfg exited $RC, expected 1 with a FAIL line"
-    echo "ok: $ex with --cfg aemstep_broken=\"$cfg\" failed as it must (exit 1)"
+    read -r ex variant <<<"$pair"
+    build "$ex" "broken:$variant"
+    run "$ex" "broken:$variant"
+    [[ $RC -eq 1 ]] || fail "$ex with --cfg aemstep_broken=\"$variant\" exited $RC, expected the failure status 1"
+    grep -q '^FAIL: ' "$OUT/$ex-broken:$variant.log" || fail "$ex ($variant) failed without saying why"
+    echo "ok: $ex with --cfg aemstep_broken=\"$variant\" failed as it must (exit 1)"
 done
 
 step "qemu: no operator inversion code in the compile-time-operator firmware"
 # The build with run-time operators (Linear::new) is the control: the same check must find
 # the inversion code there, or the check proves nothing.
-INVERSION='aemstep::ops::|inverse|cholesky|::lu::'
-build qemu_timer qemu-runtime-ops
-"$NM" -C "$OUT/qemu_timer-qemu-runtime-ops" | grep -E "$INVERSION" >/dev/null ||
+INVERSION='aemstep::linalg::|inverse|cholesky|::lu::'
+build qemu_timer control:runtime-ops
+"$NM" -C "$OUT/qemu_timer-control:runtime-ops" | grep -E "$INVERSION" >/dev/null ||
     fail "control: the symbol check did not see the inversion code of the run-time build"
 if "$NM" -C "$OUT/qemu_timer-qemu" | grep -E "$INVERSION"; then
     fail "qemu_timer links operator inversion code (symbols above)"
 fi
 echo "ok: qemu_timer has no symbol matching /$INVERSION/ (the run-time build has: $("$NM" -C \
-    "$OUT/qemu_timer-qemu-runtime-ops" | grep -E "$INVERSION" | awk '{print $3}' | tr '\n' ' '))"
+    "$OUT/qemu_timer-control:runtime-ops" | grep -E "$INVERSION" | awk '{print $3}' | tr '\n' ' '))"
 
 step "qemu: no panic reachable from any step function (call graph of the ELFs)"
 # Roots: every `#[no_mangle]` step symbol (`<example>_step`, `cost_step_*`). Edges: direct
@@ -139,11 +135,29 @@ reachable() { # <elf> <root>...: every function reachable from the roots, one pe
             for (f in seen) print f
         }'
 }
-# Control: the same walk must find the panic machinery behind the firmware's own formatted
-# failure path (core::fmt indexes slices), or the check proves nothing.
+# The walk follows direct branches only, so it also proves there is nothing else to follow:
+# no reachable function may branch through a register (`blx rN`, `bx rN` other than
+# `bx lr`, a load into pc) — a call through a function pointer or vtable that could hide a
+# panic. `indirect <elf> <fn>...` prints each such instruction with its function.
+indirect() {
+    local elf=$1
+    shift
+    "$OBJDUMP" -d --no-show-raw-insn "$elf" | awk -v fns="$*" '
+        BEGIN { n = split(fns, f, " "); for (i = 1; i <= n; i++) want[f[i]] = 1 }
+        /^[0-9a-f]+ <[^>]+>:$/ { fn = $2; gsub(/[<>:]/, "", fn); next }
+        (fn in want) && (/\tblx\tr[0-9]/ || /\tbx\tr[0-9]/ || /\tmov\tpc, r/ || /\tldr(\.w)?\tpc, \[r[0-9]/) {
+            print fn ": " $0
+        }'
+}
+# Controls: the same walk must find the panic machinery behind the firmware's own formatted
+# failure path (core::fmt indexes slices), and the indirect-branch scan must find core::fmt's
+# calls through its `dyn Write` vtable there, or the checks prove nothing.
 # (No `| grep -q` anywhere here: with pipefail, its early exit fails the writer.)
 control=$(reachable "$OUT/qemu_timer-qemu" "$("$NM" "$OUT/qemu_timer-qemu" | awk '$3 ~ /exit_failure/ { print $3 }')")
 grep -i panic <<<"$control" >/dev/null || fail "control: the call-graph walk found no panic behind exit_failure"
+mapfile -t control_fns <<<"$control"
+[[ -n $(indirect "$OUT/qemu_timer-qemu" "${control_fns[@]}") ]] ||
+    fail "control: the indirect-branch scan found nothing behind exit_failure (core::fmt calls through vtables)"
 for ex in "${EXAMPLES[@]}"; do
     mapfile -t roots < <(step_roots "$OUT/$ex-qemu")
     [[ ${#roots[@]} -gt 0 ]] || fail "$ex: no step symbol found"
@@ -151,7 +165,11 @@ for ex in "${EXAMPLES[@]}"; do
     if grep -i 'panic' <<<"$fns"; then
         fail "$ex: a panic is reachable from a step function (above)"
     fi
-    echo "ok: $ex: ${#roots[@]} step function(s), $(wc -l <<<"$fns") functions reachable, none panics"
+    mapfile -t fn_list <<<"$fns"
+    ind=$(indirect "$OUT/$ex-qemu" "${fn_list[@]}")
+    [[ -z $ind ]] || fail "$ex: a step function branches through a register; the walk cannot follow it:
+$ind"
+    echo "ok: $ex: ${#roots[@]} step function(s), $(wc -l <<<"$fns") functions reachable, none panics, no indirect branch"
 done
 
 step "qemu: host and Cortex-M4F f32 runs are bit-identical (Example 2, u at 25 s)"
@@ -172,32 +190,32 @@ target_bits=$(sed -n 's/^target roof drift f32 bits = //p' "$OUT/qemu_modal-qemu
 echo "ok: both $host_bits"
 
 step "qemu: footprint: a firmware pays only for the capabilities it uses"
-# qemu_footprint uses only Linear<f32, 5>; with qemu-footprint-modal also a compile-time
-# Modal<f32, 5, 2>; with qemu-footprint-all also the nonlinear stepper and a Modal built at
+# qemu_footprint uses only Linear<f32, 5>; with control "footprint-modal" also a compile-time
+# Modal<f32, 5, 2>; with "footprint-all" also the nonlinear stepper and a Modal built at
 # run time. The last is the control: the symbol checks must find the code there.
 UNUSED='modal|nonlinear|varying|jacobi|LinearInput|input[:.]|cholesky|Cholesky'
 EIGEN='jacobi|cholesky|modes_of|modal_operators'
-for feat in qemu qemu-footprint-modal qemu-footprint-all; do
-    build qemu_footprint "$feat"
-    run qemu_footprint "$feat"
-    [[ $RC -eq 0 ]] || fail "qemu_footprint ($feat) exited with $RC"
+for variant in qemu control:footprint-modal control:footprint-all; do
+    build qemu_footprint "$variant"
+    run qemu_footprint "$variant"
+    [[ $RC -eq 0 ]] || fail "qemu_footprint ($variant) exited with $RC"
 done
-"$NM" -C "$OUT/qemu_footprint-qemu-footprint-all" | grep -E "$UNUSED" >/dev/null ||
+"$NM" -C "$OUT/qemu_footprint-control:footprint-all" | grep -E "$UNUSED" >/dev/null ||
     fail "control: no nonlinear/modal symbol found in the build that uses them"
-"$NM" -C "$OUT/qemu_footprint-qemu-footprint-all" | grep -E "$EIGEN" >/dev/null ||
+"$NM" -C "$OUT/qemu_footprint-control:footprint-all" | grep -E "$EIGEN" >/dev/null ||
     fail "control: no eigen-solver symbol found in the build that runs Modal::new"
 if "$NM" -C "$OUT/qemu_footprint-qemu" | grep -E "$UNUSED"; then
     fail "the Linear-only firmware links code of capabilities it does not use (symbols above)"
 fi
-for elf in "$OUT/qemu_footprint-qemu-footprint-modal" "$OUT/qemu_modal-qemu"; do
+for elf in "$OUT/qemu_footprint-control:footprint-modal" "$OUT/qemu_modal-qemu"; do
     if "$NM" -C "$elf" | grep -E "$EIGEN"; then
         fail "$elf links eigen-solver code although its modes were solved at compile time"
     fi
 done
 flash_of() { "$SIZE" -B "$1" | awk 'NR == 2 { print $1 + $2 }'; }
 FP_LEAN=$(flash_of "$OUT/qemu_footprint-qemu")
-FP_MODAL=$(flash_of "$OUT/qemu_footprint-qemu-footprint-modal")
-FP_ALL=$(flash_of "$OUT/qemu_footprint-qemu-footprint-all")
+FP_MODAL=$(flash_of "$OUT/qemu_footprint-control:footprint-modal")
+FP_ALL=$(flash_of "$OUT/qemu_footprint-control:footprint-all")
 echo "ok: flash: Linear only $FP_LEAN bytes; + static Modal $FP_MODAL; + Nonlinear + run-time" \
     "Modal $FP_ALL. No /$UNUSED/ symbol in the Linear-only build, no /$EIGEN/ symbol in the" \
     "static-Modal builds"
@@ -274,9 +292,9 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "## Footprint (\`examples/qemu_footprint.rs\`)"
     echo
     echo "Flash (\`.text\` + \`.rodata\` + vector table + \`.data\`) of the same firmware using only"
-    echo "\`Linear<f32, 5>\`; also a \`Modal<f32, 5, 2>\` solved by the compiler (feature"
-    echo "\`qemu-footprint-modal\`); also \`Nonlinear<f32, 5>\` and a \`Modal<f32, 5, 2>\` built at run time"
-    echo "(feature \`qemu-footprint-all\`). Checked: the Linear-only build links no symbol of the others,"
+    echo "\`Linear<f32, 5>\`; also a \`Modal<f32, 5, 2>\` solved by the compiler ("
+    echo "\`--cfg aemstep_control=\"footprint-modal\"\`); also \`Nonlinear<f32, 5>\` and a \`Modal<f32, 5, 2>\` built at run time"
+    echo "(\`--cfg aemstep_control=\"footprint-all\"\`). Checked: the Linear-only build links no symbol of the others,"
     echo "the compile-time-modal builds no eigen-solver."
     echo
     echo "| firmware | flash (bytes) |"
@@ -306,5 +324,8 @@ cat "$COST_DOC"
 # number): fail when a quote has gone stale.
 python3 scripts/check_docs.py --quotes ||
     fail "README.md or docs/ quote numbers that $COST_DOC no longer has (copy the new lines over)"
+
+step "qemu: cost table across Cortex-M cores (scripts/cores.sh)"
+bash scripts/cores.sh || fail "scripts/cores.sh"
 
 printf '\nqemu: all firmware checks passed\n'

@@ -12,7 +12,7 @@ trap 'rm -f "$log"' EXIT
 tests() { "$@" 2>&1 | tee -a "$log"; }
 
 step "toolchain: thumb targets (idempotent)"
-rustup target add thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi
+rustup target add thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi thumbv8m.main-none-eabihf
 
 step "format and lints"
 cargo fmt --all -- --check || fail "cargo fmt: run 'cargo fmt --all'"
@@ -30,12 +30,12 @@ step "energy behaviour of the nonlinear stepper (numbers quoted in README.md)"
 cargo run --release --example energy || fail "energy example"
 
 step "no_std builds for thumb targets"
-for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi; do
+for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi thumbv8m.main-none-eabihf; do
     cargo build --lib --release --target "$t" || fail "no_std build for $t"
 done
 cargo check --lib --target thumbv7em-none-eabihf --features defmt || fail "defmt feature"
 
-step "firmware on QEMU (Cortex-M4F): run every example, broken variants must fail, cost table"
+step "firmware on QEMU (Cortex-M4F; cost table across M0, M3, M4F, M7, M33): run every example, broken variants must fail, cost tables"
 bash scripts/qemu.sh || fail "firmware (scripts/qemu.sh)"
 
 step "docs: every quoted number from its generator (scripts/check_docs.py)"

@@ -72,10 +72,18 @@ unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
 // ---------------------------------------------------------------------------------------
 // Instruction counting
 
-/// Instructions per SysTick tick: QEMU's `-icount shift=0` makes one guest instruction
-/// 1 ns, and SysTick on the core clock counts at 25 MHz on mps2 boards (40 ns a tick).
-/// [`calibrate`] checks it at run time.
-pub const INSTRUCTIONS_PER_TICK: u32 = 40;
+/// Nanoseconds per SysTick tick, doubled (so that 62.5 is an integer): QEMU's `-icount
+/// shift=0` makes one guest instruction 1 ns, and SysTick on the core clock counts at the
+/// board's clock: 25 MHz on the mps2 boards (`mps2-an385`, `-an386`, `-an500`: 40 ns),
+/// 20 MHz on `mps2-an505` (50 ns), 16 MHz on `microbit` (62.5 ns). The board is chosen by
+/// `--cfg aemstep_board="…"` (`scripts/cores.sh`; unset: mps2). [`calibrate`] checks it
+/// at run time.
+#[cfg(not(any(aemstep_board = "microbit", aemstep_board = "an505")))]
+pub const TICK_NS_X2: u32 = 80;
+#[cfg(aemstep_board = "an505")]
+pub const TICK_NS_X2: u32 = 100;
+#[cfg(aemstep_board = "microbit")]
+pub const TICK_NS_X2: u32 = 125;
 
 /// SysTick as a free-running 24-bit down-counter on the core clock, interrupt off.
 pub fn start_counter(syst: &mut SYST) {
@@ -86,8 +94,9 @@ pub fn start_counter(syst: &mut SYST) {
     syst.enable_counter();
 }
 
-/// Instructions executed by `f` (SysTick ticks × 40, so ±40). Fails the run if the
-/// 24-bit counter wrapped (more than 671 million instructions). Needs [`start_counter`].
+/// Instructions executed by `f` (SysTick ticks × the tick's ns, so ± one tick). Fails the run if the
+/// 24-bit counter wrapped (more than 2^24 ticks: 671 million instructions on mps2). Needs
+/// [`start_counter`].
 #[inline(always)]
 pub fn instructions<F: FnOnce()>(syst: &mut SYST, f: F) -> u32 {
     let _ = syst.has_wrapped(); // clears COUNTFLAG
@@ -97,7 +106,7 @@ pub fn instructions<F: FnOnce()>(syst: &mut SYST, f: F) -> u32 {
     if syst.has_wrapped() && t1 >= t0 {
         exit_failure(format_args!("SysTick wrapped during a measurement"));
     }
-    (t0.wrapping_sub(t1) & 0x00FF_FFFF) * INSTRUCTIONS_PER_TICK
+    (t0.wrapping_sub(t1) & 0x00FF_FFFF) * TICK_NS_X2 / 2
 }
 
 /// Exactly 1000 instructions (and a call and return).
@@ -114,7 +123,7 @@ fn nops_1000() {
     }
 }
 
-/// Check [`INSTRUCTIONS_PER_TICK`]: 100 × 1000 `nop`s must measure as 100 000
+/// Check [`TICK_NS_X2`]: 100 × 1000 `nop`s must measure as 100 000
 /// instructions plus the loop and call overhead (≤ 10 a round). Fails the run otherwise
 /// (e.g. QEMU started without `-icount shift=0`). Returns the measured count.
 pub fn calibrate(syst: &mut SYST) -> u32 {
