@@ -66,6 +66,9 @@ pub enum Error {
     InvalidPeriod,
     /// A damping ratio is NaN or outside `[0, 1)` (`spectrum::Bank`).
     InvalidDamping,
+    /// A hysteretic law's parameter is not finite or is outside its documented range
+    /// (e.g. a yield force `≤ 0`, a post-yield ratio outside `[0, 1)`).
+    InvalidMaterial,
 }
 
 impl Error {
@@ -112,6 +115,7 @@ impl Error {
                 "a period is not finite and > 0, or the periods are not in non-decreasing order"
             }
             Error::InvalidDamping => "a damping ratio is NaN or outside [0, 1)",
+            Error::InvalidMaterial => "a hysteretic law parameter is not finite or out of range",
         }
     }
 }

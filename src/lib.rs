@@ -23,6 +23,9 @@
 //!   with a per-step [`NewtonReport`]; [`Varying`]: `M(t), C(t), K(t)` ([`TimeVarying`]).
 //! - Comparator schemes behind the same interface: [`Newmark`] (β, γ), [`GeneralizedAlpha`]
 //!   (ρ∞, HHT-α), [`Exact`] (matrix-exponential discretization, piecewise-linear load).
+//! - [`hysteresis`]: yielding structures — models with history committed only when a step
+//!   succeeds ([`hysteresis::HistoryModel`]), bilinear, Bouc–Wen and friction laws, a
+//!   hysteretic shear building.
 //! - [`analysis`]: amplification matrix, spectral radius, period elongation and amplitude
 //!   decay of any scheme on the 1-DOF oscillator.
 //! - [`spectrum`]: response spectra: a bank of damped oscillators fed one
@@ -67,6 +70,7 @@ mod nonlinear;
 
 // Modal reduction, stability analysis, ready-made models.
 pub mod analysis;
+pub mod hysteresis;
 pub mod modal;
 pub mod models;
 

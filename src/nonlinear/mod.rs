@@ -24,6 +24,7 @@ use core::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::hysteresis::{HistoryModel, Trial};
 use crate::kinematics::{AemKinematics, Kinematics};
 use crate::linalg::lu::{solve_in_place, solve_in_place_scaled};
 use crate::scalar::initial_inputs_finite;
@@ -144,6 +145,13 @@ pub struct NewtonReport<T> {
     pub correction: T,
     /// `residual ≤ tolerance` or (`iterations ≥ 1` and `correction ≤ tolerance`).
     pub converged: bool,
+    /// How many times the active branch of a [`HistoryModel`] changed between successive
+    /// iterates (its [`Trial::branch`] differed from the previous iterate's), e.g. a storey
+    /// that yielded at one iterate and unloaded elastically at the next. Newton converges
+    /// quadratically only once the branch has settled; a change in the last iterations of
+    /// a fixed-iteration step says the iteration was still choosing the branch. Always `0`
+    /// for a memoryless [`Model`] (one branch).
+    pub branch_changes: u32,
 }
 
 /// The nonlinear AEM stepper for `M u'' + F(u, u') = p(t)` (paper Algorithm 2) with `N`
@@ -153,6 +161,12 @@ pub struct NewtonReport<T> {
 /// step that fails (no convergence, singular `J`, non-finite force or load) returns an
 /// [`Error`] and leaves the caller's [`State`] bit-identical; [`Nonlinear::trial_step`]
 /// gives the unconverged candidate when the caller wants to decide itself.
+///
+/// Models with history (yielding storeys, hysteretic devices:
+/// [`HistoryModel`](crate::hysteresis::HistoryModel)) step with
+/// [`Nonlinear::try_step_with_history`]: the same Newton iteration, every trial evaluated
+/// from the history committed at `t_{n−1}`, and state and history committed together only
+/// when the step succeeds.
 ///
 /// Each step solves, by Newton's method from the predictor `q_{n−1}`,
 ///
@@ -252,6 +266,24 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         v0: &SVector<T, N>,
         p0: &SVector<T, N>,
     ) -> Result<State<T, N>, Error> {
+        self.start_with_history(&Memoryless(model), u0, v0, p0, &())
+            .map(|(s, ())| s)
+    }
+
+    /// The state at `t = 0` of a model with history, with `q0 = M⁻¹ (p0 − F(u0, v0))`,
+    /// `F` the model's trial force at `(u0, v0)` from `history0` (e.g.
+    /// [`HistoryModel::initial_history`], the virgin material). Returns the state and the
+    /// history to step from: the trial history at `(u0, v0)`, committed.
+    ///
+    /// Errors: as [`Nonlinear::start`]. Cost: one trial evaluation and one `N×N` LU solve.
+    pub fn start_with_history<Mo: HistoryModel<T, N> + ?Sized>(
+        &self,
+        model: &Mo,
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        p0: &SVector<T, N>,
+        history0: &Mo::History,
+    ) -> Result<(State<T, N>, Mo::History), Error> {
         if !initial_inputs_finite(u0, v0, p0) {
             return Err(Error::NonFiniteInput);
         }
@@ -259,14 +291,17 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         if !m.iter().all(|x| x.is_finite()) {
             return Err(Error::NonFiniteInput);
         }
-        let f = model.force(u0, v0);
-        if !all_finite(&f) {
+        let trial = model.trial(history0, u0, v0);
+        if !all_finite(&trial.force) {
             return Err(Error::NonFiniteForce);
         }
-        initial_from_equation(u0, v0, &m, p0 - f)
+        let state = initial_from_equation(u0, v0, &m, p0 - trial.force)?;
+        Ok((state, trial.history))
     }
 
     /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M`).
+    /// A model with history starts from its history as given (e.g.
+    /// [`HistoryModel::initial_history`]).
     ///
     /// Errors: [`Error::NonFiniteInput`]. Cost: O(N).
     pub fn start_with_acceleration(
@@ -295,12 +330,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         state: &mut State<T, N>,
         p: &SVector<T, N>,
     ) -> Result<NewtonReport<T>, Error> {
-        let (next, report) = self.trial_step(model, state, p)?;
-        if !report.converged {
-            return Err(Error::NotConverged);
-        }
-        *state = next;
-        Ok(report)
+        self.try_step_with_history(&Memoryless(model), state, &mut (), p)
     }
 
     /// The candidate next state and its Newton report, without touching `state` — even
@@ -314,6 +344,61 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         state: &State<T, N>,
         p: &SVector<T, N>,
     ) -> Result<(State<T, N>, NewtonReport<T>), Error> {
+        self.newton(&Memoryless(model), &(), state, p)
+            .map(|(next, (), report)| (next, report))
+    }
+
+    /// [`Nonlinear::try_step`] for a model with history: advance `state` and commit
+    /// `history` together, only when the step converged to a finite state. The committed
+    /// history is the model's trial history at the accepted `(u_n, v_n)`, evaluated from
+    /// the history committed at `t_{n−1}` — every Newton iterate starts from that same
+    /// committed history, so a rejected iterate leaves no trace.
+    ///
+    /// Errors: as [`Nonlinear::try_step`]; on every error both `state` and `history` are
+    /// left bit-identical. Cost: as a step, with one [`HistoryModel::trial`] per force
+    /// evaluation and one [`HistoryModel::tangent`] per Newton iteration.
+    pub fn try_step_with_history<Mo: HistoryModel<T, N> + ?Sized>(
+        &self,
+        model: &Mo,
+        state: &mut State<T, N>,
+        history: &mut Mo::History,
+        p: &SVector<T, N>,
+    ) -> Result<NewtonReport<T>, Error> {
+        let (next, next_history, report) = self.newton(model, history, state, p)?;
+        if !report.converged {
+            return Err(Error::NotConverged);
+        }
+        *state = next;
+        *history = next_history;
+        Ok(report)
+    }
+
+    /// [`Nonlinear::trial_step`] for a model with history: the candidate next state, the
+    /// history that accepting it would commit, and the Newton report, without touching
+    /// `state` or `history` (commit both yourself to accept an unconverged candidate).
+    ///
+    /// Errors: as [`Nonlinear::try_step_with_history`] except [`Error::NotConverged`].
+    /// Cost: as a step.
+    pub fn trial_step_with_history<Mo: HistoryModel<T, N> + ?Sized>(
+        &self,
+        model: &Mo,
+        state: &State<T, N>,
+        history: &Mo::History,
+        p: &SVector<T, N>,
+    ) -> Result<Candidate<T, N, Mo::History>, Error> {
+        self.newton(model, history, state, p)
+    }
+
+    /// The one Newton iteration of every nonlinear step (memoryless models through
+    /// [`Memoryless`], `History = ()`): from the predictor `q_{n−1}`, every trial from the
+    /// `committed` history. Returns the last iterate, its trial history and the report.
+    fn newton<Mo: HistoryModel<T, N> + ?Sized>(
+        &self,
+        model: &Mo,
+        committed: &Mo::History,
+        state: &State<T, N>,
+        p: &SVector<T, N>,
+    ) -> Result<Candidate<T, N, Mo::History>, Error> {
         if !all_finite(p) {
             return Err(Error::NonFiniteInput);
         }
@@ -331,12 +416,22 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         let mut q = state.a;
         let mut iterations = 0u32;
         let mut last_delta = T::zero();
+        let mut branch_changes = 0u32;
+        let mut last_branch = 0u64;
         loop {
             let (v, u) = self.kin.correct_all(&vh, &uh, &q);
-            let f = model.force(&u, &v);
+            let Trial {
+                force: f,
+                history,
+                branch,
+            } = model.trial(committed, &u, &v);
             if !all_finite(&f) {
                 return Err(Error::NonFiniteForce);
             }
+            if iterations > 0 && branch != last_branch {
+                branch_changes += 1;
+            }
+            last_branch = branch;
             let mq = m * q;
             let r = mq + f - p;
             let residual = relative_residual(&r, &mq, &f, p);
@@ -364,11 +459,12 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
                     residual,
                     correction,
                     converged,
+                    branch_changes,
                 };
-                return Ok((next, report));
+                return Ok((next, history, report));
             }
             // J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u, with an entry scale for the pivot test.
-            let (mut j, scale) = match model.tangent(&u, &v) {
+            let (mut j, scale) = match model.tangent(committed, &u, &v) {
                 Some(t) => {
                     if !t
                         .stiffness
@@ -388,7 +484,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
                         });
                     (j, scale)
                 }
-                None => finite_difference_jacobian(model, &m, &u, &v, &f, b, c)?,
+                None => finite_difference_jacobian(model, committed, &m, &u, &v, &f, b, c)?,
             };
             let mut delta = r;
             if !solve_in_place(&mut j, &mut delta, scale) {
@@ -398,6 +494,41 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
             last_delta = norm_inf(&delta);
             iterations += 1;
         }
+    }
+}
+
+/// A candidate step of a model with history: the state, the history accepting it would
+/// commit, and the Newton report.
+type Candidate<T, const N: usize, H> = (State<T, N>, H, NewtonReport<T>);
+
+/// A memoryless [`Model`] as a [`HistoryModel`] with `History = ()` and one branch: how
+/// [`Nonlinear::start`], [`Nonlinear::try_step`] and [`Nonlinear::trial_step`] share the
+/// Newton iteration of the models with history.
+struct Memoryless<'a, Mo: ?Sized>(&'a Mo);
+
+impl<T: Real, const N: usize, Mo: Model<T, N> + ?Sized> HistoryModel<T, N> for Memoryless<'_, Mo> {
+    type History = ();
+
+    #[inline(always)]
+    fn initial_history(&self) {}
+
+    #[inline(always)]
+    fn mass(&self) -> SMatrix<T, N, N> {
+        self.0.mass()
+    }
+
+    #[inline(always)]
+    fn trial(&self, _: &(), u: &SVector<T, N>, v: &SVector<T, N>) -> Trial<T, N, ()> {
+        Trial {
+            force: self.0.force(u, v),
+            history: (),
+            branch: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn tangent(&self, _: &(), u: &SVector<T, N>, v: &SVector<T, N>) -> Option<Tangent<T, N>> {
+        self.0.tangent(u, v)
     }
 }
 
@@ -426,8 +557,10 @@ fn relative_residual<T: Real, const N: usize>(
 
 /// `J = M + ∂F(û + c q, v̂ + b q)/∂q` by one forward difference per column (`N` force
 /// evaluations), and the entry scale `max |M_ij| + |(J − M)_ij|` for the pivot test.
-fn finite_difference_jacobian<T: Real, const N: usize, Mo: Model<T, N> + ?Sized>(
+#[allow(clippy::too_many_arguments)]
+fn finite_difference_jacobian<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>(
     model: &Mo,
+    committed: &Mo::History,
     m: &SMatrix<T, N, N>,
     u: &SVector<T, N>,
     v: &SVector<T, N>,
@@ -451,7 +584,7 @@ fn finite_difference_jacobian<T: Real, const N: usize, Mo: Model<T, N> + ?Sized>
         let (mut up, mut vp) = (*u, *v);
         up.data.0[0][col] = shifted;
         vp.data.0[0][col] = vj + b * delta;
-        let fp = model.force(&up, &vp);
+        let fp = model.trial(committed, &up, &vp).force;
         if !all_finite(&fp) {
             return Err(Error::NonFiniteForce);
         }

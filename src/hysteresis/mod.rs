@@ -1,0 +1,151 @@
+//! Hysteretic structures: nonlinear models whose force depends on the load path, with
+//! fixed-size history committed only when a step succeeds.
+//!
+//! A [`HistoryModel`] gives the internal force at a *trial* displacement and velocity from
+//! the history *committed* at the start of the step, together with the history that
+//! accepting that trial would commit. It never mutates anything: the history is plain data
+//! (`Copy`) held by the caller beside the [`State`](crate::State), and
+//! [`Nonlinear::try_step_with_history`](crate::Nonlinear::try_step_with_history) assigns
+//! both only when the step has converged to a finite state. A failed or refused step
+//! therefore leaves state and history bit-identical — there is nothing to revert.
+//! (Solvers that keep the trial state inside each material need `commit`/`revert` calls
+//! for this; here the commit is the assignment of the accepted trial.)
+//!
+//! The built-in uniaxial [`Law`]s, each with its consistent (algorithmic) tangent:
+//!
+//! - [`Bilinear`]: elastic–plastic with linear kinematic hardening, by return mapping.
+//! - [`BoucWen`]: smooth hysteresis; the internal variable `z` integrated over the step by
+//!   the trapezoidal rule in the deformation (second order), solved by a scalar Newton
+//!   inside the law.
+//! - [`Friction`]: Coulomb friction regularized in the velocity, `f = f_s tanh(v / v_r)`.
+//!
+//! [`ShearBuilding`] assembles `N` storeys of one law type with linear damping into a
+//! [`HistoryModel`] for the [`Nonlinear`](crate::Nonlinear) stepper.
+//!
+//! Equations, measured accuracy and the commands that produce each figure:
+//! `docs/hysteresis.md`.
+
+mod bilinear;
+mod bouc_wen;
+mod building;
+mod friction;
+
+pub use bilinear::{Bilinear, BilinearHistory};
+pub use bouc_wen::{BoucWen, BoucWenHistory};
+pub use building::ShearBuilding;
+pub use friction::Friction;
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::{Real, Tangent};
+
+/// The force of a [`HistoryModel`] at a trial `(u, v)` and the history that accepting it
+/// would commit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Trial<T, const N: usize, H> {
+    /// The internal force `F(u, v; history)` (force units), `N` entries.
+    pub force: SVector<T, N>,
+    /// The history after a step ending at this `(u, v)`: what the stepper commits if the
+    /// step is accepted.
+    pub history: H,
+    /// A signature of the active branch (e.g. bit `i` set when storey `i` is on an
+    /// inelastic branch). The stepper counts how often it changes between Newton iterates
+    /// ([`NewtonReport::branch_changes`](crate::NewtonReport::branch_changes)); its value
+    /// has no other meaning. `0` for a model with one branch.
+    pub branch: u64,
+}
+
+/// A structural model `M u'' + F(u, u'; history) = p(t)` whose internal force depends on
+/// the load path through a fixed-size history, for
+/// [`Nonlinear::try_step_with_history`](crate::Nonlinear::try_step_with_history).
+///
+/// Both [`HistoryModel::trial`] and [`HistoryModel::tangent`] are pure functions of the
+/// *committed* history (the one at the start of the step) and the trial `(u, v)`: Newton
+/// may evaluate any number of trials in any order, and only the stepper decides what is
+/// committed. A memoryless [`Model`](crate::Model) is the special case `History = ()`
+/// (that is how the stepper runs it).
+///
+/// Methods must not panic; a NaN or infinite force or tangent is reported as
+/// [`Error::NonFiniteForce`](crate::Error::NonFiniteForce) and the step is not taken.
+pub trait HistoryModel<T: Real, const N: usize> {
+    /// The internal variables (plastic deformations, hysteretic variables, …): plain,
+    /// fixed-size data.
+    type History: Copy;
+
+    /// The history of the virgin structure (nothing has yielded). Cost: O(N).
+    fn initial_history(&self) -> Self::History;
+
+    /// The constant mass matrix `M` (`N×N`). Called once per step and once per start.
+    fn mass(&self) -> SMatrix<T, N, N>;
+
+    /// The force at the trial `(u, v)` from the `committed` history, and the trial
+    /// history.
+    fn trial(
+        &self,
+        committed: &Self::History,
+        u: &SVector<T, N>,
+        v: &SVector<T, N>,
+    ) -> Trial<T, N, Self::History>;
+
+    /// The consistent tangent `∂F/∂u`, `∂F/∂v` of [`HistoryModel::trial`]'s force at
+    /// `(u, v)` (the derivative of the discrete update, not of the continuous law), or
+    /// `None` (the default) for finite differences of `trial` (`N` extra trials per Newton
+    /// iteration; see [`Model::tangent`](crate::Model::tangent)).
+    fn tangent(
+        &self,
+        _committed: &Self::History,
+        _u: &SVector<T, N>,
+        _v: &SVector<T, N>,
+    ) -> Option<Tangent<T, N>> {
+        None
+    }
+}
+
+/// One uniaxial law's response at a trial deformation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LawTrial<T, H> {
+    /// The force `f` (force units).
+    pub force: T,
+    /// The consistent tangent stiffness `∂f/∂d` of the discrete update (force per
+    /// deformation).
+    pub stiffness: T,
+    /// The tangent damping `∂f/∂ḋ` (force per deformation rate).
+    pub damping: T,
+    /// The history a step ending at this trial commits.
+    pub history: H,
+    /// On an inelastic branch (yielding, loading branch of the hysteresis, sliding).
+    pub inelastic: bool,
+}
+
+/// A uniaxial hysteretic law `f(d, ḋ; history)`: a storey spring or a device, with
+/// deformation `d` and deformation rate `ḋ`.
+///
+/// Like [`HistoryModel`], a law evaluates a trial from the committed history and never
+/// mutates; to drive one under a prescribed deformation (a test, a material calibration),
+/// keep `trial.history` of each accepted step as the next committed history.
+pub trait Law<T: Real> {
+    /// The internal variables, plain data.
+    type History: Copy + PartialEq + core::fmt::Debug;
+
+    /// The virgin history (zero deformation, nothing yielded). Cost: O(1).
+    fn initial_history(&self) -> Self::History;
+
+    /// Force, consistent tangent and trial history at deformation `d` and rate `rate`
+    /// from the `committed` history (the one at the start of the step).
+    fn trial(&self, committed: &Self::History, d: T, rate: T) -> LawTrial<T, Self::History>;
+
+    /// The strain energy recoverable by elastic unloading to zero internal force, at the
+    /// committed `history` and deformation `d` (energy units). What the law has absorbed
+    /// beyond it (work `∫ f dd` minus this) is the hysteretic energy.
+    fn recoverable_energy(&self, history: &Self::History, d: T) -> T;
+}
+
+/// `x` finite and `> 0`.
+pub(crate) fn positive(x: f64) -> bool {
+    x.is_finite() && x > 0.0
+}
+
+/// `x` finite and in `[0, 1)`.
+pub(crate) fn unit_ratio(x: f64) -> bool {
+    x.is_finite() && (0.0..1.0).contains(&x)
+}
