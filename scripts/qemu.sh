@@ -15,11 +15,12 @@ cd "$(dirname "$0")/.."
 TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
-EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum)
+EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum qemu_hysteretic)
 # Broken on purpose: "example variant" pairs that must exit with failure (status 1); the
 # variant is `--cfg aemstep_broken="<variant>"` (not a public feature, see Cargo.toml).
 BROKEN=("qemu_timer inject-nan" "qemu_timer tight-bound" "qemu_nonlinear inject-nan"
-    "qemu_modal modal-tight-bound" "qemu_schemes inject-nan" "qemu_spectrum spectrum-tight-bound")
+    "qemu_modal modal-tight-bound" "qemu_schemes inject-nan" "qemu_spectrum spectrum-tight-bound"
+    "qemu_hysteretic hysteretic-tight-bound")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
 TARGET_DIR=${CARGO_TARGET_DIR:-target}
 OUT=$TARGET_DIR/qemu
@@ -288,6 +289,17 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "| bank | instructions / sample | multiply-adds |"
     echo "|---|---:|---:|"
     grep '^COST spectrum' "$OUT/qemu_spectrum-qemu.log" | while read -r _ what instr madds; do echo "| \`$what\` | $instr | $madds |"; done
+    echo
+    echo "## A yielding building (\`examples/qemu_hysteretic.rs\`)"
+    echo
+    echo "The 3-storey building with bilinear storeys under El Centro, \`Nonlinear<f32, 3>\` with exactly 3"
+    echo "Newton iterations a step, storey histories committed with each step; over the 3994 steps of the record."
+    echo
+    echo "| model | instructions / step (mean) | instructions / step (max) |"
+    echo "|---|---:|---:|"
+    grep '^COST ' "$OUT/qemu_hysteretic-qemu.log" | while read -r _ what mean max; do
+        echo "| \`$what\` | $mean | $max |"
+    done
     echo
     echo "## Footprint (\`examples/qemu_footprint.rs\`)"
     echo

@@ -615,6 +615,7 @@ fn runs() -> &'static Runs {
 fn building_constants_are_the_closed_form() {
     let (w1, w2) = building::elastic_frequencies();
     let root = (building::STIFFNESS / building::MASS).sqrt();
+    assert_eq!(building::ROOT, root);
     assert!((w1 - 2.0 * root * (PI / 14.0).sin()).abs() <= 4.0 * EPS * w1);
     assert!((w2 - 2.0 * root * (3.0 * PI / 14.0).sin()).abs() <= 4.0 * EPS * w2);
 }

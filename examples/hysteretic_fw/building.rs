@@ -27,23 +27,14 @@ pub const GAMMA: f64 = 0.5;
 /// See [`BETA`].
 pub const EXPONENT: f64 = 2.0;
 
+/// `√(k/m)` (rad/s), written out (no `sqrt` in `core`); checked in tests/hysteresis.rs.
+pub const ROOT: f64 = 31.622_776_601_683_793;
+/// `sin(π/14)` and `sin(3π/14)`, written out; checked in tests/hysteresis.rs.
+pub const SINES: (f64, f64) = (0.222_520_933_956_314_4, 0.623_489_801_858_733_5);
+
 /// Elastic circular frequencies of modes 1 and 2 (rad/s): `2 √(k/m) sin((2r − 1)π/14)`.
 pub fn elastic_frequencies() -> (f64, f64) {
-    let root = (STIFFNESS / MASS).sqrt();
-    let pi = core::f64::consts::PI;
-    (
-        2.0 * root * libm_sin(pi / 14.0),
-        2.0 * root * libm_sin(3.0 * pi / 14.0),
-    )
-}
-
-// sin(π/14), sin(3π/14) written out (no `sin` in `core`); checked in tests/hysteresis.rs.
-fn libm_sin(x: f64) -> f64 {
-    if x < 0.3 {
-        0.222_520_933_956_314_4
-    } else {
-        0.623_489_801_858_733_5
-    }
+    (2.0 * ROOT * SINES.0, 2.0 * ROOT * SINES.1)
 }
 
 /// The Rayleigh damping matrix (N·s/m) of the elastic building.
