@@ -667,6 +667,25 @@ fn el_centro_energy_balance_closes_at_order_2() {
 }
 
 #[test]
+fn docs_quote_the_building_tables_as_computed() {
+    // The rows of docs/hysteresis.md (written by `cargo run --release --example
+    // hysteresis_report`) at h = 2.5 ms and 1.25 ms are fully determined by the runs here:
+    // they must appear verbatim, so a quoted figure cannot drift from the code.
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/hysteresis.md"))
+        .unwrap();
+    let runs = runs();
+    for rs in [&runs.bilinear, &runs.bouc_wen] {
+        let table = hyst::table(&RS, rs);
+        for row in &table[4..] {
+            assert!(
+                doc.lines().any(|l| l == row),
+                "docs/hysteresis.md lacks the row\n{row}"
+            );
+        }
+    }
+}
+
+#[test]
 fn bouc_wen_building_converges_at_order_2_and_bilinear_order_is_stated() {
     let runs = runs();
     for (name, rs, lo, hi) in [

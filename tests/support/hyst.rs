@@ -152,3 +152,38 @@ pub fn rms_diff(a: &Run, b: &Run) -> f64 {
             .fold((0.0, 0usize), |(s, n), e| (s + e, n + 1));
     (s / n as f64).sqrt()
 }
+
+/// The markdown table of `docs/hysteresis.md` for runs at `h = DT / rs[j]`: the header,
+/// the separator, then one row per run. A row's orders use the two runs before it, so the
+/// rows from the third on are fully determined by runs at halving steps.
+pub fn table(rs: &[u64], runs: &[Run]) -> Vec<String> {
+    let mut out = vec![
+        "| h (s) | closure / max E_in | order | RMS ‖u_h − u_2h‖ (m) | order | Newton iterations / step | branch changes | max ductility | E_h / E_in | E_v / E_in |".to_string(),
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|".to_string(),
+    ];
+    let order = |a: f64, b: f64| format!("{:.2}", (a / b).log2());
+    for (j, run) in runs.iter().enumerate() {
+        let h = super::elcentro::DT / rs[j] as f64;
+        let c_order = if j > 0 {
+            order(runs[j - 1].closure, run.closure)
+        } else {
+            "—".into()
+        };
+        let diff = (j > 0).then(|| rms_diff(&runs[j - 1], run));
+        let d_order = match diff {
+            Some(d) if j > 1 => order(rms_diff(&runs[j - 2], &runs[j - 1]), d),
+            _ => "—".into(),
+        };
+        out.push(format!(
+            "| {h} | {:.2e} | {c_order} | {} | {d_order} | {:.2} | {} | {:.2} | {:.3} | {:.3} |",
+            run.closure,
+            diff.map_or("—".into(), |d| format!("{d:.2e}")),
+            run.newton_iterations as f64 / run.steps as f64,
+            run.branch_changes,
+            run.ductility,
+            run.hysteretic / run.input,
+            run.viscous / run.input,
+        ));
+    }
+    out
+}
