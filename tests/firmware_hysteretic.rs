@@ -66,9 +66,8 @@ fn roof<T: Real>(settings: NewtonSettings<T>, ag: &[T]) -> (Vec<f64>, f64, usize
         (s, h) = (next, hist);
         out.push(s.u()[2].as_f64());
         let d = [s.u()[0], s.u()[1] - s.u()[0], s.u()[2] - s.u()[1]];
-        for i in 0..3 {
-            ductility =
-                ductility.max(d[i].as_f64().abs() * building::STIFFNESS / building::YIELD[i]);
+        for (di, fy) in d.iter().zip(building::YIELD) {
+            ductility = ductility.max(di.as_f64().abs() * building::STIFFNESS / fy);
         }
     }
     (out, ductility, unconverged)
