@@ -100,10 +100,10 @@ fn main() -> ! {
     let (mut total, mut worst_cost) = (0u64, 0u32);
     let (mut max_err, mut yielded, mut branch_changes) = (0.0f64, false, 0u32);
     let mut last = 0.0f32;
-    for n in 1..elcentro::SAMPLES {
+    for (n, &a) in ag.iter().enumerate().skip(1) {
         let mut result = Err(Error::NonFiniteInput);
         let c = fw::instructions(syst, || {
-            result = qemu_hysteretic_step(&stepper, &building, &mut s, &mut history, ag[n]);
+            result = qemu_hysteretic_step(&stepper, &building, &mut s, &mut history, a);
         });
         let report = match result {
             Ok(r) => r,

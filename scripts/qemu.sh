@@ -190,6 +190,14 @@ target_bits=$(sed -n 's/^target roof drift f32 bits = //p' "$OUT/qemu_modal-qemu
     fail "roof drift: host '$host_bits', target '$target_bits'"
 echo "ok: both $host_bits"
 
+step "qemu: host and Cortex-M4F f32 runs are bit-identical (yielding building, roof at 79.9 s)"
+host_bits=$(cargo test -q --release --test firmware_hysteretic -- --nocapture 2>&1 |
+    sed -n 's/^host roof displacement f32 bits = //p')
+target_bits=$(sed -n 's/^target roof displacement f32 bits = //p' "$OUT/qemu_hysteretic-qemu.log")
+[[ -n $host_bits && $host_bits == "$target_bits" ]] ||
+    fail "hysteretic roof: host '$host_bits', target '$target_bits'"
+echo "ok: both $host_bits"
+
 step "qemu: footprint: a firmware pays only for the capabilities it uses"
 # qemu_footprint uses only Linear<f32, 5>; with control "footprint-modal" also a compile-time
 # Modal<f32, 5, 2>; with "footprint-all" also the nonlinear stepper and a Modal built at
