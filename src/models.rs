@@ -1,7 +1,10 @@
 //! Ready-made structural models: builders for `M`, `K`, `C` as row-major `f64` arrays,
 //! usable in `const` contexts (so firmware can build operators from them at compile time).
 //!
-//! The benchmark building of this repository's tables is [`five_storey_building`].
+//! The benchmark building of this repository's tables is [`five_storey_building`]. A
+//! shear building whose storeys yield (bilinear, Bouc–Wen or friction storeys with linear
+//! damping, for the nonlinear stepper) is
+//! [`hysteresis::ShearBuilding`](crate::hysteresis::ShearBuilding).
 
 pub use crate::linalg::Rows;
 
