@@ -109,6 +109,7 @@ GENERATED = {
             "",
         ),
     ),
+    "docs/hysteresis_figures.md": dict(cmd=example("hysteresis_report"), out="stdout"),
 }
 # Generated in place by a slower stage of the test command: compared with the git index.
 IN_PLACE = {

@@ -16,12 +16,14 @@
 mod building;
 #[path = "../examples/modal_fw/elcentro.rs"]
 mod elcentro;
+#[path = "support/hyst.rs"]
+mod hyst;
 #[path = "../examples/hysteretic_fw/reference.rs"]
 mod reference;
 
-use aemstep::hysteresis::HistoryModel;
-use aemstep::nalgebra::SVector;
-use aemstep::{NewtonSettings, Nonlinear, Real};
+use hyst::roof;
+
+use aemstep::NewtonSettings;
 
 /// Every how many steps the reference keeps a sample (0.2 s).
 const EVERY: usize = 10;
@@ -43,35 +45,6 @@ const BOUND: f64 = 1e-7;
 /// Independent of the measurement: f32 firmware must track the f64 model to 1e-5 of the
 /// peak roof displacement (far below any engineering tolerance on drift).
 const ENGINEERING: f64 = 1e-5;
-
-/// Roof displacement at every step, the largest storey ductility, and how many steps did
-/// not converge within the settings.
-fn roof<T: Real>(settings: NewtonSettings<T>, ag: &[T]) -> (Vec<f64>, f64, usize) {
-    let b = building::bilinear::<T>().unwrap();
-    let stepper = Nonlinear::<T, 3>::new(elcentro::DT, settings).unwrap();
-    let z = SVector::zeros();
-    let (mut s, mut h) = stepper
-        .start_with_history(&b, &z, &z, &b.ground_load(ag[0]), &b.initial_history())
-        .unwrap();
-    let mut out = vec![0.0];
-    let mut unconverged = 0;
-    let mut ductility: f64 = 0.0;
-    for &a in &ag[1..] {
-        let (next, hist, report) = stepper
-            .trial_step_with_history(&b, &s, &h, &b.ground_load(a))
-            .unwrap();
-        if !report.converged {
-            unconverged += 1;
-        }
-        (s, h) = (next, hist);
-        out.push(s.u()[2].as_f64());
-        let d = [s.u()[0], s.u()[1] - s.u()[0], s.u()[2] - s.u()[1]];
-        for (di, fy) in d.iter().zip(building::YIELD) {
-            ductility = ductility.max(di.as_f64().abs() * building::STIFFNESS / fy);
-        }
-    }
-    (out, ductility, unconverged)
-}
 
 fn generate(full: &[f64]) -> String {
     let mut s = String::new();

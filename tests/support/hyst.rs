@@ -6,7 +6,7 @@
 
 use aemstep::hysteresis::{HistoryModel, Law, ShearBuilding};
 use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::{NewtonSettings, Nonlinear};
+use aemstep::{NewtonSettings, Nonlinear, Real};
 
 use super::elcentro;
 
@@ -186,4 +186,33 @@ pub fn table(rs: &[u64], runs: &[Run]) -> Vec<String> {
         ));
     }
     out
+}
+
+/// Roof displacement at every step, the largest storey ductility, and how many steps did
+/// not converge within the settings.
+pub fn roof<T: Real>(settings: NewtonSettings<T>, ag: &[T]) -> (Vec<f64>, f64, usize) {
+    let b = super::building::bilinear::<T>().unwrap();
+    let stepper = Nonlinear::<T, 3>::new(super::elcentro::DT, settings).unwrap();
+    let z = SVector::zeros();
+    let (mut s, mut h) = stepper
+        .start_with_history(&b, &z, &z, &b.ground_load(ag[0]), &b.initial_history())
+        .unwrap();
+    let mut out = vec![0.0];
+    let mut unconverged = 0;
+    let mut ductility: f64 = 0.0;
+    for &a in &ag[1..] {
+        let (next, hist, report) = stepper
+            .trial_step_with_history(&b, &s, &h, &b.ground_load(a))
+            .unwrap();
+        if !report.converged {
+            unconverged += 1;
+        }
+        (s, h) = (next, hist);
+        out.push(s.u()[2].as_f64());
+        let d = [s.u()[0], s.u()[1] - s.u()[0], s.u()[2] - s.u()[1]];
+        for (di, fy) in d.iter().zip(super::building::YIELD) {
+            ductility = ductility.max(di.as_f64().abs() * super::building::STIFFNESS / fy);
+        }
+    }
+    (out, ductility, unconverged)
 }
