@@ -63,22 +63,23 @@ impl<T: Real> Bilinear<T> {
         })
     }
 
-    /// The elastic stiffness `k`.
+    /// The elastic stiffness `k` (force/deformation). Cost: O(1).
     pub fn stiffness(&self) -> T {
         self.k
     }
 
-    /// The yield force `f_y`.
+    /// The yield force `f_y` (force). Cost: O(1).
     pub fn yield_force(&self) -> T {
         self.fy
     }
 
-    /// The post-yield (tangent) stiffness `α k`.
+    /// The post-yield (tangent) stiffness `α k` (force/deformation). Cost: O(1).
     pub fn post_yield_stiffness(&self) -> T {
         self.kt
     }
 
-    /// The hardening modulus `H = α k/(1 − α)` (the back force is `H d_p`).
+    /// The hardening modulus `H = α k/(1 − α)` (force/deformation; the back force is
+    /// `H d_p`). Cost: O(1).
     pub fn hardening(&self) -> T {
         self.hard
     }

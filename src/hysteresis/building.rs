@@ -78,12 +78,12 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
         })
     }
 
-    /// The storey laws, ground storey first.
+    /// The storey laws, ground storey first. Cost: O(1).
     pub fn laws(&self) -> &[L; N] {
         &self.laws
     }
 
-    /// The damping matrix `C`.
+    /// The damping matrix `C` (N·s/m). Cost: O(1).
     pub fn damping(&self) -> &SMatrix<T, N, N> {
         &self.damping
     }

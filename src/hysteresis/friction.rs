@@ -39,7 +39,7 @@ impl<T: Real> Friction<T> {
         })
     }
 
-    /// The slip force `f_s`.
+    /// The slip force `f_s` (force). Cost: O(1).
     pub fn slip_force(&self) -> T {
         self.fs
     }
