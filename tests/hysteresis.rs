@@ -21,7 +21,7 @@ use std::f64::consts::PI;
 use std::sync::OnceLock;
 
 use aemstep::hysteresis::{
-    Bilinear, BilinearHistory, BoucWen, Friction, HistoryModel, Law, ShearBuilding, Trial,
+    Bilinear, BilinearHistory, BoucWen, Friction, HistoryModel, Law, Parallel, ShearBuilding, Trial,
 };
 use aemstep::nalgebra::{SMatrix, SVector, Vector3};
 use aemstep::{Error, Linear, NewtonSettings, Nonlinear, State, Stepper, Tangent, models};
@@ -807,4 +807,106 @@ fn branch_changes_are_reported_and_fixed_iterations_stay_available() {
             .unwrap();
         assert_eq!(rep.branch_changes, 0);
     }
+}
+
+#[test]
+fn friction_damped_building_steps_and_converges() {
+    // Each storey: the bilinear frame with a friction damper across it slipping at 10 % of
+    // the frame's yield force, v_r = 1 cm/s.
+    let law = |i: usize| {
+        Parallel(
+            Bilinear::<f64>::new(building::STIFFNESS, building::YIELD[i], building::ALPHA).unwrap(),
+            Friction::<f64>::new(0.1 * building::YIELD[i], 1e-2).unwrap(),
+        )
+    };
+    let b = ShearBuilding::new(
+        [building::MASS; 3],
+        [law(0), law(1), law(2)],
+        &building::damping(),
+    )
+    .unwrap();
+    let yd = [uy(0), uy(1), uy(2)];
+    let runs: Vec<hyst::Run> = RS
+        .iter()
+        .map(|&r| {
+            hyst::run(
+                &b,
+                r,
+                NewtonSettings::up_to(30, TOL),
+                yd,
+                |_, _, _, _, _| 0.0,
+                |_, _| 0.0,
+            )
+        })
+        .collect();
+    let diffs: Vec<f64> = runs
+        .windows(2)
+        .map(|w| hyst::rms_diff(&w[0], &w[1]))
+        .collect();
+    let iterations: Vec<f64> = runs
+        .iter()
+        .map(|r| r.newton_iterations as f64 / r.steps as f64)
+        .collect();
+    println!(
+        "friction-damped building: RMS |u_h − u_h/2| {diffs:?}, orders {:?}, Newton iterations a step {iterations:?}, ductility {}",
+        laws::orders(&diffs),
+        runs[0].ductility
+    );
+    // Smooth regularized friction with its consistent (damping) tangent: second order
+    // (measured 2.23, 2.21, pre-asymptotic), Newton in ≤ 3 iterations a step on average
+    // (measured 2.52 at h = 0.01 s, 1.97 at 1.25 ms).
+    for o in laws::orders(&diffs) {
+        assert!((1.8..=2.4).contains(&o), "{diffs:?}");
+    }
+    assert!(iterations.iter().all(|&k| k <= 3.0), "{iterations:?}");
+    // The dampers take load off the frames: a smaller peak ductility than the bare
+    // bilinear building (measured 4.97 against 5.65).
+    assert!(runs[0].ductility < self::runs().bilinear[0].ductility - 0.3);
+
+    // A sharper regularization (v_r = 1 mm/s) at h = 0.01 s puts (h/2) f_s/v_r = 3 M on the
+    // Newton matrix and Newton, bouncing on the tanh, fails to converge at some step
+    // (measured: step 353): the step is refused and state and history are unchanged.
+    let sharp = |i: usize| {
+        Parallel(
+            Bilinear::<f64>::new(building::STIFFNESS, building::YIELD[i], building::ALPHA).unwrap(),
+            Friction::<f64>::new(0.1 * building::YIELD[i], 1e-3).unwrap(),
+        )
+    };
+    let b = ShearBuilding::new(
+        [building::MASS; 3],
+        [sharp(0), sharp(1), sharp(2)],
+        &building::damping(),
+    )
+    .unwrap();
+    let stepper = Nonlinear::<f64, 3>::new(0.01, NewtonSettings::up_to(30, TOL)).unwrap();
+    let z = Vector3::zeros();
+    let (mut s, mut hist) = stepper
+        .start_with_history(
+            &b,
+            &z,
+            &z,
+            &b.ground_load(hyst::ground(0, 2)),
+            &b.initial_history(),
+        )
+        .unwrap();
+    let mut refused = None;
+    for n in 1..=2000 {
+        let (s0, h0) = (bits(&s), format!("{hist:?}"));
+        match stepper.try_step_with_history(
+            &b,
+            &mut s,
+            &mut hist,
+            &b.ground_load(hyst::ground(n, 2)),
+        ) {
+            Ok(_) => {}
+            Err(e) => {
+                assert_eq!(e, Error::NotConverged);
+                assert_eq!((bits(&s), format!("{hist:?}")), (s0, h0));
+                refused = Some(n);
+                break;
+            }
+        }
+    }
+    println!("sharp friction (v_r = 1 mm/s, h = 0.01 s): first refused step {refused:?}");
+    assert!(refused.is_some());
 }

@@ -19,6 +19,7 @@
 //!   inside the law.
 //! - [`Friction`]: Coulomb friction regularized in the velocity, `f = f_s tanh(v / v_r)`.
 //!
+//! [`Parallel`] puts two laws side by side in one storey (a frame and a friction damper).
 //! [`ShearBuilding`] assembles `N` storeys of one law type with linear damping into a
 //! [`HistoryModel`] for the [`Nonlinear`](crate::Nonlinear) stepper.
 //!
@@ -29,11 +30,13 @@ mod bilinear;
 mod bouc_wen;
 mod building;
 mod friction;
+mod parallel;
 
 pub use bilinear::{Bilinear, BilinearHistory};
 pub use bouc_wen::{BoucWen, BoucWenHistory};
 pub use building::ShearBuilding;
 pub use friction::Friction;
+pub use parallel::Parallel;
 
 use nalgebra::{SMatrix, SVector};
 
