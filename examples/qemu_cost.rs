@@ -205,6 +205,59 @@ macro_rules! case {
             stringify!($sym),
         );
     }};
+    ($syst:expr, compensated, $t:ident, $n:literal, $reps:expr, $sym:ident) => {{
+        // `CompensatedLinear` (two-sum state update, its own state type): the same
+        // measurement as `measure`, against the same empty call.
+        #[unsafe(no_mangle)]
+        #[inline(never)]
+        fn $sym(
+            sys: &aemstep::CompensatedLinear<$t, $n>,
+            s: &mut aemstep::CompensatedState<$t, $n>,
+            p: &SVector<$t, $n>,
+        ) {
+            sys.step(s, p)
+        }
+        const B: (Rows<$n>, Rows<$n>, Rows<$n>) = building::<$n>();
+        static S: aemstep::CompensatedLinear<$t, $n> =
+            match aemstep::CompensatedLinear::<$t, $n>::from_rows(B.0, B.1, B.2, H) {
+                Ok(s) => s,
+                Err(e) => panic!("{}", e.as_str()),
+            };
+        let p = SVector::<$t, $n>::from_fn(|i, _| 1.0e5 * (i + 1) as $t);
+        let mut s = match S.start(
+            &SVector::from_element(0.01),
+            &SVector::from_element(0.1),
+            &p,
+        ) {
+            Ok(s) => s,
+            Err(e) => fail!("start: {}", e.as_str()),
+        };
+        let mut e = S.full_state(&s);
+        let full = fw::instructions($syst, || {
+            for _ in 0..$reps {
+                $sym(black_box(&S), black_box(&mut s), black_box(&p));
+            }
+        });
+        let base = fw::instructions($syst, || {
+            for _ in 0..$reps {
+                empty_step(black_box(&S), black_box(&mut e), black_box(&p));
+            }
+        });
+        if !aemstep::StepState::is_finite(&s) {
+            fail!("state not finite after {} steps", $reps);
+        }
+        let st = fw::stack_used_by(|| $sym(black_box(&S), black_box(&mut s), black_box(&p)));
+        let c = ((full - base) as u64 * 10 / $reps as u64) as u32;
+        row(
+            "compensated",
+            stringify!($t),
+            $n,
+            c,
+            5 * $n * $n,
+            st,
+            stringify!($sym),
+        );
+    }};
     ($syst:expr, duffing, $t:ident, $reps:expr, $sym:ident) => {{
         /// A Duffing step; a failed step (none is expected) is caught by the step count.
         #[unsafe(no_mangle)]
@@ -251,6 +304,9 @@ fn main() -> ! {
     case!(syst, aform, f64, 5, 200, cost_step_aform_f64_5);
     case!(syst, aform, f64, 6, 200, cost_step_aform_f64_6);
     case!(syst, aform, f64, 12, 200, cost_step_aform_f64_12);
+
+    case!(syst, compensated, f32, 1, 1000, cost_step_compensated_f32_1);
+    case!(syst, compensated, f32, 5, 1000, cost_step_compensated_f32_5);
 
     case!(syst, duffing, f32, 1000, cost_step_duffing_f32_1);
     case!(syst, duffing, f64, 200, cost_step_duffing_f64_1);

@@ -266,6 +266,7 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
         case $form in
         fast) name="fast (\`Linear\`)" ;;
         aform) name="A-form (\`AForm\`)" ;;
+        compensated) name="compensated (\`CompensatedLinear\`)" ;;
         duffing) name="Duffing (\`Nonlinear\`, exactly 2 Newton iterations)" ;;
         *) fail "unknown cost row '$form'" ;;
         esac

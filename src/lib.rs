@@ -16,6 +16,8 @@
 //!   into flash with [`Linear::from_rows`]); `3N²` multiply-adds a step.
 //! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference and
 //!   inspection.
+//! - [`CompensatedLinear`]: the same step with the state update compensated (two-sum), for
+//!   long undamped runs in `f32` (`docs/drift.md`).
 //! - [`LinearInput`]: inputs through an influence matrix, `p = B w(t)` (`2N² + N·I`).
 //! - [`Modal`]: `R` of the `N` modes, `I` inputs, `O` outputs (`R·I + 7R`; [`modal`]).
 //! - [`State`], [`Stepper`]: the state and the interface every scheme shares.
@@ -79,7 +81,10 @@ pub use modal::{Damping, Modal, ModalState};
 pub use nonlinear::varying::{Coefficients, TimeVarying, Varying};
 pub use nonlinear::{Iterations, Model, NewtonReport, NewtonSettings, Nonlinear, Tangent};
 pub use scalar::Real;
-pub use schemes::{AForm, AlphaParameters, Exact, GeneralizedAlpha, Linear, LinearInput, Newmark};
+pub use schemes::{
+    AForm, AlphaParameters, CompensatedLinear, CompensatedState, Exact, GeneralizedAlpha, Linear,
+    LinearInput, Newmark,
+};
 pub use state::State;
 pub use stepper::{StepInput, StepState, Stepper};
 

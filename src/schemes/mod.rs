@@ -4,9 +4,11 @@
 //! - [`Linear`]: the AEM in eliminated form (`3N²` a step), the crate's kernel.
 //! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference.
 //! - [`LinearInput`]: loads through an influence matrix `p = B w` (`2N² + N·I`).
+//! - [`CompensatedLinear`]: the AEM with the state update compensated (long `f32` runs).
 //! - [`Newmark`], [`GeneralizedAlpha`], [`Exact`]: the comparators.
 
 mod aform;
+mod compensated;
 mod exact;
 mod generalized_alpha;
 mod input;
@@ -14,6 +16,7 @@ mod linear;
 mod newmark;
 
 pub use aform::AForm;
+pub use compensated::{CompensatedLinear, CompensatedState};
 pub use exact::Exact;
 pub use generalized_alpha::{AlphaParameters, GeneralizedAlpha};
 pub use input::LinearInput;
