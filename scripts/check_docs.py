@@ -112,6 +112,8 @@ GENERATED = {
     "docs/hysteresis_figures.md": dict(cmd=example("hysteresis_report"), out="stdout"),
     # 10⁸ f32 steps x 12 runs: about 15 s (release) on an idle core.
     "docs/drift.md": dict(cmd=example("drift", "100000000", "{dir}"), out="file"),
+    # The property tests in release, 20000 cases per test, fixed seed: about 10 s.
+    "docs/robustness.md": dict(cmd=["bash", "scripts/robustness.sh", "{dir}"], out="file"),
 }
 # Generated in place by a slower stage of the test command: compared with the git index.
 IN_PLACE = {
