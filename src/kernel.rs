@@ -115,7 +115,7 @@ macro_rules! kernel_stepper {
                 $crate::kinematics::Kinematics::h(&self.kernel.kin)
             }
 
-            /// Cost: `3N²` multiply-adds + `7N` (see [`crate::kernel`]).
+            /// Cost: `3N²` multiply-adds + `7N` (the kernel module's `newmark_step`).
             #[inline]
             fn step(&self, s: &mut $crate::State<T, N>, p: &nalgebra::SVector<T, N>) {
                 $crate::kernel::newmark_step(&self.kernel.ops, &self.kernel.kin, s, p);

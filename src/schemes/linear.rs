@@ -27,7 +27,7 @@ use crate::{AForm, Error, Real};
 /// [`Linear::new`] (run time, from `nalgebra` matrices) or [`Linear::from_rows`]
 /// (`const fn`, from row-major arrays: operators computed by the compiler into flash).
 /// Both take the data in `f64` and round the operators once, so they are bit-identical.
-/// Then [`Stepper::start`] and [`Stepper::step`] (or the checked [`Stepper::try_step`]).
+/// Then [`Stepper::start`](crate::Stepper::start) and [`Stepper::step`](crate::Stepper::step) (or the checked [`Stepper::try_step`](crate::Stepper::try_step)).
 ///
 /// Size: `6N² + 5` values of `T` (`3N²` for stepping, `3N²` for start-up).
 ///
@@ -59,7 +59,7 @@ impl<T: Real, const N: usize> Linear<T, N> {
     /// and rounded once, so the same data gives bit-identical operators through
     /// [`Linear::from_rows`]), fully populated, not necessarily symmetric. `M` may be
     /// singular as long as `M + (h/2) C + (h²/4) K` is not (then start with
-    /// [`Stepper::start_with_acceleration`]).
+    /// [`Stepper::start_with_acceleration`](crate::Stepper::start_with_acceleration)).
     ///
     /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (`h ≤ 0`, not finite,
     /// or `h²` out of range), [`Error::SingularEffectiveMatrix`] (singular to working
