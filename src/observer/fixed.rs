@@ -212,17 +212,20 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
     /// that must not happen.
     #[inline]
     pub fn step(&self, e: &mut Estimate<T, S, I>, w: &SVector<T, I>, y: &SVector<T, O>) {
-        let mut xp = [T::zero(); S];
-        for i in 0..S {
-            let mut s = T::zero();
+        // Sums start from −0 (`−0 + x = x` exactly, so the compiler drops the add) and the
+        // prediction is built in place (no zeroed temporary).
+        let neg_zero = -T::zero();
+        let xp: [T; S] = core::array::from_fn(|i| {
+            let mut s = neg_zero;
             for j in 0..I {
-                s += self.gamma0[i][j] * e.w[j] + self.gamma1[i][j] * w[j];
+                s += self.gamma0[i][j] * e.w[j];
+                s += self.gamma1[i][j] * w[j];
             }
             for j in 0..S {
                 s += self.phi[i][j] * e.x[j];
             }
-            xp[i] = s;
-        }
+            s
+        });
         let mut innov = [T::zero(); O];
         let mut measured = true;
         for o in 0..O {
