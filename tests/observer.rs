@@ -5,6 +5,8 @@
 //! Every tolerance is derived in its test from the method's error or the rounding of the
 //! computation; the measured values are printed (`-- --nocapture`).
 
+#![allow(clippy::needless_range_loop)] // matrix and record indices read best explicitly
+
 use aemstep::models::{self, base_excitation, storey_drifts};
 use aemstep::observer::{Kalman, Observer, Outputs, Readout, StateSpace, SteadyState};
 use aemstep::{Damping, Error, Exact, LinearInput, Modal, StepState, Stepper};

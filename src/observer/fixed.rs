@@ -293,7 +293,7 @@ macro_rules! const_ctor {
             /// };
             /// static OPEN_LOOP: Observer<f32, 10, 1, 1> = match SS.outputs(
             ///     &Outputs::displacements(Outputs::<5, 1, 1>::select([4]))) {
-            ///     Ok(meas) => match Observer::from_parts(&SS, &meas, &[[0.0]; 10]) {
+            ///     Ok(meas) => match Observer::<f32, 10, 1, 1>::from_parts(&SS, &meas, &[[0.0]; 10]) {
             ///         Ok(o) => o,
             ///         Err(e) => panic!("{}", e.as_str()),
             ///     },
