@@ -7,7 +7,8 @@
 //! model). The scene's constants (noise, seed, covariances) are in
 //! `examples/observer_fw/scene.rs`, shared with the firmware and the tests.
 //!
-//! Run: `cargo run --release --example observer_building`
+//! Run: `cargo run --release --example observer_building`; with `-- --check` it writes
+//! nothing and fails if `docs/observer.md` differs from what it computes (`scripts/test.sh`).
 
 #[path = "modal_fw/elcentro.rs"]
 mod elcentro;
@@ -126,47 +127,73 @@ fn plot(
     ag_len: usize,
     series: &[(&str, &Drifts, RGBColor)],
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let root = SVGBackend::new(path, (1000, 520)).into_drawing_area();
+    let root = SVGBackend::new(path, (1000, 820)).into_drawing_area();
     root.fill(&WHITE)?;
+    let (top, bottom) = root.split_vertically(500);
     let t_end = 30.0;
     let n_end = ((t_end / scene::H) as usize).min(ag_len);
-    let peak = series[0].1[..n_end]
-        .iter()
-        .fold(0.0f64, |m, d| m.max(d[0].abs()))
-        * 1e3;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "Storey-1 drift, 5-storey building under El Centro (model: storey 1 10 % too stiff)",
-            ("sans-serif", 18),
-        )
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..t_end, -1.3 * peak..1.3 * peak)?;
-    chart
-        .configure_mesh()
-        .x_desc("t (s)")
-        .y_desc("drift (mm)")
-        .draw()?;
-    for &(name, d, col) in series {
-        let pts: Vec<(f64, f64)> = d[..n_end]
-            .iter()
-            .enumerate()
-            .map(|(n, x)| (n as f64 * scene::H, x[0] * 1e3))
-            .collect();
-        let style = col.stroke_width(if name.starts_with("truth") { 3 } else { 1 });
+    let truth = series[0].1;
+    let peak = truth[..n_end].iter().fold(0.0f64, |m, d| m.max(d[0].abs())) * 1e3;
+    // Top: the drifts; bottom: each estimate's error against the truth.
+    for (area, err) in [(&top, false), (&bottom, true)] {
+        let lim = if err {
+            series[1..]
+                .iter()
+                .flat_map(|(_, d, _)| {
+                    d[..n_end]
+                        .iter()
+                        .zip(truth)
+                        .map(|(a, b)| (a[0] - b[0]).abs())
+                })
+                .fold(0.0f64, f64::max)
+                * 1.3e3
+        } else {
+            1.3 * peak
+        };
+        let mut chart = ChartBuilder::on(area)
+            .caption(
+                if err {
+                    "Error against the truth"
+                } else {
+                    "Storey-1 drift, 5-storey building under El Centro (model: storey 1 10 % too stiff)"
+                },
+                ("sans-serif", 18),
+            )
+            .margin(15)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..t_end, -lim..lim)?;
         chart
-            .draw_series(LineSeries::new(pts, style))?
-            .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            .configure_mesh()
+            .x_desc("t (s)")
+            .y_desc(if err { "error (mm)" } else { "drift (mm)" })
+            .draw()?;
+        for &(name, d, col) in series.iter().skip(usize::from(err)) {
+            let pts: Vec<(f64, f64)> = d[..n_end]
+                .iter()
+                .zip(truth)
+                .enumerate()
+                .map(|(n, (x, t))| {
+                    (
+                        n as f64 * scene::H,
+                        (x[0] - if err { t[0] } else { 0.0 }) * 1e3,
+                    )
+                })
+                .collect();
+            let style = col.stroke_width(if name.starts_with("truth") { 3 } else { 1 });
+            chart
+                .draw_series(LineSeries::new(pts, style))?
+                .label(name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()?;
     root.present()?;
     Ok(())
 }
@@ -355,11 +382,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     writeln!(md)?;
     writeln!(
         md,
-        "![storey-1 drift: truth, observer, open loop](observer.svg)"
+        "![storey-1 drift: truth, observer, open loop; and their errors](observer.svg)"
     )?;
+    print!("{md}");
+    if std::env::args().any(|a| a == "--check") {
+        // The test command's check: the committed page must be what this run produces.
+        if std::fs::read_to_string("docs/observer.md")? != md {
+            eprintln!(
+                "docs/observer.md is stale: rerun `cargo run --release --example observer_building`"
+            );
+            std::process::exit(1);
+        }
+        return Ok(());
+    }
     std::fs::create_dir_all("docs")?;
     std::fs::write("docs/observer.md", &md)?;
-    print!("{md}");
     plot(
         "docs/observer.svg",
         ag.len(),

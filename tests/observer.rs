@@ -198,6 +198,10 @@ fn modal_state_space_reproduces_modal() {
         let full = sys.full_state(&s);
         let u = SMatrix::<f64, 5, S>::from_fn(|i, j| ss.dof_u[i][j]) * x;
         assert!(max_abs((u - full.u()).iter()) <= bound * 5.0);
+        // And back: the modal coordinates of (u, v) = (U x, V x) are x.
+        let v = SMatrix::<f64, 5, S>::from_fn(|i, j| ss.dof_v[i][j]) * x;
+        let back = ss.modal_coordinates(&sm(&B.0), &u, &v);
+        assert!(max_abs((back - x).iter()) <= bound * 5.0);
     }
     check::<2, 4>();
     check::<5, 10>();
@@ -769,11 +773,23 @@ fn generate_reference(drifts: &[[f64; 5]], bound: f64) -> String {
         "/// f64 observer drift estimates (m) at steps 0, EVERY, 2·EVERY, …\npub static DRIFTS: [[f64; 5]; {}] = [\n",
         rows.len()
     ));
+    // The layout rustfmt keeps (the file is formatted with the examples that include it):
+    // a row on one line if it fits in 100 columns, else one value a line.
     for r in rows {
-        s.push_str(&format!(
-            "    [{:?}, {:?}, {:?}, {:?}, {:?}],\n",
+        let line = format!(
+            "    [{:?}, {:?}, {:?}, {:?}, {:?}],",
             r[0], r[1], r[2], r[3], r[4]
-        ));
+        );
+        if line.chars().count() <= 100 {
+            s.push_str(&line);
+            s.push('\n');
+        } else {
+            s.push_str("    [\n");
+            for x in r {
+                s.push_str(&format!("        {x:?},\n"));
+            }
+            s.push_str("    ],\n");
+        }
     }
     s.push_str("];\n");
     s

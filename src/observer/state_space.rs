@@ -24,7 +24,7 @@
 //! `D = Y_a A_w + Y_w` through the maps `u = U x`, `v = V x`, `a = A_x x + A_w w` of the
 //! model ([`StateSpace::outputs`]); an acceleration output has a direct feedthrough `D`.
 
-use nalgebra::SMatrix;
+use nalgebra::{SMatrix, SVector};
 
 use crate::kernel::{newmark_operators, start_operators};
 use crate::linalg::lu::Lu;
@@ -407,7 +407,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
 
     /// The form of [`Modal`](crate::Modal) keeping the modes `modes` (indices in ascending
     /// frequency, `R` of them, `S = 2R`): `x = [η; η']`, each mode the scalar AEM of
-    /// `η'' + 2ξω η' + ω² η = Γ w`; each `R×R` block of `Φ`, `Γ` rows per mode
+    /// `η'' + 2ξω η' + ω² η = Γ w`, so each of the four `R×R` blocks of `Φ` is diagonal
     /// (`const fn`). Same data and checks as `Modal::from_rows_with_modes`; `U = [Φ_R 0]`,
     /// `V = [0 Φ_R]`, `A_x = [−Φ_R ω², −Φ_R 2ξω]`, `A_w = Φ_R Γ`.
     ///
@@ -498,9 +498,9 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     pub fn modal_coordinates(
         &self,
         m: &SMatrix<f64, N, N>,
-        u: &SMatrix<f64, N, 1>,
-        v: &SMatrix<f64, N, 1>,
-    ) -> SMatrix<f64, S, 1> {
+        u: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> SVector<f64, S> {
         // Φ_Rᵀ = the rows of U (u = Φ_R η): η = (U-block)ᵀ M u.
         let (mu, mv) = (m * u, m * v);
         SMatrix::from_fn(|s, _| {
