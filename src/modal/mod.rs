@@ -388,7 +388,12 @@ pub(crate) struct ModalOps<const N: usize, const R: usize, const I: usize, const
 // The model's matrices, the mode selection, the step and the target type's range: one
 // `const fn` serves both constructors, so its arguments are the constructors' arguments.
 #[allow(clippy::too_many_arguments)]
-pub(crate) const fn modal_operators<const N: usize, const R: usize, const I: usize, const O: usize>(
+pub(crate) const fn modal_operators<
+    const N: usize,
+    const R: usize,
+    const I: usize,
+    const O: usize,
+>(
     m: &Rows<N>,
     k: &Rows<N>,
     damping: &Damping<N>,
