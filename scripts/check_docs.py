@@ -110,6 +110,7 @@ GENERATED = {
         ),
     ),
     "docs/hysteresis_figures.md": dict(cmd=example("hysteresis_report"), out="stdout"),
+    "docs/observer.md": dict(cmd=example("observer_building", "{dir}"), out="file"),
 }
 # Generated in place by a slower stage of the test command: compared with the git index.
 IN_PLACE = {

@@ -29,9 +29,6 @@ tests cargo test --release --all-targets --features std -- --ignored || fail "lo
 step "energy behaviour of the nonlinear stepper (numbers quoted in README.md)"
 cargo run --release --example energy || fail "energy example"
 
-step "observer scene (docs/observer.md must be what the example computes)"
-cargo run --release --example observer_building -- --check || fail "observer scene"
-
 step "no_std builds for thumb targets"
 for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi thumbv8m.main-none-eabihf; do
     cargo build --lib --release --target "$t" || fail "no_std build for $t"
