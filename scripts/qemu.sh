@@ -113,6 +113,12 @@ fi
 echo "ok: qemu_timer has no symbol matching /$INVERSION/ (the run-time build has: $("$NM" -C \
     "$OUT/qemu_timer-control:runtime-ops" | grep -E "$INVERSION" | awk '{print $3}' | tr '\n' ' '))"
 
+# The observer firmware: model, Riccati gain and operators all computed by the compiler.
+if "$NM" -C "$OUT/qemu_observer-qemu" | grep -E "$INVERSION|riccati|SteadyState"; then
+    fail "qemu_observer links factorization or Riccati code (symbols above)"
+fi
+echo "ok: qemu_observer has no symbol matching /$INVERSION|riccati|SteadyState/"
+
 step "qemu: no panic reachable from any step function (call graph of the ELFs)"
 # Roots: every `#[no_mangle]` step symbol (`<example>_step`, `cost_step_*`). Edges: direct
 # calls and tail branches between functions in the disassembly. A panic path in a step
