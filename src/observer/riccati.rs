@@ -132,7 +132,11 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
     /// unstable one), [`Error::OperatorOverflow`].
     ///
     /// Cost: about `10 S³` flops an iteration, `≤ 64` iterations (typically 10–25), and a
-    /// few `S×S` `f64` temporaries on the stack.
+    /// few `S×S` `f64` temporaries on the stack. In a `static` the compiler evaluates it;
+    /// `S = 10` (the 5-storey building, 10 iterations) is pinned by `tests/observer.rs`
+    /// (`CONST_GAIN`). Much larger `S` may stop rustc with the `long_running_const_eval`
+    /// lint, as for the steppers' `from_rows`: allow it at the firmware's crate root, or
+    /// solve at run time with [`SteadyState::new`].
     pub const fn solve<const N: usize, const I: usize>(
         model: &StateSpace<N, S, I>,
         meas: &Measurement<S, I, O>,
