@@ -27,7 +27,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::kernel::{newmark_operators, start_operators};
-use crate::linalg::lu::Lu;
+use crate::linalg::lu::{Lu, row_scales};
 use crate::linalg::{Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled};
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::{Error, Exact};
@@ -426,7 +426,8 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         if S != 2 * R {
             return Err(Error::StateSizeMismatch);
         }
-        let op = match modal_operators::<N, R, I, 0>(&m, &k, &damping, &b, &[], &modes, h) {
+        let op = match modal_operators::<N, R, I, 0>(&m, &k, &damping, &b, &[], &modes, h, f64::MAX)
+        {
             Ok(op) => op,
             Err(e) => return Err(e),
         };
@@ -595,8 +596,8 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     }
 }
 
-/// Factorize a symmetric matrix for a solve, judged against its own size (`None` if
+/// Factorize a matrix for a solve, each row judged against its own size (`None` if
 /// singular to working precision).
 pub(crate) const fn lu_of<const N: usize>(a: &Mat<N, N>) -> Option<Lu<N>> {
-    Lu::new(a, crate::linalg::max_abs(a))
+    Lu::new(a, &row_scales(a))
 }
