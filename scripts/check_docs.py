@@ -114,6 +114,7 @@ GENERATED = {
     "docs/drift.md": dict(cmd=example("drift", "100000000", "{dir}"), out="file"),
     # The property tests in release, 20000 cases per test, fixed seed: about 10 s.
     "docs/robustness.md": dict(cmd=["bash", "scripts/robustness.sh", "{dir}"], out="file"),
+    "docs/observer.md": dict(cmd=example("observer_building", "{dir}"), out="file"),
 }
 # Generated in place by a slower stage of the test command: compared with the git index.
 IN_PLACE = {

@@ -15,12 +15,13 @@ cd "$(dirname "$0")/.."
 TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
-EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum qemu_hysteretic)
+EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum qemu_hysteretic qemu_observer)
 # Broken on purpose: "example variant" pairs that must exit with failure (status 1); the
 # variant is `--cfg aemstep_broken="<variant>"` (not a public feature, see Cargo.toml).
 BROKEN=("qemu_timer inject-nan" "qemu_timer tight-bound" "qemu_nonlinear inject-nan"
     "qemu_modal modal-tight-bound" "qemu_schemes inject-nan" "qemu_spectrum spectrum-tight-bound"
-    "qemu_hysteretic hysteretic-tight-bound")
+    "qemu_hysteretic hysteretic-tight-bound"
+    "qemu_observer observer-nan" "qemu_observer observer-tight-bound")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
 TARGET_DIR=${CARGO_TARGET_DIR:-target}
 OUT=$TARGET_DIR/qemu
@@ -112,6 +113,12 @@ fi
 echo "ok: qemu_timer has no symbol matching /$INVERSION/ (the run-time build has: $("$NM" -C \
     "$OUT/qemu_timer-control:runtime-ops" | grep -E "$INVERSION" | awk '{print $3}' | tr '\n' ' '))"
 
+# The observer firmware: model, Riccati gain and operators all computed by the compiler.
+if "$NM" -C "$OUT/qemu_observer-qemu" | grep -E "$INVERSION|riccati|SteadyState"; then
+    fail "qemu_observer links factorization or Riccati code (symbols above)"
+fi
+echo "ok: qemu_observer has no symbol matching /$INVERSION|riccati|SteadyState/"
+
 step "qemu: no panic reachable from any step function (call graph of the ELFs)"
 # Roots: every `#[no_mangle]` step symbol (`<example>_step`, `cost_step_*`). Edges: direct
 # calls and tail branches between functions in the disassembly. A panic path in a step
@@ -196,6 +203,15 @@ host_bits=$(cargo test -q --release --test firmware_hysteretic -- --nocapture 2>
 target_bits=$(sed -n 's/^target roof displacement f32 bits = //p' "$OUT/qemu_hysteretic-qemu.log")
 [[ -n $host_bits && $host_bits == "$target_bits" ]] ||
     fail "hysteretic roof: host '$host_bits', target '$target_bits'"
+echo "ok: both $host_bits"
+
+step "qemu: host and Cortex-M4F f32 runs are bit-identical (observer, storey-1 drift at 80 s)"
+host_bits=$(cargo test -q --release --test observer -- --nocapture --exact \
+    scene_constants_and_firmware_reference_are_current 2>&1 |
+    sed -n 's/^host f32 storey-1 drift at the last step, f32 bits = //p')
+target_bits=$(sed -n 's/^target storey-1 drift f32 bits = //p' "$OUT/qemu_observer-qemu.log")
+[[ -n $host_bits && $host_bits == "$target_bits" ]] ||
+    fail "observer storey-1 drift: host '$host_bits', target '$target_bits'"
 echo "ok: both $host_bits"
 
 step "qemu: footprint: a firmware pays only for the capabilities it uses"
@@ -308,6 +324,17 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "|---|---:|---:|"
     grep '^COST ' "$OUT/qemu_hysteretic-qemu.log" | while read -r _ what mean max; do
         echo "| \`$what\` | $mean | $max |"
+    done
+    echo
+    echo "## Observer loops (\`examples/qemu_observer.rs\`)"
+    echo
+    echo "One step of the fixed-gain observer (predict, correct with 2 accelerometers), \`f32\`: the full building"
+    echo "(\`Observer<f32, 10, 1, 2>\`, 10 states) and 2 of its 5 modes (\`Observer<f32, 4, 1, 2>\`)."
+    echo
+    echo "| observer | instructions / step | multiply-adds | instructions / multiply-add |"
+    echo "|---|---:|---:|---:|"
+    grep '^COST ' "$OUT/qemu_observer-qemu.log" | while read -r _ what instr madds; do
+        echo "| \`$what\` | $instr | $madds | $(awk -v a="$instr" -v b="$madds" 'BEGIN { printf "%.2f", a / b }') |"
     done
     echo
     echo "## Footprint (\`examples/qemu_footprint.rs\`)"

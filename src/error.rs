@@ -69,6 +69,18 @@ pub enum Error {
     /// A hysteretic law's parameter is not finite or is outside its documented range
     /// (e.g. a yield force `≤ 0`, a post-yield ratio outside `[0, 1)`).
     InvalidMaterial,
+    /// A covariance matrix (observer process or measurement noise, or an initial
+    /// estimation covariance) is not finite, not symmetric, or not positive (semi)definite
+    /// as required; or a Kalman filter's innovation covariance lost definiteness (state
+    /// unchanged).
+    InvalidCovariance,
+    /// The discrete algebraic Riccati equation of the steady-state Kalman gain did not
+    /// converge (the model is not detectable from the outputs, or not stabilizable by the
+    /// process noise).
+    RiccatiNotConverged,
+    /// A state-space size parameter does not match the model: `S = 2N` for the full state
+    /// `x = [u; v]`, `S = 2R` for `R` modes.
+    StateSizeMismatch,
 }
 
 impl Error {
@@ -116,6 +128,13 @@ impl Error {
             }
             Error::InvalidDamping => "a damping ratio is NaN or outside [0, 1)",
             Error::InvalidMaterial => "a hysteretic law parameter is not finite or out of range",
+            Error::InvalidCovariance => {
+                "a covariance is not finite, symmetric and positive (semi)definite"
+            }
+            Error::RiccatiNotConverged => {
+                "the Riccati equation of the steady-state gain did not converge"
+            }
+            Error::StateSizeMismatch => "the state size must be S = 2N (or S = 2R for R modes)",
         }
     }
 }

@@ -33,6 +33,9 @@
 //! - [`spectrum`]: response spectra: a bank of damped oscillators fed one
 //!   ground-acceleration sample at a time, RotD50/RotD100, and (feature `std`) many
 //!   records in parallel on the host.
+//! - [`observer`]: virtual sensing — the discrete state-space form of the linear schemes,
+//!   a fixed-gain observer with the steady-state Kalman gain (also in `const fn`), a full
+//!   Kalman filter, modal observers.
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
 //!
@@ -75,6 +78,7 @@ pub mod analysis;
 pub mod hysteresis;
 pub mod modal;
 pub mod models;
+pub mod observer;
 
 pub use error::Error;
 pub use modal::{Damping, Modal, ModalState};

@@ -368,18 +368,19 @@ const fn modal_damping<const N: usize>(
     Ok(out)
 }
 
-/// Every operator of a [`Modal`], in `f64`.
-struct ModalOps<const N: usize, const R: usize, const I: usize, const O: usize> {
+/// Every operator of a [`Modal`], in `f64` (the observer's modal state-space form reads
+/// `c`, `k`, `gamma`, `phi`, `proj`).
+pub(crate) struct ModalOps<const N: usize, const R: usize, const I: usize, const O: usize> {
     kin: AemKinematics<f64>,
     g_gamma: [[f64; I]; R],
     g_c: [f64; R],
     g_k: [f64; R],
-    gamma: [[f64; I]; R],
-    c: [f64; R],
-    k: [f64; R],
+    pub(crate) gamma: [[f64; I]; R],
+    pub(crate) c: [f64; R],
+    pub(crate) k: [f64; R],
     out: [[f64; R]; O],
-    phi: [[f64; R]; N],
-    proj: [[f64; N]; R],
+    pub(crate) phi: [[f64; R]; N],
+    pub(crate) proj: [[f64; N]; R],
 }
 
 /// Check the data and build every operator (shared by `with_modes` and the `const`
@@ -387,7 +388,12 @@ struct ModalOps<const N: usize, const R: usize, const I: usize, const O: usize> 
 // The model's matrices, the mode selection, the step and the target type's range: one
 // `const fn` serves both constructors, so its arguments are the constructors' arguments.
 #[allow(clippy::too_many_arguments)]
-const fn modal_operators<const N: usize, const R: usize, const I: usize, const O: usize>(
+pub(crate) const fn modal_operators<
+    const N: usize,
+    const R: usize,
+    const I: usize,
+    const O: usize,
+>(
     m: &Rows<N>,
     k: &Rows<N>,
     damping: &Damping<N>,

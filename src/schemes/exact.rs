@@ -75,9 +75,10 @@ fn mac<T: Real, const N: usize>(y: &mut [T; N], a: &[[T; N]; N], x: &[T; N]) {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Exact<T, const N: usize> {
     h: T,
-    /// `[Φ_uu, Φ_uv, P0_u, P1_u]` and `[Φ_vu, Φ_vv, P0_v, P1_v]`.
-    au: [[[T; N]; N]; 4],
-    av: [[[T; N]; N]; 4],
+    /// `[Φ_uu, Φ_uv, P0_u, P1_u]` and `[Φ_vu, Φ_vv, P0_v, P1_v]` (read by the observer's
+    /// state-space form).
+    pub(crate) au: [[[T; N]; N]; 4],
+    pub(crate) av: [[[T; N]; N]; 4],
     /// `M, C, K` (the previous load of a one-sample step).
     mck: [[[T; N]; N]; 3],
     /// `M⁻¹, M⁻¹C, M⁻¹K` (equation of motion, and start-up; always `Some`).

@@ -1,0 +1,603 @@
+//! The discrete state-space form of the linear schemes, for `x = [u; v]` (or `[η; η']`).
+//!
+//! Every linear scheme of the crate advances the displacement and velocity by a linear map
+//! of the previous ones and of the input samples at both ends of the step:
+//!
+//! ```text
+//! x_n = Φ x_{n−1} + Γ₀ w_{n−1} + Γ₁ w_n          y_n = H x_n + D w_n
+//! ```
+//!
+//! **AEM** ([`Linear`](crate::Linear), [`LinearInput`](crate::LinearInput)): the
+//! acceleration of every step satisfies the equation of motion,
+//! `a_{n−1} = M⁻¹ (B w_{n−1} − C v − K u)`; substituted into the predictor
+//! `v̂ = v + (h/2) a`, `û = u + h v̂ − (h²/4) a` and the corrector
+//! `q_n = M_eff⁻¹ (B w_n − C v̂ − K û)`, `v_n = v̂ + (h/2) q_n`, `u_n = û + (h²/4) q_n`, it
+//! gives `Φ, Γ₀, Γ₁` blockwise. Formed in `f64` by two factorizations (`M` and
+//! `M_eff = M + (h/2) C + (h²/4) K`) and solves with right-hand sides `K, C, B` — no
+//! explicit inverse is multiplied. **Exact** ([`Exact`](crate::Exact)): the blocks of its
+//! matrix exponential, the first-order-hold load `p = B w` linear over the step.
+//! **Modal** ([`Modal`](crate::Modal)): the scalar AEM of each kept mode, `x = [η; η']`
+//! (`2R` values); each of the four `R×R` blocks of `Φ` is diagonal.
+//!
+//! Outputs: `y = Y_u u + Y_v v + Y_a a + Y_w w` ([`Outputs`]) — displacements, drifts,
+//! velocities, relative or absolute accelerations — become `H = Y_u U + Y_v V + Y_a A_x`,
+//! `D = Y_a A_w + Y_w` through the maps `u = U x`, `v = V x`, `a = A_x x + A_w w` of the
+//! model ([`StateSpace::outputs`]); an acceleration output has a direct feedthrough `D`.
+
+use nalgebra::{SMatrix, SVector};
+
+use crate::kernel::{newmark_operators, start_operators};
+use crate::linalg::lu::{Lu, row_scales};
+use crate::linalg::{Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled};
+use crate::modal::{Damping, lowest_modes, modal_operators};
+use crate::{Error, Exact};
+
+/// The discrete state-space model of a linear scheme with `N` degrees of freedom, state
+/// size `S` (`2N`, or `2R` for `R` modes) and `I` inputs, all in `f64` (row-major:
+/// `phi[i][j]` is row `i`, column `j`):
+///
+/// ```text
+/// x_n = Φ x_{n−1} + Γ₀ w_{n−1} + Γ₁ w_n,      u = U x,  v = V x,  a = A_x x + A_w w
+/// ```
+///
+/// `x = [u; v]` (m, m/s for a building) or, modal, `[η; η']`. Plain matrices a user can
+/// check; [`StateSpace::outputs`] makes the output matrices of any [`Outputs`]. Built by
+/// [`StateSpace::aem`], [`StateSpace::exact`], [`StateSpace::modal`] (run time) or the
+/// `const fn` [`StateSpace::aem_from_rows`], [`StateSpace::modal_from_rows`] (in a
+/// `static`: computed by the compiler).
+///
+/// Size: `S² + 2S·I + N·(3S + I) + 1` values of `f64` (a build-time object: the
+/// observers keep only what they step with).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StateSpace<const N: usize, const S: usize, const I: usize> {
+    /// `Φ` (`S×S`), the state transition over one step.
+    pub phi: [[f64; S]; S],
+    /// `Γ₀` (`S×I`), multiplies the input at the start of the step, `w_{n−1}`.
+    pub gamma0: [[f64; I]; S],
+    /// `Γ₁` (`S×I`), multiplies the input at the end of the step, `w_n`.
+    pub gamma1: [[f64; I]; S],
+    /// `U` (`N×S`): the displacements `u = U x`.
+    pub dof_u: [[f64; S]; N],
+    /// `V` (`N×S`): the velocities `v = V x`.
+    pub dof_v: [[f64; S]; N],
+    /// `A_x` (`N×S`): the accelerations (relative to the base) `a = A_x x + A_w w`.
+    pub dof_a: [[f64; S]; N],
+    /// `A_w` (`N×I`): the accelerations' direct dependence on the input.
+    pub dof_a_input: [[f64; I]; N],
+    /// The time step `h` (s).
+    pub dt: f64,
+}
+
+/// What is measured or estimated: `y = Y_u u + Y_v v + Y_a a + Y_w w`, `O` outputs of a
+/// model with `N` degrees of freedom and `I` inputs (row-major `f64`). Fill the fields or
+/// use the `const` helpers ([`Outputs::displacements`], [`Outputs::absolute_accelerations`],
+/// …); combine kinds by filling several fields.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Outputs<const N: usize, const I: usize, const O: usize> {
+    /// `Y_u` (`O×N`): weights of the displacements (e.g. [`storey_drifts`](crate::models::storey_drifts)).
+    pub u: [[f64; N]; O],
+    /// `Y_v` (`O×N`): weights of the velocities.
+    pub v: [[f64; N]; O],
+    /// `Y_a` (`O×N`): weights of the accelerations (relative to the base).
+    pub a: [[f64; N]; O],
+    /// `Y_w` (`O×I`): weights of the inputs (e.g. the ground acceleration of an absolute
+    /// acceleration).
+    pub w: [[f64; I]; O],
+}
+
+impl<const N: usize, const I: usize, const O: usize> Outputs<N, I, O> {
+    /// No output weight at all (fill the fields from here).
+    pub const fn zero() -> Self {
+        Self {
+            u: [[0.0; N]; O],
+            v: [[0.0; N]; O],
+            a: [[0.0; N]; O],
+            w: [[0.0; I]; O],
+        }
+    }
+
+    /// `y = Y u`: displacements or drifts (rows of `y`, e.g.
+    /// [`storey_drifts`](crate::models::storey_drifts)).
+    pub const fn displacements(y: [[f64; N]; O]) -> Self {
+        let mut o = Self::zero();
+        o.u = y;
+        o
+    }
+
+    /// `y = Y v`: velocities (or drift rates).
+    pub const fn velocities(y: [[f64; N]; O]) -> Self {
+        let mut o = Self::zero();
+        o.v = y;
+        o
+    }
+
+    /// `y = Y a`: accelerations relative to the base.
+    pub const fn accelerations(y: [[f64; N]; O]) -> Self {
+        let mut o = Self::zero();
+        o.a = y;
+        o
+    }
+
+    /// `y = Y (a + ι a_g)`: absolute accelerations under base excitation (the
+    /// accelerometer's reading), where input `input` is the ground acceleration `a_g` and
+    /// `ι = (1, …, 1)` (every DOF moves with the ground, as
+    /// [`base_excitation`](crate::models::base_excitation)). An `input ≥ I` adds nothing
+    /// (relative accelerations).
+    pub const fn absolute_accelerations(y: [[f64; N]; O], input: usize) -> Self {
+        let mut o = Self::accelerations(y);
+        if input < I {
+            let mut r = 0;
+            while r < O {
+                let mut s = 0.0;
+                let mut j = 0;
+                while j < N {
+                    s += y[r][j];
+                    j += 1;
+                }
+                o.w[r][input] = s;
+                r += 1;
+            }
+        }
+        o
+    }
+
+    /// Rows of the `N×N` identity selected by `dofs`: `[[0, 1, 0, …], …]` for DOF 1 etc.
+    /// An index `≥ N` gives a zero row.
+    pub const fn select(dofs: [usize; O]) -> [[f64; N]; O] {
+        let mut y = [[0.0; N]; O];
+        let mut r = 0;
+        while r < O {
+            if dofs[r] < N {
+                y[r][dofs[r]] = 1.0;
+            }
+            r += 1;
+        }
+        y
+    }
+}
+
+/// The output matrices `y = H x + D w` of [`Outputs`] on a [`StateSpace`] (`f64`,
+/// row-major): what an observer measures or a [`Readout`](crate::observer::Readout)
+/// estimates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measurement<const S: usize, const I: usize, const O: usize> {
+    /// `H` (`O×S`).
+    pub h: [[f64; S]; O],
+    /// `D` (`O×I`), the direct feedthrough (nonzero for acceleration outputs).
+    pub d: [[f64; I]; O],
+}
+
+impl<const S: usize, const I: usize, const O: usize> Measurement<S, I, O> {
+    /// `H` as a `nalgebra` matrix.
+    pub fn h_matrix(&self) -> SMatrix<f64, O, S> {
+        SMatrix::from_fn(|i, j| self.h[i][j])
+    }
+    /// `D` as a `nalgebra` matrix.
+    pub fn d_matrix(&self) -> SMatrix<f64, O, I> {
+        SMatrix::from_fn(|i, j| self.d[i][j])
+    }
+}
+
+/// The blocks of one AEM step in `f64`: `u_n = uu u + uv v + u0 w_{n−1} + u1 w_n`, same for
+/// `v_n`; `a = au u + av v + aw w` (the equation of motion).
+struct AemBlocks<const N: usize, const I: usize> {
+    uu: Mat<N, N>,
+    uv: Mat<N, N>,
+    vu: Mat<N, N>,
+    vv: Mat<N, N>,
+    u0: Mat<N, I>,
+    v0: Mat<N, I>,
+    u1: Mat<N, I>,
+    v1: Mat<N, I>,
+    au: Mat<N, N>,
+    av: Mat<N, N>,
+    aw: Mat<N, I>,
+}
+
+/// `a + s·b` for `N×C` blocks (local shorthand).
+const fn axpy<const R: usize, const C: usize>(a: &Mat<R, C>, s: f64, b: &Mat<R, C>) -> Mat<R, C> {
+    add_scaled(a, s, b)
+}
+
+/// The AEM step as blocks (see the module docs): factorizations of `M` and `M_eff`, solves.
+const fn aem_blocks<const N: usize, const I: usize>(
+    m: &Rows<N>,
+    c: &Rows<N>,
+    k: &Rows<N>,
+    b: &Mat<N, I>,
+    h: f64,
+) -> Result<AemBlocks<N, I>, Error> {
+    if !all_finite(b) {
+        return Err(Error::NonFiniteInput);
+    }
+    let op = match newmark_operators(m, c, k, h, 0.25, 0.5, f64::MAX) {
+        Ok(op) => op,
+        Err(e) => return Err(e),
+    };
+    let (lu_m, st) = match op.start {
+        Some(s) => s,
+        None => return Err(Error::SingularMass),
+    };
+    let kin = op.kin;
+    let zero_i = [[0.0; I]; N];
+    let id: Mat<N, N> = identity();
+    // The equation of motion: a = −M⁻¹K u − M⁻¹C v + M⁻¹B w.
+    let au = scaled(-1.0, &st.minv_k);
+    let av = scaled(-1.0, &st.minv_c);
+    let aw = lu_m.solve(b);
+    // Predictor: v̂ = v + c_v a, û = u + h v̂ − c_u a.
+    let vh_u = scaled(kin.c_v, &au);
+    let vh_v = axpy(&id, kin.c_v, &av);
+    let vh_w = scaled(kin.c_v, &aw);
+    let uh_u = axpy(&axpy(&id, kin.h, &vh_u), -kin.c_u, &au);
+    let uh_v = axpy(&scaled(kin.h, &vh_v), -kin.c_u, &av);
+    let uh_w = axpy(&axpy(&zero_i, kin.h, &vh_w), -kin.c_u, &aw);
+    // q = M_eff⁻¹ (B w_n − C v̂ − K û): solves with the right-hand sides −C v̂ − K û, B.
+    let rhs_u = axpy(&scaled(-1.0, &mul(c, &vh_u)), -1.0, &mul(k, &uh_u));
+    let rhs_v = axpy(&scaled(-1.0, &mul(c, &vh_v)), -1.0, &mul(k, &uh_v));
+    let rhs_w = axpy(&scaled(-1.0, &mul(c, &vh_w)), -1.0, &mul(k, &uh_w));
+    let (qu, qv, qw, q1) = (
+        op.lu.solve(&rhs_u),
+        op.lu.solve(&rhs_v),
+        op.lu.solve(&rhs_w),
+        op.lu.solve(b),
+    );
+    // Corrector: u_n = û + β h² q, v_n = v̂ + γ h q.
+    let (bh2, gh) = (kin.beta_h2, kin.gamma_h);
+    let blocks = AemBlocks {
+        uu: axpy(&uh_u, bh2, &qu),
+        uv: axpy(&uh_v, bh2, &qv),
+        vu: axpy(&vh_u, gh, &qu),
+        vv: axpy(&vh_v, gh, &qv),
+        u0: axpy(&uh_w, bh2, &qw),
+        v0: axpy(&vh_w, gh, &qw),
+        u1: axpy(&zero_i, bh2, &q1),
+        v1: axpy(&zero_i, gh, &q1),
+        au,
+        av,
+        aw,
+    };
+    Ok(blocks)
+}
+
+/// Copy the `R2×C2` block `src` into `dst` at row `r0`, column `c0` (entries outside
+/// `dst` are skipped).
+const fn put<const R1: usize, const C1: usize, const R2: usize, const C2: usize>(
+    dst: &mut Mat<R1, C1>,
+    src: &Mat<R2, C2>,
+    r0: usize,
+    c0: usize,
+) {
+    let mut i = 0;
+    while i < R2 {
+        let mut j = 0;
+        while j < C2 {
+            if r0 + i < R1 && c0 + j < C1 {
+                dst[r0 + i][c0 + j] = src[i][j];
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+}
+
+impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
+    /// A model with every matrix zero (filled by the builders).
+    const fn zero(dt: f64) -> Self {
+        Self {
+            phi: [[0.0; S]; S],
+            gamma0: [[0.0; I]; S],
+            gamma1: [[0.0; I]; S],
+            dof_u: [[0.0; S]; N],
+            dof_v: [[0.0; S]; N],
+            dof_a: [[0.0; S]; N],
+            dof_a_input: [[0.0; I]; N],
+            dt,
+        }
+    }
+
+    /// The full-state form of [`Linear`](crate::Linear) / [`LinearInput`](crate::LinearInput)
+    /// (the AEM) for `M u'' + C u' + K u = B w(t)`, `x = [u; v]`, `S = 2N` (`const fn`; see
+    /// the module docs for the derivation). `M, C, K` are `N×N`, `B` is `N×I`, row-major
+    /// `f64`; `h` in s. The same data as the steppers' `from_rows`.
+    ///
+    /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`],
+    /// [`Error::InvalidTimeStep`], [`Error::SingularEffectiveMatrix`],
+    /// [`Error::SingularMass`] (the state-space form needs `a = M⁻¹(…)`),
+    /// [`Error::OperatorOverflow`].
+    ///
+    /// Cost: about `12N³ + 4N²·I` `f64` flops and a few `N×N` temporaries on the stack.
+    pub const fn aem_from_rows(
+        m: Rows<N>,
+        c: Rows<N>,
+        k: Rows<N>,
+        b: [[f64; I]; N],
+        h: f64,
+    ) -> Result<Self, Error> {
+        if S != 2 * N {
+            return Err(Error::StateSizeMismatch);
+        }
+        let bl = match aem_blocks(&m, &c, &k, &b, h) {
+            Ok(bl) => bl,
+            Err(e) => return Err(e),
+        };
+        let mut ss = Self::zero(h);
+        put(&mut ss.phi, &bl.uu, 0, 0);
+        put(&mut ss.phi, &bl.uv, 0, N);
+        put(&mut ss.phi, &bl.vu, N, 0);
+        put(&mut ss.phi, &bl.vv, N, N);
+        put(&mut ss.gamma0, &bl.u0, 0, 0);
+        put(&mut ss.gamma0, &bl.v0, N, 0);
+        put(&mut ss.gamma1, &bl.u1, 0, 0);
+        put(&mut ss.gamma1, &bl.v1, N, 0);
+        let id: Mat<N, N> = identity();
+        put(&mut ss.dof_u, &id, 0, 0);
+        put(&mut ss.dof_v, &id, 0, N);
+        put(&mut ss.dof_a, &bl.au, 0, 0);
+        put(&mut ss.dof_a, &bl.av, 0, N);
+        ss.dof_a_input = bl.aw;
+        if ss.all_finite() {
+            Ok(ss)
+        } else {
+            Err(Error::OperatorOverflow)
+        }
+    }
+
+    /// [`StateSpace::aem_from_rows`] from `nalgebra` matrices (run time; same numbers).
+    ///
+    /// Errors and cost: as [`StateSpace::aem_from_rows`].
+    pub fn aem(
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        b: &SMatrix<f64, N, I>,
+        h: f64,
+    ) -> Result<Self, Error> {
+        Self::aem_from_rows(rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(b), h)
+    }
+
+    /// The full-state form of [`Exact`] (matrix exponential, load `p = B w` linear over
+    /// the step): `Φ` and the first-order-hold `Γ₀ = (Γ₁ᵉ − Γ₂ᵉ/h) B`, `Γ₁ = (Γ₂ᵉ/h) B` of
+    /// the exponential, `x = [u; v]`, `S = 2N`; reproduces
+    /// [`Stepper::step_with_previous_input`](crate::Stepper::step_with_previous_input) of
+    /// [`Exact`] to rounding. Run time only.
+    ///
+    /// Errors: [`Error::StateSizeMismatch`], those of [`Exact::new`], and
+    /// [`Error::NonFiniteInput`] for `B`.
+    ///
+    /// Cost: that of [`Exact::new`] plus `4N²·I` flops.
+    pub fn exact(
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        b: &SMatrix<f64, N, I>,
+        h: f64,
+    ) -> Result<Self, Error> {
+        if S != 2 * N {
+            return Err(Error::StateSizeMismatch);
+        }
+        let bb = rows_f64(b);
+        if !all_finite(&bb) {
+            return Err(Error::NonFiniteInput);
+        }
+        let ex = Exact::<f64, N>::new(m, c, k, h)?;
+        let (mm, cc, kk) = (rows_f64(m), rows_f64(c), rows_f64(k));
+        let (lu_m, st) = start_operators(&mm, &cc, &kk, f64::MAX)?.ok_or(Error::SingularMass)?;
+        let mut ss = Self::zero(h);
+        put(&mut ss.phi, &ex.au[0], 0, 0);
+        put(&mut ss.phi, &ex.au[1], 0, N);
+        put(&mut ss.phi, &ex.av[0], N, 0);
+        put(&mut ss.phi, &ex.av[1], N, N);
+        put(&mut ss.gamma0, &mul(&ex.au[2], &bb), 0, 0);
+        put(&mut ss.gamma0, &mul(&ex.av[2], &bb), N, 0);
+        put(&mut ss.gamma1, &mul(&ex.au[3], &bb), 0, 0);
+        put(&mut ss.gamma1, &mul(&ex.av[3], &bb), N, 0);
+        let id: Mat<N, N> = identity();
+        put(&mut ss.dof_u, &id, 0, 0);
+        put(&mut ss.dof_v, &id, 0, N);
+        put(&mut ss.dof_a, &scaled(-1.0, &st.minv_k), 0, 0);
+        put(&mut ss.dof_a, &scaled(-1.0, &st.minv_c), 0, N);
+        ss.dof_a_input = lu_m.solve(&bb);
+        if ss.all_finite() {
+            Ok(ss)
+        } else {
+            Err(Error::OperatorOverflow)
+        }
+    }
+
+    /// The form of [`Modal`](crate::Modal) keeping the modes `modes` (indices in ascending
+    /// frequency, `R` of them, `S = 2R`): `x = [η; η']`, each mode the scalar AEM of
+    /// `η'' + 2ξω η' + ω² η = Γ w`, so each of the four `R×R` blocks of `Φ` is diagonal
+    /// (`const fn`). Same data and checks as `Modal::from_rows_with_modes`; `U = [Φ_R 0]`,
+    /// `V = [0 Φ_R]`, `A_x = [−Φ_R ω², −Φ_R 2ξω]`, `A_w = Φ_R Γ`.
+    ///
+    /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2R`) and those of
+    /// [`Modal::new`](crate::Modal::new).
+    ///
+    /// Cost: that of the modal build (`O(N³)`) plus `O(R·(N + I))`.
+    pub const fn modal_from_rows<const R: usize>(
+        m: Rows<N>,
+        k: Rows<N>,
+        damping: Damping<N>,
+        b: [[f64; I]; N],
+        modes: [usize; R],
+        h: f64,
+    ) -> Result<Self, Error> {
+        if S != 2 * R {
+            return Err(Error::StateSizeMismatch);
+        }
+        let op = match modal_operators::<N, R, I, 0>(&m, &k, &damping, &b, &[], &modes, h, f64::MAX)
+        {
+            Ok(op) => op,
+            Err(e) => return Err(e),
+        };
+        let mut ss = Self::zero(h);
+        let mut r = 0;
+        while r < R {
+            let bl =
+                match aem_blocks::<1, I>(&[[1.0]], &[[op.c[r]]], &[[op.k[r]]], &[op.gamma[r]], h) {
+                    Ok(bl) => bl,
+                    Err(e) => return Err(e),
+                };
+            ss.phi[r][r] = bl.uu[0][0];
+            ss.phi[r][R + r] = bl.uv[0][0];
+            ss.phi[R + r][r] = bl.vu[0][0];
+            ss.phi[R + r][R + r] = bl.vv[0][0];
+            ss.gamma0[r] = bl.u0[0];
+            ss.gamma0[R + r] = bl.v0[0];
+            ss.gamma1[r] = bl.u1[0];
+            ss.gamma1[R + r] = bl.v1[0];
+            let mut i = 0;
+            while i < N {
+                let p = op.phi[i][r];
+                ss.dof_u[i][r] = p;
+                ss.dof_v[i][R + r] = p;
+                ss.dof_a[i][r] = -p * op.k[r];
+                ss.dof_a[i][R + r] = -p * op.c[r];
+                let mut j = 0;
+                while j < I {
+                    ss.dof_a_input[i][j] += p * op.gamma[r][j];
+                    j += 1;
+                }
+                i += 1;
+            }
+            r += 1;
+        }
+        if ss.all_finite() {
+            Ok(ss)
+        } else {
+            Err(Error::OperatorOverflow)
+        }
+    }
+
+    /// [`StateSpace::modal_from_rows`] with the `R` lowest modes, from `nalgebra`
+    /// matrices (run time; same numbers).
+    ///
+    /// Errors and cost: as [`StateSpace::modal_from_rows`].
+    pub fn modal<const R: usize>(
+        m: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        damping: &Damping<N>,
+        b: &SMatrix<f64, N, I>,
+        h: f64,
+    ) -> Result<Self, Error> {
+        Self::modal_from_rows::<R>(
+            rows_f64(m),
+            rows_f64(k),
+            *damping,
+            rows_f64(b),
+            lowest_modes(),
+            h,
+        )
+    }
+
+    /// The modal coordinates `[η; η']` of a full state `(u, v)`, `η = Φ_Rᵀ M u` (exact when
+    /// `u` lies in the span of the kept modes), for a model from
+    /// [`StateSpace::modal_from_rows`]. `m` is the mass matrix it was built with.
+    ///
+    /// Cost: `2N²` + `2N·R` flops.
+    pub fn modal_coordinates(
+        &self,
+        m: &SMatrix<f64, N, N>,
+        u: &SVector<f64, N>,
+        v: &SVector<f64, N>,
+    ) -> SVector<f64, S> {
+        // Φ_Rᵀ = the rows of U (u = Φ_R η): η = (U-block)ᵀ M u.
+        let (mu, mv) = (m * u, m * v);
+        SMatrix::from_fn(|s, _| {
+            let mut e = 0.0;
+            for i in 0..N {
+                e += self.dof_u[i][s] * mu[i] + self.dof_v[i][s] * mv[i];
+            }
+            e
+        })
+    }
+
+    /// Every entry of every matrix is finite.
+    const fn all_finite(&self) -> bool {
+        all_finite(&self.phi)
+            && all_finite(&self.gamma0)
+            && all_finite(&self.gamma1)
+            && all_finite(&self.dof_u)
+            && all_finite(&self.dof_v)
+            && all_finite(&self.dof_a)
+            && all_finite(&self.dof_a_input)
+    }
+
+    /// The output matrices `H = Y_u U + Y_v V + Y_a A_x`, `D = Y_a A_w + Y_w` of `outputs`
+    /// (`const fn`).
+    ///
+    /// Errors: [`Error::NonFiniteInput`] (a non-finite weight). Cost: `3O·N·S + O·N·I` flops.
+    pub const fn outputs<const O: usize>(
+        &self,
+        outputs: &Outputs<N, I, O>,
+    ) -> Result<Measurement<S, I, O>, Error> {
+        if !(all_finite(&outputs.u)
+            && all_finite(&outputs.v)
+            && all_finite(&outputs.a)
+            && all_finite(&outputs.w))
+        {
+            return Err(Error::NonFiniteInput);
+        }
+        let h = add_scaled(
+            &add_scaled(
+                &mul(&outputs.u, &self.dof_u),
+                1.0,
+                &mul(&outputs.v, &self.dof_v),
+            ),
+            1.0,
+            &mul(&outputs.a, &self.dof_a),
+        );
+        let d = add_scaled(&outputs.w, 1.0, &mul(&outputs.a, &self.dof_a_input));
+        if all_finite(&h) && all_finite(&d) {
+            Ok(Measurement { h, d })
+        } else {
+            Err(Error::OperatorOverflow)
+        }
+    }
+
+    /// The process-noise covariance of a white input noise held over each step:
+    /// `Q = (Γ₀ + Γ₁) Q_w (Γ₀ + Γ₁)ᵀ` (`S×S`) for an input-noise covariance `Q_w`
+    /// (`I×I`, input units squared). For unmodelled forces on every DOF, build the model
+    /// with `B = I` (`I = N`) and `Q_w = σ_f² I`. `const fn`; cost `S²·I + S·I²` flops.
+    pub const fn input_noise(&self, qw: &[[f64; I]; I]) -> [[f64; S]; S] {
+        let g = add_scaled(&self.gamma0, 1.0, &self.gamma1);
+        let gq = mul(&g, qw);
+        let mut q = [[0.0; S]; S];
+        let mut i = 0;
+        while i < S {
+            let mut j = 0;
+            while j < S {
+                let mut s = 0.0;
+                let mut l = 0;
+                while l < I {
+                    s += gq[i][l] * g[j][l];
+                    l += 1;
+                }
+                q[i][j] = s;
+                j += 1;
+            }
+            i += 1;
+        }
+        q
+    }
+
+    /// `Φ` as a `nalgebra` matrix.
+    pub fn phi_matrix(&self) -> SMatrix<f64, S, S> {
+        SMatrix::from_fn(|i, j| self.phi[i][j])
+    }
+    /// `Γ₀` as a `nalgebra` matrix.
+    pub fn gamma0_matrix(&self) -> SMatrix<f64, S, I> {
+        SMatrix::from_fn(|i, j| self.gamma0[i][j])
+    }
+    /// `Γ₁` as a `nalgebra` matrix.
+    pub fn gamma1_matrix(&self) -> SMatrix<f64, S, I> {
+        SMatrix::from_fn(|i, j| self.gamma1[i][j])
+    }
+}
+
+/// Factorize a matrix for a solve, each row judged against its own size (`None` if
+/// singular to working precision).
+pub(crate) const fn lu_of<const N: usize>(a: &Mat<N, N>) -> Option<Lu<N>> {
+    Lu::new(a, &row_scales(a))
+}
