@@ -27,7 +27,7 @@
 #[path = "fw/mod.rs"]
 mod fw;
 
-use aemstep::modal::base_excitation;
+use aemstep::models::base_excitation;
 use aemstep::models::{self, Rows, rayleigh, shear_building};
 use aemstep::{
     Damping, Linear, Modal, ModalState, Model, NewtonSettings, Nonlinear, Real, State, Stepper,
@@ -189,10 +189,10 @@ macro_rules! duffing {
         #[unsafe(no_mangle)]
         #[inline(never)]
         fn $sym(sys: &Nonlinear<$t, 1>, s: &mut State<$t, 1>, p: &SVector<$t, 1>) {
-            let _ = sys.step(&Duffing, s, p);
+            let _ = sys.try_step(&Duffing, s, p);
         }
         let r = <$t as Real>::from_f64_rounded;
-        let Ok(sys) = Nonlinear::<$t, 1>::new(r(0.01), NewtonSettings::exactly(2, r(1e-5))) else {
+        let Ok(sys) = Nonlinear::<$t, 1>::new(0.01, NewtonSettings::exactly(2, r(1e-5))) else {
             fail!("Newton settings");
         };
         let p = vector![r(0.5)];
