@@ -27,17 +27,17 @@
 #[path = "fw/mod.rs"]
 mod fw;
 
+use aemstep::models::Duffing;
 use aemstep::models::base_excitation;
 use aemstep::models::{self, Rows, rayleigh, shear_building};
 use aemstep::{
-    Damping, Linear, Modal, ModalState, Model, NewtonSettings, Nonlinear, Real, State, Stepper,
-    Tangent,
+    Damping, Linear, Modal, ModalState, NewtonSettings, Nonlinear, Real, State, Stepper,
 };
 use core::hint::black_box;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use nalgebra::{SMatrix, SVector, matrix, vector};
+use nalgebra::{SVector, vector};
 
 /// Step (s) of the `Linear` cases; the cost does not depend on it.
 const H: f64 = 0.01;
@@ -163,26 +163,6 @@ macro_rules! modal {
     }};
 }
 
-/// The Duffing oscillator of paper Example 5, `u'' + 0.2 u' + u + u³ = p`.
-struct Duffing;
-
-impl<T: Real> Model<T, 1> for Duffing {
-    fn mass(&self) -> SMatrix<T, 1, 1> {
-        matrix![T::one()]
-    }
-    fn force(&self, u: &SVector<T, 1>, v: &SVector<T, 1>) -> SVector<T, 1> {
-        let (u, v) = (u[0], v[0]);
-        vector![T::from_f64_rounded(0.2) * v + u + u * u * u]
-    }
-    fn tangent(&self, u: &SVector<T, 1>, _v: &SVector<T, 1>) -> Option<Tangent<T, 1>> {
-        let u = u[0];
-        Some(Tangent {
-            stiffness: matrix![T::one() + T::from_f64_rounded(3.0) * u * u],
-            damping: matrix![T::from_f64_rounded(0.2)],
-        })
-    }
-}
-
 /// The Duffing step with exactly 2 Newton iterations; every step must be taken.
 macro_rules! duffing {
     ($syst:expr, $t:ident, $reps:expr, $sym:ident) => {{
@@ -210,13 +190,8 @@ macro_rules! duffing {
 
 #[entry]
 fn main() -> ! {
-    let Some(mut cp) = cortex_m::Peripherals::take() else {
-        fail!("peripherals taken twice");
-    };
+    let mut cp = fw::init();
     let syst = &mut cp.SYST;
-    fw::start_counter(syst);
-    let cal = fw::calibrate(syst);
-    hprintln!("calibration: 100 x 1000 nops = {} instructions", cal);
 
     linear!(syst, f32, 1, 200, core_linear_f32_1);
     linear!(syst, f32, 2, 200, core_linear_f32_2);

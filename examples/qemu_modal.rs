@@ -28,19 +28,19 @@
 mod fw;
 #[path = "modal_fw/elcentro.rs"]
 mod elcentro;
+#[path = "fw/periodic.rs"]
+mod periodic;
 #[path = "modal_fw/reference.rs"]
 mod reference;
 
 use core::cell::RefCell;
 use core::hint::black_box;
-use core::sync::atomic::{AtomicBool, Ordering};
 
 use aemstep::models::base_excitation;
 use aemstep::models::{self, Rows};
 use aemstep::{Damping, Linear, LinearInput, Modal, ModalState, State, Stepper};
 use cortex_m::interrupt::Mutex;
 use cortex_m::peripheral::SYST;
-use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::hprintln;
 use heapless::spsc::{Producer, Queue};
@@ -49,8 +49,6 @@ use nalgebra::SVector;
 const H: f64 = elcentro::DT;
 /// Steps after step 0: the whole record.
 const STEPS: u32 = (elcentro::SAMPLES - 1) as u32;
-/// SysTick reload for one step per h on the 25 MHz core clock.
-const TICKS_PER_STEP: u32 = (25_000_000.0 * H) as u32;
 
 /// Max |roof drift − full-model roof drift| (m): measured and derived on the host.
 #[cfg(not(aemstep_broken = "modal-tight-bound"))]
@@ -182,8 +180,6 @@ type Ctx = (
     ModalState<f32, 2>,
 );
 static CTX: Mutex<RefCell<Option<Ctx>>> = Mutex::new(RefCell::new(None));
-/// The queue was full when the handler had a sample: the main loop fell behind.
-static OVERRUN: AtomicBool = AtomicBool::new(false);
 
 #[exception]
 fn SysTick() {
@@ -202,19 +198,14 @@ fn SysTick() {
         .unwrap_or(f32::NAN);
     let y = qemu_modal_step(sys, state, ag);
     if tx.enqueue((n, y)).is_err() {
-        OVERRUN.store(true, Ordering::Relaxed);
+        periodic::overrun();
     }
 }
 
 #[entry]
 fn main() -> ! {
-    let Some(mut cp) = cortex_m::Peripherals::take() else {
-        fail!("peripherals taken twice");
-    };
+    let mut cp = fw::init();
     let syst = &mut cp.SYST;
-    fw::start_counter(syst);
-    let cal = fw::calibrate(syst);
-    hprintln!("calibration: 100 x 1000 nops = {} instructions", cal);
 
     // Instructions per step, one output (roof drift) read each step.
     modal_cost!(syst, 1, cost_step_modal_r1);
@@ -258,16 +249,14 @@ fn main() -> ! {
     let mut max_err = libm::fabs(sys.output(&s0)[0] as f64 - reference::ROOF[0] as f64);
     cortex_m::interrupt::free(|cs| CTX.borrow(cs).replace(Some((sys, tx, s0))));
 
-    syst.set_clock_source(SystClkSource::Core);
-    syst.set_reload(TICKS_PER_STEP - 1);
-    syst.clear_current();
-    syst.enable_interrupt();
-    syst.enable_counter();
-
+    periodic::start(syst, H);
     let mut expected = 1;
     let mut last = 0.0f32;
-    while expected <= STEPS {
-        while let Some((n, y)) = rx.dequeue() {
+    periodic::serve(
+        syst,
+        &mut rx,
+        || {},
+        |(n, y)| {
             if n != expected {
                 fail!("sample {} arrived, expected {}", n, expected);
             }
@@ -286,14 +275,9 @@ fn main() -> ! {
             }
             last = y;
             expected += 1;
-        }
-        if OVERRUN.load(Ordering::Relaxed) {
-            fail!("queue overrun at step {}", expected);
-        }
-        cortex_m::asm::wfi();
-    }
-    syst.disable_interrupt();
-    syst.disable_counter();
+            n == STEPS
+        },
+    );
 
     hprintln!(
         "qemu_modal: {} SysTick steps of the 5-storey building under El Centro (R = 2, f32), max |roof drift - full model| = {:e} m <= bound {:e} m",

@@ -18,10 +18,11 @@
 #[path = "fw/mod.rs"]
 mod fw;
 
-use aemstep::{Error, Model, NewtonReport, NewtonSettings, Nonlinear, State, Tangent};
+use aemstep::models::Duffing;
+use aemstep::{Error, NewtonReport, NewtonSettings, Nonlinear, State};
 use cortex_m_rt::entry;
 use cortex_m_semihosting::hprintln;
-use nalgebra::{SMatrix, SVector, matrix, vector};
+use nalgebra::{SVector, vector};
 
 const H: f32 = 0.01;
 const STEPS: u32 = 2000;
@@ -29,26 +30,6 @@ const STEPS: u32 = 2000;
 const TOL: f32 = 1.5e-5;
 /// `FIRMWARE_BOUND` of `tests/firmware_duffing.rs` (f32 error measured there: 1.622e-5).
 const BOUND: f64 = 1.85e-5;
-
-/// `u'' + 0.2 u' + u + u³`: `M = 1`, `F(u, v) = 0.2 v + u + u³`, analytic tangent.
-struct Duffing;
-
-impl Model<f32, 1> for Duffing {
-    fn mass(&self) -> SMatrix<f32, 1, 1> {
-        matrix![1.0]
-    }
-    fn force(&self, u: &SVector<f32, 1>, v: &SVector<f32, 1>) -> SVector<f32, 1> {
-        let (u, v) = (u[0], v[0]);
-        vector![0.2 * v + u + u * u * u]
-    }
-    fn tangent(&self, u: &SVector<f32, 1>, _v: &SVector<f32, 1>) -> Option<Tangent<f32, 1>> {
-        let u = u[0];
-        Some(Tangent {
-            stiffness: matrix![1.0 + 3.0 * u * u],
-            damping: matrix![0.2],
-        })
-    }
-}
 
 /// The exact solution `e^{−0.1t} sin t` (f64, libm).
 fn exact(t: f64) -> f64 {

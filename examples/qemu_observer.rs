@@ -31,6 +31,8 @@
 mod fw;
 #[path = "modal_fw/elcentro.rs"]
 mod elcentro;
+#[path = "fw/periodic.rs"]
+mod periodic;
 #[path = "observer_fw/reference.rs"]
 mod reference;
 #[path = "observer_fw/scene.rs"]
@@ -38,14 +40,12 @@ mod scene;
 
 use core::cell::RefCell;
 use core::hint::black_box;
-use core::sync::atomic::{AtomicBool, Ordering};
 
 use aemstep::models::base_excitation;
 use aemstep::observer::{Estimate, Observer, Readout};
 use aemstep::{LinearInput, Stepper};
 use cortex_m::interrupt::Mutex;
 use cortex_m::peripheral::SYST;
-use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::hprintln;
 use heapless::spsc::{Consumer, Producer, Queue};
@@ -53,8 +53,6 @@ use nalgebra::SVector;
 
 /// Steps after step 0: the whole record.
 const STEPS: u32 = (elcentro::SAMPLES - 1) as u32;
-/// SysTick reload for one step per h on the 25 MHz core clock.
-const TICKS_PER_STEP: u32 = (25_000_000.0 * scene::H) as u32;
 
 /// Max |f32 drift estimate − host f64 estimate| (m), measured on the host.
 #[cfg(not(aemstep_broken = "observer-tight-bound"))]
@@ -181,8 +179,6 @@ type Ctx = (
     Estimate<f32, 10, 1>,
 );
 static CTX: Mutex<RefCell<Option<Ctx>>> = Mutex::new(RefCell::new(None));
-/// The handler found no sample (the sensors fell behind) or a full output queue.
-static OVERRUN: AtomicBool = AtomicBool::new(false);
 
 #[exception]
 fn SysTick() {
@@ -194,12 +190,12 @@ fn SysTick() {
         return;
     }
     let Some((n, ag, y)) = rx.dequeue() else {
-        OVERRUN.store(true, Ordering::Relaxed);
+        periodic::overrun();
         return;
     };
     let d = qemu_observer_step(&OBSERVER, &DRIFTS, e, ag, y);
     if tx.enqueue((n, d, e.missing() as u32)).is_err() {
-        OVERRUN.store(true, Ordering::Relaxed);
+        periodic::overrun();
     }
 }
 
@@ -246,13 +242,8 @@ impl Sensors {
 
 #[entry]
 fn main() -> ! {
-    let Some(mut cp) = cortex_m::Peripherals::take() else {
-        fail!("peripherals taken twice");
-    };
+    let mut cp = fw::init();
     let syst = &mut cp.SYST;
-    fw::start_counter(syst);
-    let cal = fw::calibrate(syst);
-    hprintln!("calibration: 100 x 1000 nops = {} instructions", cal);
 
     // Instructions per observer step.
     let z = SVector::from([0.0f32]);
@@ -320,57 +311,47 @@ fn main() -> ! {
     }
     cortex_m::interrupt::free(|cs| CTX.borrow(cs).replace(Some((sensor_rx, drift_tx, e0))));
 
-    syst.set_clock_source(SystClkSource::Core);
-    syst.set_reload(TICKS_PER_STEP - 1);
-    syst.clear_current();
-    syst.enable_interrupt();
-    syst.enable_counter();
-
+    periodic::start(syst, scene::H);
     let mut expected = 1;
     let mut max_err = 0.0f64;
     let mut last = (0u32, [0.0f32; 5], 0u32);
-    while expected <= STEPS {
-        // Keep the sensors ahead of the observer.
+    // Keep the sensors ahead of the observer.
+    let feed = || {
         while sensors.n < STEPS && sensor_tx.ready() {
             let s = sensors.next();
             if sensor_tx.enqueue(s).is_err() {
                 fail!("sample queue full");
             }
         }
-        while let Some((n, d, missing)) = drift_rx.dequeue() {
-            if n != expected {
-                fail!("estimate {} arrived, expected {}", n, expected);
-            }
-            if (n as usize).is_multiple_of(reference::EVERY) {
-                let r = reference::DRIFTS
-                    .get(n as usize / reference::EVERY)
-                    .copied();
-                let r = r.unwrap_or([f64::NAN; 5]);
-                for i in 0..5 {
-                    let err = libm::fabs(d[i] as f64 - r[i]);
-                    if err.is_nan() || err > BOUND {
-                        fail!(
-                            "step {}: storey {} drift estimate off the host's f64 estimate by {:e} m > bound {:e} m ({} samples missing)",
-                            n,
-                            i + 1,
-                            err,
-                            BOUND,
-                            missing
-                        );
-                    }
-                    max_err = max_err.max(err);
+    };
+    periodic::serve(syst, &mut drift_rx, feed, |(n, d, missing)| {
+        if n != expected {
+            fail!("estimate {} arrived, expected {}", n, expected);
+        }
+        if (n as usize).is_multiple_of(reference::EVERY) {
+            let r = reference::DRIFTS
+                .get(n as usize / reference::EVERY)
+                .copied();
+            let r = r.unwrap_or([f64::NAN; 5]);
+            for i in 0..5 {
+                let err = libm::fabs(d[i] as f64 - r[i]);
+                if err.is_nan() || err > BOUND {
+                    fail!(
+                        "step {}: storey {} drift estimate off the host's f64 estimate by {:e} m > bound {:e} m ({} samples missing)",
+                        n,
+                        i + 1,
+                        err,
+                        BOUND,
+                        missing
+                    );
                 }
+                max_err = max_err.max(err);
             }
-            last = (n, d, missing);
-            expected += 1;
         }
-        if OVERRUN.load(Ordering::Relaxed) {
-            fail!("queue overrun or underrun at step {}", expected);
-        }
-        cortex_m::asm::wfi();
-    }
-    syst.disable_interrupt();
-    syst.disable_counter();
+        last = (n, d, missing);
+        expected += 1;
+        n == STEPS
+    });
     if last.2 != 0 {
         fail!(
             "{} accelerometer samples were missing (NaN): the estimate ran open loop",

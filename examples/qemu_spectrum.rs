@@ -186,13 +186,8 @@ fn SysTick() {
 
 #[entry]
 fn main() -> ! {
-    let Some(mut cp) = cortex_m::Peripherals::take() else {
-        fail!("peripherals taken twice");
-    };
+    let mut cp = fw::init();
     let syst = &mut cp.SYST;
-    fw::start_counter(syst);
-    let cal = fw::calibrate(syst);
-    hprintln!("calibration: 100 x 1000 nops = {} instructions", cal);
 
     // Instructions per incoming sample, averaged over the record; the spectra checked.
     let mut r10 = BANK10.at_rest();

@@ -19,13 +19,13 @@
 #[macro_use]
 #[path = "fw/mod.rs"]
 mod fw;
+#[path = "fw/periodic.rs"]
+mod periodic;
 
 use core::cell::RefCell;
-use core::sync::atomic::{AtomicBool, Ordering};
 
 use aemstep::{Error, Linear, State, Stepper};
 use cortex_m::interrupt::Mutex;
-use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::hprintln;
 use heapless::spsc::{Producer, Queue};
@@ -47,9 +47,6 @@ const BOUND: f64 = 1.2e-4;
 /// Broken on purpose: 1000× tighter than the measured error allows; must fail.
 #[cfg(aemstep_broken = "tight-bound")]
 const BOUND: f64 = 1.2e-7;
-
-/// SysTick reload for one step per h on the 25 MHz core clock.
-const TICKS_PER_STEP: u32 = (25_000_000.0 * H) as u32;
 
 /// The operators, computed by the compiler (in f64, rounded once to f32) into flash.
 #[cfg_attr(aemstep_control = "runtime-ops", allow(dead_code))]
@@ -126,8 +123,6 @@ type Ctx = (
     State<f32, 1>,
 );
 static CTX: Mutex<RefCell<Option<Ctx>>> = Mutex::new(RefCell::new(None));
-/// The queue was full when the handler had a sample: the main loop fell behind.
-static OVERRUN: AtomicBool = AtomicBool::new(false);
 
 #[exception]
 fn SysTick() {
@@ -145,7 +140,7 @@ fn SysTick() {
         Err(e) => Msg::Refused { n, e },
     };
     if tx.enqueue(msg).is_err() {
-        OVERRUN.store(true, Ordering::Relaxed);
+        periodic::overrun();
     }
 }
 
@@ -173,40 +168,31 @@ fn main() -> ! {
     cortex_m::interrupt::free(|cs| CTX.borrow(cs).replace(Some((sys, tx, s0))));
 
     let syst = &mut cp.SYST;
-    syst.set_clock_source(SystClkSource::Core);
-    syst.set_reload(TICKS_PER_STEP - 1);
-    syst.clear_current();
-    syst.enable_interrupt();
-    syst.enable_counter();
-
+    periodic::start(syst, H);
     let mut expected = 1;
     let mut max_err: f64 = 0.0;
     let mut last_u = 0.0f32;
-    while expected <= STEPS {
-        while let Some(msg) = rx.dequeue() {
-            match msg {
-                Msg::Sample { n, u } => {
-                    if n != expected {
-                        fail!("sample {} arrived, expected {}", n, expected);
-                    }
-                    let err = libm::fabs(u as f64 - exact(n as f64 * H));
-                    if err.is_nan() || err > BOUND {
-                        fail!("step {}: |u − exact| = {:e} > bound {:e}", n, err, BOUND);
-                    }
-                    max_err = max_err.max(err);
-                    last_u = u;
-                    expected += 1;
+    periodic::serve(
+        syst,
+        &mut rx,
+        || {},
+        |msg| match msg {
+            Msg::Sample { n, u } => {
+                if n != expected {
+                    fail!("sample {} arrived, expected {}", n, expected);
                 }
-                Msg::Refused { n, e } => fail!("step {} refused: {}", n, e.as_str()),
+                let err = libm::fabs(u as f64 - exact(n as f64 * H));
+                if err.is_nan() || err > BOUND {
+                    fail!("step {}: |u − exact| = {:e} > bound {:e}", n, err, BOUND);
+                }
+                max_err = max_err.max(err);
+                last_u = u;
+                expected += 1;
+                n == STEPS
             }
-        }
-        if OVERRUN.load(Ordering::Relaxed) {
-            fail!("queue overrun at step {}", expected);
-        }
-        cortex_m::asm::wfi();
-    }
-    syst.disable_interrupt();
-    syst.disable_counter();
+            Msg::Refused { n, e } => fail!("step {} refused: {}", n, e.as_str()),
+        },
+    );
 
     hprintln!(
         "qemu_timer: {} SysTick steps of Example 2 (h = 1/500 s, f32), max |u - exact| = {:e} <= bound {:e}",

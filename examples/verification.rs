@@ -13,10 +13,11 @@
 #[path = "../tests/support/mod.rs"]
 mod support;
 
+use aemstep::models::Duffing;
 use aemstep::models::base_excitation;
 use aemstep::{
-    Coefficients, Linear, LinearInput, Model, NewtonSettings, Nonlinear, Real, State, Stepper,
-    Tangent, TimeVarying, Varying, models,
+    Coefficients, Linear, LinearInput, NewtonSettings, Nonlinear, Real, State, Stepper,
+    TimeVarying, Varying, models,
 };
 use nalgebra::{DMatrix, DVector, SMatrix, SVector, matrix, vector};
 use support::*;
@@ -318,26 +319,6 @@ fn tiny_step<T: Build>() -> f64 {
 }
 
 // ------------------------------------------------------------------ nonlinear, time-varying
-
-/// Paper Example 5, Duffing `u'' + 0.2u' + u + u³ = p(t)` with exact `u = e^{−0.1t} sin t`.
-struct Duffing;
-
-impl<T: Real> Model<T, 1> for Duffing {
-    fn mass(&self) -> SMatrix<T, 1, 1> {
-        matrix![T::one()]
-    }
-    fn force(&self, u: &SVector<T, 1>, v: &SVector<T, 1>) -> SVector<T, 1> {
-        let (u, v) = (u[0], v[0]);
-        vector![T::from_f64_rounded(0.2) * v + u + u * u * u]
-    }
-    fn tangent(&self, u: &SVector<T, 1>, _v: &SVector<T, 1>) -> Option<Tangent<T, 1>> {
-        let u = u[0];
-        Some(Tangent {
-            stiffness: matrix![T::one() + T::from_f64_rounded(3.0) * u * u],
-            damping: matrix![T::from_f64_rounded(0.2)],
-        })
-    }
-}
 
 fn duffing_load(t: f64) -> f64 {
     -0.01 * (-0.1 * t).exp() * t.sin() + (-0.3 * t).exp() * t.sin().powi(3)

@@ -1,14 +1,15 @@
 //! The step kernel of the constant-coefficient Newmark family (the AEM and
 //! [`Newmark`](crate::Newmark)), and the blocked matrix–vector products it runs on.
 //!
-//! Operators are stored interleaved by row, `ops[i] = [G[i], −GC[i], −GK[i]]` with
-//! `G = (M + γh C + βh² K)⁻¹`, so row `i` of all three is one contiguous run that
-//! multiplies `x = (p, v̂, û)`; `q_i` is a single multiply-accumulate chain over it.
+//! Operators are rows `[G[i], −GC[i], −GK[i]]` with `G = (M + γh C + βh² K)⁻¹`, each
+//! multiplying `x = (p, v̂, û)` as one multiply-accumulate chain; stored in the target's
+//! layout ([`OpRows`]).
 
 use nalgebra::SVector;
 
 use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics};
 use crate::linalg::lu::{Lu, condition, row_scales};
+use crate::linalg::op_rows::OpRows;
 use crate::linalg::{Mat, add_scaled, all_finite, finite_as, round_rows, rows_f64};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
@@ -21,8 +22,8 @@ use crate::{Error, Real, State};
 // immediate offset from `self` (Thumb-2 `vldr` reaches ±1020 bytes).
 #[repr(C)]
 pub(crate) struct Kernel<T, const N: usize, K> {
-    /// `ops[i] = [G[i], −GC[i], −GK[i]]` (negation is exact).
-    pub ops: [[[T; N]; 3]; N],
+    /// Row `i`: `[G[i], −GC[i], −GK[i]]` (negation is exact), in the target's layout.
+    pub ops: OpRows<T, N, 3>,
     /// [`AemKinematics`] or [`NewmarkKinematics`].
     pub kin: K,
     pub start: Option<StartOps<T, N>>,
@@ -83,7 +84,7 @@ macro_rules! const_kernel {
                     i += 1;
                 }
                 Self {
-                    ops,
+                    ops: OpRows::new(ops),
                     kin: crate::linalg::const_round!($t, kin op.aem),
                     start: match &op.start {
                         Some((_, s)) => Some(StartOps {
@@ -149,7 +150,7 @@ pub(crate) use kernel_stepper;
 /// Cost: `3N²` multiply-adds + `7N`; branch-free, panic-free.
 #[inline(always)]
 pub(crate) fn newmark_step<T: Real, const N: usize, K: Kinematics<T>>(
-    ops: &[[[T; N]; 3]; N],
+    ops: &OpRows<T, N, 3>,
     kin: &K,
     s: &mut State<T, N>,
     p: &SVector<T, N>,
@@ -160,7 +161,7 @@ pub(crate) fn newmark_step<T: Real, const N: usize, K: Kinematics<T>>(
         x[0][j] = p[j];
         (x[1][j], x[2][j]) = kin.predict(s.u[j], s.v[j], s.a[j]);
     }
-    mat_vec_blocked(ops, &x, s.a.as_mut_slice());
+    ops.mat_vec(&x, s.a.as_mut_slice());
     // A separate pass with constant indices (once unrolled), so v̂, û are used straight
     // from registers.
     for j in 0..N {
@@ -203,7 +204,7 @@ pub(crate) fn two_sum<T: Real>(a: T, b: T) -> (T, T) {
 /// branch-free, panic-free.
 #[inline(always)]
 pub(crate) fn newmark_step_compensated<T: Real, const N: usize, K: Kinematics<T>>(
-    ops: &[[[T; N]; 3]; N],
+    ops: &OpRows<T, N, 3>,
     kin: &K,
     s: &mut State<T, N>,
     lo: &mut Lows<T, N>,
@@ -220,12 +221,12 @@ pub(crate) fn newmark_step_compensated<T: Real, const N: usize, K: Kinematics<T>
         (x[2][j], e[1][j]) = two_sum(s.u[j], du);
     }
     let mut q = [T::zero(); N];
-    mat_vec_blocked(ops, &x, &mut q);
+    ops.mat_vec(&x, &mut q);
     for i in 0..N {
         // −GC e_v̂ − GK e_û (the stored blocks are already negated).
         let mut q_lo = T::zero();
         for j in 0..N {
-            q_lo += ops[i][1][j] * e[0][j] + ops[i][2][j] * e[1][j];
+            q_lo += ops.get(i, 1, j) * e[0][j] + ops.get(i, 2, j) * e[1][j];
         }
         q[i] += q_lo;
     }
@@ -245,7 +246,7 @@ pub(crate) fn newmark_step_compensated<T: Real, const N: usize, K: Kinematics<T>
 #[inline(always)]
 pub(crate) fn input_step<T: Real, const N: usize, const I: usize, K: Kinematics<T>>(
     gb: &[[T; I]; N],
-    ops: &[[[T; N]; 2]; N],
+    ops: &OpRows<T, N, 2>,
     kin: &K,
     s: &mut State<T, N>,
     w: &SVector<T, I>,
@@ -254,7 +255,7 @@ pub(crate) fn input_step<T: Real, const N: usize, const I: usize, K: Kinematics<
     for j in 0..N {
         (x[0][j], x[1][j]) = kin.predict(s.u[j], s.v[j], s.a[j]);
     }
-    mat_vec_blocked(ops, &x, s.a.as_mut_slice());
+    ops.mat_vec(&x, s.a.as_mut_slice());
     for j in 0..N {
         let mut q = s.a[j];
         for k in 0..I {
@@ -264,111 +265,6 @@ pub(crate) fn input_step<T: Real, const N: usize, const I: usize, K: Kinematics<
         (s.v[j], s.u[j]) = kin.correct(x[0][j], x[1][j], q);
     }
     s.n = s.n.wrapping_add(1);
-}
-
-/// Operator rows processed together by the steps ("block"), chosen per target. Any block
-/// shape gives bit-identical results: each row's sum is the same chain of products in the
-/// same order (see [`dots`]); blocks only interleave independent chains.
-///
-/// - Cortex-M (and every non-x86-64 target): 2 rows. On the Cortex-M4F this is what keeps
-///   the f32 fast form at or below 3 instructions a multiply-add for N = 6 and 12; 3 or 4
-///   rows spill registers at one size or the other.
-/// - x86-64: 8 rows. A row's chain is serial (an add every 3-4 cycles), so the host needs
-///   many chains in flight; LLVM puts pairs of rows in the lanes of one packed register,
-///   so 8 rows are 4 packed chains. 2 rows leave the core waiting on the add latency
-///   (measured: 2.2 multiply-adds per ns at N = 100, against 5+ with 8 rows).
-#[cfg(not(target_arch = "x86_64"))]
-const BLOCK: usize = 2;
-#[cfg(target_arch = "x86_64")]
-const BLOCK: usize = 8;
-
-/// Columns of each row loaded together in [`dots`] (the products are still added one at a
-/// time, in column order). On x86-64, 2: two rows' pairs of columns become one
-/// `unpcklpd`/`unpckhpd` pair that puts both rows in the lanes of a packed register. On
-/// Cortex-M, 1 (the loop the M4F cost table was measured with).
-#[cfg(not(target_arch = "x86_64"))]
-const CHUNK: usize = 1;
-#[cfg(target_arch = "x86_64")]
-const CHUNK: usize = 2;
-
-/// `R` dot products of interleaved operator rows (each `K` blocks of `N`) with `x`: `R`
-/// accumulators, so each `x` value is loaded once for `R` multiply-adds. Each sum starts
-/// from its first product (no `0 +`), then accumulates block by block, column by column,
-/// in order: row `r`'s result is
-/// `((rows[r][0][0]·x[0][0] + rows[r][0][1]·x[0][1]) + …) + rows[r][K−1][N−1]·x[K−1][N−1]`
-/// whatever `R` and [`CHUNK`] are, so every target computes the same bits.
-#[inline(always)]
-pub(crate) fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
-    rows: &[[[T; N]; K]; R],
-    x: &[[T; N]; K],
-) -> [T; R] {
-    let mut q = [T::zero(); R];
-    if N == 0 || K == 0 {
-        return q;
-    }
-    for r in 0..R {
-        q[r] = rows[r][0][0] * x[0][0];
-    }
-    if CHUNK == 1 {
-        for b in 0..K {
-            let first = if b == 0 { 1 } else { 0 };
-            for j in first..N {
-                let xj = x[b][j];
-                for r in 0..R {
-                    q[r] += rows[r][b][j] * xj;
-                }
-            }
-        }
-        return q;
-    }
-    // `CHUNK` columns at a time over each row's whole run of `K·N` values (the same order:
-    // block by block, column by column): loaded together, added one after the other.
-    let xf = x.as_flattened();
-    let rf: [&[T]; R] = core::array::from_fn(|r| rows[r].as_flattened());
-    let len = K * N;
-    let mut j = 1;
-    while j + CHUNK <= len {
-        let xs: [T; CHUNK] = core::array::from_fn(|c| xf[j + c]);
-        let rs: [[T; CHUNK]; R] = core::array::from_fn(|r| core::array::from_fn(|c| rf[r][j + c]));
-        for c in 0..CHUNK {
-            for r in 0..R {
-                q[r] += rs[r][c] * xs[c];
-            }
-        }
-        j += CHUNK;
-    }
-    // The last `(K·N − 1) mod CHUNK` columns.
-    while j < len {
-        for r in 0..R {
-            q[r] += rf[r][j] * xf[j];
-        }
-        j += 1;
-    }
-    q
-}
-
-/// `out = rows · x` for `N` interleaved rows: the first `N mod BLOCK` rows in pairs (and
-/// one single row if that is odd), then blocks of [`BLOCK`] rows. (With `BLOCK = 2` that
-/// is the remainder row first, then pairs.)
-#[inline(always)]
-pub(crate) fn mat_vec_blocked<T: Real, const N: usize, const K: usize>(
-    rows: &[[[T; N]; K]; N],
-    x: &[[T; N]; K],
-    out: &mut [T],
-) {
-    let (rest, blocks) = rows.as_rchunks::<BLOCK>();
-    let (out_rest, out_blocks) = out.as_rchunks_mut::<BLOCK>();
-    let (single, pairs) = rest.as_rchunks::<2>();
-    let (out_single, out_pairs) = out_rest.as_rchunks_mut::<2>();
-    for (row, o) in single.iter().zip(out_single) {
-        [*o] = dots(core::array::from_ref(row), x);
-    }
-    for (rows, o) in pairs.iter().zip(out_pairs) {
-        *o = dots(rows, x);
-    }
-    for (rows, o) in blocks.iter().zip(out_blocks) {
-        *o = dots(rows, x);
-    }
 }
 
 /// `y = A x` for a row-major `A` (`R×C`). `R·C` multiply-adds.
@@ -386,12 +282,15 @@ pub(crate) fn mat_vec<T: Real, const R: usize, const C: usize>(
     })
 }
 
-/// `[G[i], −GC[i], −GK[i]]` for every row `i` (the storage of the kernel's operators).
+/// Row `i`: `[s_0 A_0[i], …, s_{K−1} A_{K−1}[i]]` (e.g. `[G[i], −GC[i], −GK[i]]`), in the
+/// target's layout: the storage of the kernel's operators.
 pub(crate) fn interleave<T: Real, const N: usize, const K: usize>(
     blocks: [&[[T; N]; N]; K],
     signs: [T; K],
-) -> [[[T; N]; K]; N] {
-    core::array::from_fn(|i| core::array::from_fn(|b| blocks[b][i].map(|x| signs[b] * x)))
+) -> OpRows<T, N, K> {
+    OpRows::new(core::array::from_fn(|i| {
+        core::array::from_fn(|b| blocks[b][i].map(|x| signs[b] * x))
+    }))
 }
 
 /// Operators for the start-up acceleration `q0 = M⁻¹ p0 − (M⁻¹C) v0 − (M⁻¹K) u0`
@@ -571,57 +470,4 @@ pub(crate) fn initial_state<T: Real, const N: usize>(
     }
     let a0 = mat_vec(&ops.minv, p0) - mat_vec(&ops.minv_c, v0) - mat_vec(&ops.minv_k, u0);
     State::initial_computed(u0, v0, a0)
-}
-
-#[cfg(test)]
-mod block_tests {
-    use super::mat_vec_blocked;
-    use crate::Real;
-
-    /// Row `i` of `rows · x` as one serial chain, first product first: the order every
-    /// block shape must keep.
-    fn serial<T: Real, const N: usize, const K: usize>(
-        rows: &[[[T; N]; K]; N],
-        x: &[[T; N]; K],
-    ) -> [T; N] {
-        core::array::from_fn(|i| {
-            let (r, x) = (rows[i].as_flattened(), x.as_flattened());
-            r[1..]
-                .iter()
-                .zip(&x[1..])
-                .fold(r[0] * x[0], |q, (&a, &b)| q + a * b)
-        })
-    }
-
-    fn check<T: Real, const N: usize>() {
-        let mut s = 0x2545_f491_4f6c_dd1d_u64 ^ N as u64;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        };
-        let mut next = || T::from_f64_rounded(next());
-        let rows: [[[T; N]; 3]; N] =
-            core::array::from_fn(|_| core::array::from_fn(|_| core::array::from_fn(|_| next())));
-        let x: [[T; N]; 3] = core::array::from_fn(|_| core::array::from_fn(|_| next()));
-        let mut out = [T::zero(); N];
-        mat_vec_blocked(&rows, &x, &mut out);
-        let want = serial(&rows, &x);
-        for i in 0..N {
-            assert_eq!(
-                out[i].as_f64().to_bits(),
-                want[i].as_f64().to_bits(),
-                "N = {N}, row {i}"
-            );
-        }
-    }
-
-    /// Bit-identical to the serial chain for every remainder of every block size (host
-    /// and Cortex-M therefore agree bit for bit: same chains, same order).
-    #[test]
-    fn blocked_rows_sum_in_serial_order() {
-        macro_rules! sizes { ($($n:literal)*) => { $( check::<f64, $n>(); check::<f32, $n>(); )* } }
-        sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 25 50 99 100);
-    }
 }

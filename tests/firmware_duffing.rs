@@ -11,8 +11,9 @@
 //! error 1.588e-5, 3.970e-6, 9.925e-7 at h, h/2, h/4 (ratios 4.000: second order);
 //! f32 max error 1.622e-5; max |u_f32 − u_f64| 1.139e-6; every report converged in 2.
 
-use aemstep::{Model, NewtonSettings, Nonlinear, Real, Tangent};
-use nalgebra::{SMatrix, SVector, matrix, vector};
+use aemstep::models::Duffing;
+use aemstep::{NewtonSettings, Nonlinear, Real};
+use nalgebra::vector;
 
 const H: f64 = 0.01;
 const STEPS: u32 = 2000;
@@ -22,26 +23,6 @@ const STEPS: u32 = 2000;
 const FIRMWARE_BOUND: f64 = 1.85e-5;
 /// Newton tolerance of the firmware: `NewtonSettings::default_tolerance()` for f32.
 const TOL: f64 = 1.5e-5;
-
-struct Duffing;
-
-impl<T: Real> Model<T, 1> for Duffing {
-    fn mass(&self) -> SMatrix<T, 1, 1> {
-        matrix![T::one()]
-    }
-    fn force(&self, u: &SVector<T, 1>, v: &SVector<T, 1>) -> SVector<T, 1> {
-        let (u, v) = (u[0], v[0]);
-        vector![T::from_f64_rounded(0.2) * v + u + u * u * u]
-    }
-    fn tangent(&self, u: &SVector<T, 1>, _v: &SVector<T, 1>) -> Option<Tangent<T, 1>> {
-        let u = u[0];
-        let three = T::from_f64_rounded(3.0);
-        Some(Tangent {
-            stiffness: matrix![T::one() + three * u * u],
-            damping: matrix![T::from_f64_rounded(0.2)],
-        })
-    }
-}
 
 /// The exact solution, written here.
 fn exact(t: f64) -> f64 {

@@ -109,6 +109,19 @@ pub fn instructions<F: FnOnce()>(syst: &mut SYST, f: F) -> u32 {
     (t0.wrapping_sub(t1) & 0x00FF_FFFF) * TICK_NS_X2 / 2
 }
 
+/// The core peripherals, with SysTick started as the instruction counter
+/// ([`start_counter`]) and checked ([`calibrate`], result printed): every example's first
+/// line. Fails the run if the peripherals were already taken.
+pub fn init() -> cortex_m::Peripherals {
+    let Some(mut cp) = cortex_m::Peripherals::take() else {
+        exit_failure(format_args!("peripherals taken twice"));
+    };
+    start_counter(&mut cp.SYST);
+    let cal = calibrate(&mut cp.SYST);
+    hprintln!("calibration: 100 x 1000 nops = {} instructions", cal);
+    cp
+}
+
 /// Exactly 1000 instructions (and a call and return).
 #[inline(never)]
 fn nops_1000() {

@@ -18,6 +18,7 @@
 pub(crate) mod cholesky;
 pub(crate) mod expm;
 pub(crate) mod lu;
+pub(crate) mod op_rows;
 pub(crate) mod symmetric_eigen;
 
 use nalgebra::SMatrix;
@@ -247,6 +248,24 @@ macro_rules! const_round {
     };
 }
 pub(crate) use const_round;
+
+/// `|a_ij − a_ji| ≤ rel · max|a|` for every pair (not a finiteness check: callers check
+/// that first). Cost: `N²/2` comparisons.
+pub(crate) const fn is_symmetric<const N: usize>(a: &Mat<N, N>, rel: f64) -> bool {
+    let tol = rel * max_abs(a);
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < i {
+            if (a[i][j] - a[j][i]).abs() > tol {
+                return false;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    true
+}
 
 #[cfg(test)]
 mod tests {

@@ -26,7 +26,9 @@ use nalgebra::{SMatrix, SVector};
 use crate::kinematics::{AemKinematics, Kinematics};
 use crate::linalg::cholesky::{cholesky, lower_solve, lower_transpose_solve};
 use crate::linalg::symmetric_eigen::{JACOBI_MAX_SWEEPS, jacobi_eigen};
-use crate::linalg::{self, Rows, all_finite, finite_as, max_abs, mul, rows_f64, sqrt, transpose};
+use crate::linalg::{
+    self, Rows, all_finite, finite_as, is_symmetric, max_abs, mul, rows_f64, sqrt, transpose,
+};
 use crate::{Error, Real, State, StepState, Stepper};
 
 /// Relative tolerance below which `M`, `K` count as symmetric: `|a_ij − a_ji| ≤
@@ -168,22 +170,6 @@ pub struct Modal<T, const N: usize, const R: usize, const I: usize = 1, const O:
 // Construction, all in `const fn` `f64`: the same code serves `Modal::new` at run time and
 // `Modal::from_rows` evaluated by the compiler, so both give bit-identical operators.
 
-const fn is_symmetric<const N: usize>(a: &Rows<N>) -> bool {
-    let tol = SYMMETRY_TOL * max_abs(a);
-    let mut i = 0;
-    while i < N {
-        let mut j = 0;
-        while j < i {
-            if (a[i][j] - a[j][i]).abs() > tol {
-                return false;
-            }
-            j += 1;
-        }
-        i += 1;
-    }
-    true
-}
-
 /// `(ω², Φ)` of `K φ = ω² M φ`, ascending, `Φᵀ M Φ = I` (`Φ` row-major, column `r` is
 /// mode `r`): Cholesky `M = L Lᵀ`, Jacobi on `L⁻¹ K L⁻ᵀ = Q Λ Qᵀ`, `Φ = L⁻ᵀ Q`.
 ///
@@ -192,10 +178,10 @@ const fn is_symmetric<const N: usize>(a: &Rows<N>) -> bool {
 /// finite data (`s = 1e±300` gives the modes of `s = 1`); the scales are undone on `ω²`
 /// and `Φ` at the end. [`Error::OperatorOverflow`] if `ω²` or `Φ` then overflows `f64`.
 const fn modes_of<const N: usize>(m: &Rows<N>, k: &Rows<N>) -> Result<([f64; N], Rows<N>), Error> {
-    if !is_symmetric(m) {
+    if !is_symmetric(m, SYMMETRY_TOL) {
         return Err(Error::MassNotSpd);
     }
-    if !is_symmetric(k) {
+    if !is_symmetric(k, SYMMETRY_TOL) {
         return Err(Error::StiffnessNotSymmetric);
     }
     // M' = M 2^−em (em even, so √(2^em) is exact), K' = K 2^−ek.

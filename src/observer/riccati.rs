@@ -27,7 +27,9 @@ use nalgebra::SMatrix;
 use super::state_space::{Measurement, StateSpace, lu_of};
 use crate::Error;
 use crate::linalg::cholesky::cholesky;
-use crate::linalg::{Mat, add_scaled, all_finite, identity, max_abs, mul, rows_f64, transpose};
+use crate::linalg::{
+    Mat, add_scaled, all_finite, identity, is_symmetric, max_abs, mul, rows_f64, transpose,
+};
 
 /// Iteration budget of the doubling algorithm: iterate `k` covers `2^k` steps of the
 /// Riccati difference equation, so 64 cover any convergent case.
@@ -47,22 +49,7 @@ pub struct SteadyState<const S: usize, const O: usize> {
 
 /// `a` symmetric to `64 ε max|a|` and all finite.
 const fn symmetric<const N: usize>(a: &Mat<N, N>) -> bool {
-    if !all_finite(a) {
-        return false;
-    }
-    let tol = 64.0 * f64::EPSILON * max_abs(a);
-    let mut i = 0;
-    while i < N {
-        let mut j = 0;
-        while j < i {
-            if (a[i][j] - a[j][i]).abs() > tol {
-                return false;
-            }
-            j += 1;
-        }
-        i += 1;
-    }
-    true
+    all_finite(a) && is_symmetric(a, 64.0 * f64::EPSILON)
 }
 
 /// `(a + aᵀ)/2`.

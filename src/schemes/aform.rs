@@ -18,7 +18,8 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, mat_vec_blocked};
+use crate::kernel::StartOps;
+use crate::linalg::op_rows::OpRows;
 use crate::{Real, State, Stepper};
 
 /// The amplification operator `A` and load operator `b` of the linear AEM step, as
@@ -29,10 +30,10 @@ use crate::{Real, State, Stepper};
 // `repr(C)` with the operator first: every operator load is a small immediate offset.
 #[repr(C)]
 pub struct AForm<T, const N: usize> {
-    /// `rows[r][i] = [A_r0[i], A_r1[i], A_r2[i], b_r[i]]`: row `i` of block row `r`
-    /// (0 = q, 1 = v, 2 = u) of `[A | b]`, one contiguous run of `4N` values that
-    /// multiplies `(q, v, u, p)`.
-    rows: [[[[T; N]; 4]; N]; 3],
+    /// `rows[r]`, row `i`: `[A_r0[i], A_r1[i], A_r2[i], b_r[i]]`, row `i` of block row `r`
+    /// (0 = q, 1 = v, 2 = u) of `[A | b]`, `4N` values that multiply `(q, v, u, p)`; in
+    /// the target's layout.
+    rows: [OpRows<T, N, 4>; 3],
     h: T,
     start: Option<StartOps<T, N>>,
 }
@@ -72,7 +73,9 @@ impl<T: Real, const N: usize> AForm<T, N> {
             }
         }
         let rows = core::array::from_fn(|r| {
-            core::array::from_fn(|i| [a[r][0][i], a[r][1][i], a[r][2][i], b[r][i]])
+            OpRows::new(core::array::from_fn(|i| {
+                [a[r][0][i], a[r][1][i], a[r][2][i], b[r][i]]
+            }))
         });
         Self { rows, h, start }
     }
@@ -83,13 +86,13 @@ impl<T: Real, const N: usize> AForm<T, N> {
             return None; // the 4th column block of `rows` is b
         }
         let blk = self.rows.get(r)?;
-        Some(SMatrix::from_fn(|i, j| blk[i][c][j]))
+        Some(SMatrix::from_fn(|i, j| blk.get(i, c, j)))
     }
 
     /// Block `b_r` (`r` in `0..3`), or `None` if out of range.
     pub fn b_block(&self, r: usize) -> Option<SMatrix<T, N, N>> {
         let blk = self.rows.get(r)?;
-        Some(SMatrix::from_fn(|i, j| blk[i][3][j]))
+        Some(SMatrix::from_fn(|i, j| blk.get(i, 3, j)))
     }
 }
 
@@ -109,7 +112,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for AForm<T, N> {
         let x = [s.a.into(), s.v.into(), s.u.into(), (*p).into()];
         let mut new = [[T::zero(); N]; 3];
         for (rows, out) in self.rows.iter().zip(new.iter_mut()) {
-            mat_vec_blocked(rows, &x, out);
+            rows.mat_vec(&x, out);
         }
         let [a, v, u] = new;
         s.a = a.into();

@@ -125,7 +125,7 @@ impl<T: Real, const N: usize> CompensatedLinear<T, N> {
     /// `G = (M + (h/2) C + (h²/4) K)⁻¹` (bit-identical to
     /// [`Linear::effective_inverse`](crate::Linear::effective_inverse)).
     pub fn effective_inverse(&self) -> SMatrix<T, N, N> {
-        SMatrix::from_fn(|i, j| self.kernel.ops[i][0][j])
+        SMatrix::from_fn(|i, j| self.kernel.ops.get(i, 0, j))
     }
 }
 

@@ -17,6 +17,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::kernel::{StartOps, input_step, interleave, newmark_operators};
 use crate::kinematics::AemKinematics;
+use crate::linalg::op_rows::OpRows;
 use crate::linalg::{self, Mat, Rows, all_finite, finite_as, rows_f64};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State, Stepper};
@@ -47,8 +48,8 @@ use crate::{Error, Real, State, Stepper};
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LinearInput<T, const N: usize, const I: usize> {
-    /// `[−GC[i], −GK[i]]` for every row `i`.
-    ops: [[[T; N]; 2]; N],
+    /// Row `i`: `[−GC[i], −GK[i]]`, in the target's layout.
+    ops: OpRows<T, N, 2>,
     /// `G·B`, row-major `N×I`.
     gb: [[T; I]; N],
     kin: AemKinematics<T>,
@@ -207,7 +208,7 @@ macro_rules! const_ctor {
                     i += 1;
                 }
                 Ok(Self {
-                    ops,
+                    ops: OpRows::new(ops),
                     gb: linalg::const_round!($t, rows op.gb),
                     kin: linalg::const_round!($t, kin op.kin),
                     start: match op.start {

@@ -82,14 +82,17 @@ impl<T: Real, const N: usize> Linear<T, N> {
 
     /// `G = (M + (h/2) C + (h²/4) K)⁻¹`.
     pub fn effective_inverse(&self) -> SMatrix<T, N, N> {
-        SMatrix::from_fn(|i, j| self.kernel.ops[i][0][j])
+        SMatrix::from_fn(|i, j| self.kernel.ops.get(i, 0, j))
     }
 
     /// The paper's literal form `U_n = A U_{n−1} + b p_n` of this stepper (`12N²`
     /// multiply-adds a step): the reference the fast form is tested against, and a way to
     /// inspect the amplification operator. Cost to build: about `6N³` flops in `T`.
     pub fn a_form(&self) -> AForm<T, N> {
-        let block = |b: usize, sign: T| self.kernel.ops.map(|row| row[b].map(|x| sign * x));
+        let ops = &self.kernel.ops;
+        let block = |b: usize, sign: T| -> [[T; N]; N] {
+            core::array::from_fn(|i| core::array::from_fn(|j| sign * ops.get(i, b, j)))
+        };
         let one = T::one();
         let (g, gc, gk) = (block(0, one), block(1, -one), block(2, -one));
         AForm::from_operators(self.kernel.kin.h, &g, &gc, &gk, self.kernel.start)
