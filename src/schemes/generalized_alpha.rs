@@ -84,13 +84,16 @@ impl AlphaParameters {
 
 /// The `f64` operators of a generalized-α step, `a_n = G p̄ − GK u_{n−1} + A_v v_{n−1} +
 /// A_a a_{n−1}` with `p̄ = (1 − α_f) p_n + α_f p_{n−1}` and `G = M_eff⁻¹`, the kinematics,
-/// and the start-up operators, in a `const fn` that other builders can share.
+/// the factorization of `M_eff` (for further solves, e.g. `G B`) and the start-up
+/// operators: shared by [`GeneralizedAlpha`] (rounded to `T`) and the state-space form
+/// ([`StateSpace::generalized_alpha`](crate::observer::StateSpace::generalized_alpha)).
 pub(crate) struct AlphaOps<const N: usize> {
     pub g: Mat<N, N>,
     pub gk: Mat<N, N>,
     pub av: Mat<N, N>,
     pub aa: Mat<N, N>,
     pub kin: NewmarkKinematics<f64>,
+    pub lu: Lu<N>,
     /// `κ₁` of the row-equilibrated `M_eff` ([`condition`]).
     pub condition: f64,
     /// The factorization of `M` (if regular) and the start-up operators.
@@ -166,6 +169,7 @@ pub(crate) const fn alpha_operators<const N: usize>(
         av,
         aa,
         kin,
+        lu,
         condition: condition(&meff, &g, &scales),
         start,
     })
