@@ -382,6 +382,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     writeln!(md)?;
     writeln!(
         md,
+        "The observers run on the discrete model of any linear scheme, plain `f64` matrices a user can check:"
+    )?;
+    writeln!(
+        md,
+        "`StateSpace::aem` / `aem_from_rows` (`Linear`, `LinearInput`), `newmark` / `newmark_from_rows` (`Newmark`,"
+    )?;
+    writeln!(
+        md,
+        "any β, γ), `generalized_alpha` / `generalized_alpha_from_rows` (`GeneralizedAlpha`, HHT-α: its acceleration is"
+    )?;
+    writeln!(
+        md,
+        "a state of its own, `x = [u; v; a]`, `S = 3N`, started by `StateSpace::initial_state`), `exact` (`Exact`) and"
+    )?;
+    writeln!(
+        md,
+        "`modal` / `modal_from_rows` (`Modal`). Each reproduces its stepper to rounding (`tests/state_space.rs`,"
+    )?;
+    writeln!(
+        md,
+        "`tests/observer.rs`); the acceleration output is the physical `M⁻¹ (B w − C v − K u)` for every scheme."
+    )?;
+    writeln!(md)?;
+    writeln!(
+        md,
         "![storey-1 drift: truth, observer, open loop; and their errors](observer.svg)"
     )?;
     print!("{md}");

@@ -79,7 +79,7 @@ pub enum Error {
     /// process noise).
     RiccatiNotConverged,
     /// A state-space size parameter does not match the model: `S = 2N` for the full state
-    /// `x = [u; v]`, `S = 2R` for `R` modes.
+    /// `x = [u; v]`, `S = 3N` for generalized-α's `x = [u; v; a]`, `S = 2R` for `R` modes.
     StateSizeMismatch,
 }
 
@@ -134,7 +134,7 @@ impl Error {
             Error::RiccatiNotConverged => {
                 "the Riccati equation of the steady-state gain did not converge"
             }
-            Error::StateSizeMismatch => "the state size must be S = 2N (or S = 2R for R modes)",
+            Error::StateSizeMismatch => "state size must be S = 2N (or 3N gen-alpha, 2R modal)",
         }
     }
 }

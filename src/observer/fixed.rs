@@ -8,9 +8,9 @@ use crate::linalg::{self, all_finite, finite_as, round_rows, rows_f64};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
 
-/// The state of an observer: the estimate `x̂` (`S` values, `[u; v]` or `[η; η']`), the
-/// last input `w_{n−1}` (the next prediction uses it), the step count and the number of
-/// missing measurements. Plain data.
+/// The state of an observer: the estimate `x̂` (`S` values, `[u; v]`, `[u; v; a]` or
+/// `[η; η']`), the last input `w_{n−1}` (the next prediction uses it), the step count and
+/// the number of missing measurements. Plain data.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Estimate<T, const S: usize, const I: usize> {
     pub(crate) x: SVector<T, S>,
@@ -174,8 +174,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
         SMatrix::from_fn(|i, j| self.gain[i][j])
     }
 
-    /// The estimate at `t = 0`: `x̂_0 = x0` (e.g. `[u0; v0]`, or the modal coordinates),
-    /// input `w0`. Errors: [`Error::NonFiniteInput`].
+    /// The estimate at `t = 0`: `x̂_0 = x0` (e.g. `[u0; v0]`, `[u0; v0; a0]` for
+    /// generalized-α — [`StateSpace::initial_state`] — or the modal coordinates), input
+    /// `w0`. Errors: [`Error::NonFiniteInput`].
     pub fn start(
         &self,
         x0: &SVector<T, S>,

@@ -4,10 +4,13 @@
 //! measures (every inter-storey drift of a building from two accelerometers, say):
 //!
 //! - [`StateSpace`]: the discrete state-space form `x_n = Φ x_{n−1} + Γ₀ w_{n−1} + Γ₁ w_n`
-//!   of the AEM ([`Linear`](crate::Linear), [`LinearInput`](crate::LinearInput)), of
-//!   [`Exact`](crate::Exact) and of [`Modal`](crate::Modal) (`R` modes, `2R` states), with
-//!   outputs `y = H x + D w` ([`Outputs`], [`Measurement`]) for displacements, drifts,
-//!   velocities, relative or absolute accelerations. Plain `f64` matrices.
+//!   of every linear scheme — the AEM ([`Linear`](crate::Linear),
+//!   [`LinearInput`](crate::LinearInput)), [`Newmark`](crate::Newmark) (β, γ),
+//!   [`GeneralizedAlpha`](crate::GeneralizedAlpha) and HHT-α (`x = [u; v; a]`, `3N`
+//!   states), [`Exact`](crate::Exact) and [`Modal`](crate::Modal) (`R` modes, `2R`
+//!   states) — with outputs `y = H x + D w` ([`Outputs`], [`Measurement`]) for
+//!   displacements, drifts, velocities, relative or absolute accelerations. Plain `f64`
+//!   matrices.
 //! - [`SteadyState`]: the steady-state Kalman gain from the discrete algebraic Riccati
 //!   equation, in `const fn` (a `static` observer keeps its gain in flash, no Riccati code
 //!   linked) and at run time (the same code).
@@ -17,7 +20,8 @@
 //! - [`Kalman`]: the full Kalman filter (covariance propagated in Joseph form), for the host
 //!   and small firmware models.
 //!
-//! Sizes are const generics: `N` degrees of freedom, `S` states (`S = 2N`, or `2R` modal —
+//! Sizes are const generics: `N` degrees of freedom, `S` states (`S = 2N`, `3N` for
+//! generalized-α, or `2R` modal —
 //! a parameter of its own, checked at construction: [`Error::StateSizeMismatch`](crate::Error::StateSizeMismatch)),
 //! `I` inputs, `O` measurements.
 //!

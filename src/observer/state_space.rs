@@ -1,28 +1,44 @@
-//! The discrete state-space form of the linear schemes, for `x = [u; v]` (or `[η; η']`).
+//! The discrete state-space form of every linear scheme, for `x = [u; v]` (or `[η; η']`,
+//! or `[u; v; a]` for generalized-α).
 //!
-//! Every linear scheme of the crate advances the displacement and velocity by a linear map
-//! of the previous ones and of the input samples at both ends of the step:
+//! Every linear scheme of the crate advances its state by a linear map of the previous
+//! state and of the input samples at both ends of the step (load `p = B w`):
 //!
 //! ```text
 //! x_n = Φ x_{n−1} + Γ₀ w_{n−1} + Γ₁ w_n          y_n = H x_n + D w_n
 //! ```
 //!
-//! **AEM** ([`Linear`](crate::Linear), [`LinearInput`](crate::LinearInput)): the
-//! acceleration of every step satisfies the equation of motion,
-//! `a_{n−1} = M⁻¹ (B w_{n−1} − C v − K u)`; substituted into the predictor
-//! `v̂ = v + (h/2) a`, `û = u + h v̂ − (h²/4) a` and the corrector
-//! `q_n = M_eff⁻¹ (B w_n − C v̂ − K û)`, `v_n = v̂ + (h/2) q_n`, `u_n = û + (h²/4) q_n`, it
-//! gives `Φ, Γ₀, Γ₁` blockwise. Formed in `f64` by two factorizations (`M` and
-//! `M_eff = M + (h/2) C + (h²/4) K`) and solves with right-hand sides `K, C, B` — no
-//! explicit inverse is multiplied. **Exact** ([`Exact`](crate::Exact)): the blocks of its
-//! matrix exponential, the first-order-hold load `p = B w` linear over the step.
-//! **Modal** ([`Modal`](crate::Modal)): the scalar AEM of each kept mode, `x = [η; η']`
-//! (`2R` values); each of the four `R×R` blocks of `Φ` is diagonal.
+//! **Newmark (β, γ)** ([`Newmark`](crate::Newmark); the AEM [`Linear`](crate::Linear),
+//! [`LinearInput`](crate::LinearInput) is β = 1/4, γ = 1/2): the stepper's new
+//! acceleration solves `M_eff q_n = B w_n − C v̂ − K û` with `M_eff = M + γh C + βh² K`,
+//! `v_n = v̂ + γh q_n`, `u_n = û + βh² q_n`, so `M q_n + C v_n + K u_n = B w_n`: the
+//! acceleration of every step (and of the start) satisfies the equation of motion,
+//! `a_{n−1} = M⁻¹ (B w_{n−1} − C v − K u)`, and is no state of its own. Substituted into
+//! the predictor `v̂ = v + (1 − γ)h a`, `û = u + h v̂ − (β + 1/2 − γ)h² a` and the corrector,
+//! it gives `Φ, Γ₀, Γ₁` blockwise on `x = [u; v]` (`S = 2N`). Formed in `f64` by two
+//! factorizations (`M` and `M_eff`) and solves with right-hand sides `K, C, B` — no
+//! explicit inverse is multiplied. ([`StateSpace::newmark`], [`StateSpace::aem`].)
+//!
+//! **Generalized-α** ([`GeneralizedAlpha`](crate::GeneralizedAlpha), HHT-α): the
+//! stepper's acceleration solves `(1 − α_m) M a_n + α_m M a_{n−1} + (1 − α_f)(C v_n +
+//! K u_n) + α_f (C v + K u) = p̄`, not the equation of motion at `t_n`, so it is a state
+//! of its own: `x = [u; v; a]` (`S = 3N`). With `G = M_eff⁻¹`, `M_eff = (1 − α_m) M +
+//! (1 − α_f)(γh C + βh² K)`, the stepper's operators give the `a` row
+//! `a_n = −GK u + A_v v + A_a a + G p̄`; the load `p̄ = α_f B w_{n−1} + (1 − α_f) B w_n`
+//! gives `Γ₀ = α_f (…) GB`, `Γ₁ = (1 − α_f)(…) GB`, and the Newmark predictor–corrector
+//! the `u` and `v` rows (`u_n = û + βh² a_n`, `v_n = v̂ + γh a_n`). ([`StateSpace::generalized_alpha`].)
+//!
+//! **Exact** ([`Exact`](crate::Exact)): the blocks of its matrix exponential, the
+//! first-order-hold load `p = B w` linear over the step. **Modal**
+//! ([`Modal`](crate::Modal)): the scalar AEM of each kept mode, `x = [η; η']` (`2R` values);
+//! each of the four `R×R` blocks of `Φ` is diagonal.
 //!
 //! Outputs: `y = Y_u u + Y_v v + Y_a a + Y_w w` ([`Outputs`]) — displacements, drifts,
 //! velocities, relative or absolute accelerations — become `H = Y_u U + Y_v V + Y_a A_x`,
 //! `D = Y_a A_w + Y_w` through the maps `u = U x`, `v = V x`, `a = A_x x + A_w w` of the
 //! model ([`StateSpace::outputs`]); an acceleration output has a direct feedthrough `D`.
+//! `a` is the physical acceleration `M⁻¹ (B w − C v − K u)` for every scheme (for
+//! generalized-α too: what an accelerometer measures, not the scheme's variable).
 
 use nalgebra::{SMatrix, SVector};
 
@@ -30,21 +46,25 @@ use crate::kernel::{newmark_operators, start_operators};
 use crate::linalg::lu::{Lu, row_scales};
 use crate::linalg::{Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled};
 use crate::modal::{Damping, lowest_modes, modal_operators};
-use crate::{Error, Exact};
+use crate::schemes::alpha_operators;
+use crate::{AlphaParameters, Error, Exact};
 
 /// The discrete state-space model of a linear scheme with `N` degrees of freedom, state
-/// size `S` (`2N`, or `2R` for `R` modes) and `I` inputs, all in `f64` (row-major:
-/// `phi[i][j]` is row `i`, column `j`):
+/// size `S` (`2N`; `3N` for generalized-α; `2R` for `R` modes) and `I` inputs, all in `f64`
+/// (row-major: `phi[i][j]` is row `i`, column `j`):
 ///
 /// ```text
 /// x_n = Φ x_{n−1} + Γ₀ w_{n−1} + Γ₁ w_n,      u = U x,  v = V x,  a = A_x x + A_w w
 /// ```
 ///
-/// `x = [u; v]` (m, m/s for a building) or, modal, `[η; η']`. Plain matrices a user can
-/// check; [`StateSpace::outputs`] makes the output matrices of any [`Outputs`]. Built by
-/// [`StateSpace::aem`], [`StateSpace::exact`], [`StateSpace::modal`] (run time) or the
-/// `const fn` [`StateSpace::aem_from_rows`], [`StateSpace::modal_from_rows`] (in a
-/// `static`: computed by the compiler).
+/// `x = [u; v]` (m, m/s for a building), `[u; v; a]` (generalized-α; m/s² for `a`) or,
+/// modal, `[η; η']`. Plain matrices a user can check; [`StateSpace::outputs`] makes the
+/// output matrices of any [`Outputs`]. Built by [`StateSpace::aem`],
+/// [`StateSpace::newmark`], [`StateSpace::generalized_alpha`], [`StateSpace::exact`],
+/// [`StateSpace::modal`] (run time) or the `const fn` [`StateSpace::aem_from_rows`],
+/// [`StateSpace::newmark_from_rows`], [`StateSpace::generalized_alpha_from_rows`],
+/// [`StateSpace::modal_from_rows`] (in a `static`: computed by the compiler). Each
+/// reproduces its stepper to rounding (`tests/state_space.rs`).
 ///
 /// Size: `S² + 2S·I + N·(3S + I) + 1` values of `f64` (a build-time object: the
 /// observers keep only what they step with).
@@ -60,7 +80,9 @@ pub struct StateSpace<const N: usize, const S: usize, const I: usize> {
     pub dof_u: [[f64; S]; N],
     /// `V` (`N×S`): the velocities `v = V x`.
     pub dof_v: [[f64; S]; N],
-    /// `A_x` (`N×S`): the accelerations (relative to the base) `a = A_x x + A_w w`.
+    /// `A_x` (`N×S`): the accelerations (relative to the base) `a = A_x x + A_w w`, the
+    /// physical `M⁻¹ (B w − C v − K u)` for every builder (zero columns on the `a` block
+    /// of a generalized-α state).
     pub dof_a: [[f64; S]; N],
     /// `A_w` (`N×I`): the accelerations' direct dependence on the input.
     pub dof_a_input: [[f64; I]; N],
@@ -178,9 +200,10 @@ impl<const S: usize, const I: usize, const O: usize> Measurement<S, I, O> {
     }
 }
 
-/// The blocks of one AEM step in `f64`: `u_n = uu u + uv v + u0 w_{n−1} + u1 w_n`, same for
-/// `v_n`; `a = au u + av v + aw w` (the equation of motion).
-struct AemBlocks<const N: usize, const I: usize> {
+/// The blocks of one Newmark step (β, γ; the AEM is β = 1/4, γ = 1/2) in `f64`:
+/// `u_n = uu u + uv v + u0 w_{n−1} + u1 w_n`, same for `v_n`; `a = au u + av v + aw w`
+/// (the equation of motion).
+struct NewmarkBlocks<const N: usize, const I: usize> {
     uu: Mat<N, N>,
     uv: Mat<N, N>,
     vu: Mat<N, N>,
@@ -199,18 +222,22 @@ const fn axpy<const R: usize, const C: usize>(a: &Mat<R, C>, s: f64, b: &Mat<R, 
     add_scaled(a, s, b)
 }
 
-/// The AEM step as blocks (see the module docs): factorizations of `M` and `M_eff`, solves.
-const fn aem_blocks<const N: usize, const I: usize>(
+/// The Newmark step (β, γ) as blocks (see the module docs): factorizations of `M` and
+/// `M_eff = M + γh C + βh² K`, solves. The checks of [`newmark_operators`] (the
+/// steppers'), after `B`'s.
+const fn newmark_blocks<const N: usize, const I: usize>(
     m: &Rows<N>,
     c: &Rows<N>,
     k: &Rows<N>,
     b: &Mat<N, I>,
     h: f64,
-) -> Result<AemBlocks<N, I>, Error> {
+    beta: f64,
+    gamma: f64,
+) -> Result<NewmarkBlocks<N, I>, Error> {
     if !all_finite(b) {
         return Err(Error::NonFiniteInput);
     }
-    let op = match newmark_operators(m, c, k, h, 0.25, 0.5, f64::MAX) {
+    let op = match newmark_operators(m, c, k, h, beta, gamma, f64::MAX) {
         Ok(op) => op,
         Err(e) => return Err(e),
     };
@@ -244,7 +271,7 @@ const fn aem_blocks<const N: usize, const I: usize>(
     );
     // Corrector: u_n = û + β h² q, v_n = v̂ + γ h q.
     let (bh2, gh) = (kin.beta_h2, kin.gamma_h);
-    let blocks = AemBlocks {
+    let blocks = NewmarkBlocks {
         uu: axpy(&uh_u, bh2, &qu),
         uv: axpy(&uh_v, bh2, &qv),
         vu: axpy(&vh_u, gh, &qu),
@@ -299,7 +326,8 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// The full-state form of [`Linear`](crate::Linear) / [`LinearInput`](crate::LinearInput)
     /// (the AEM) for `M u'' + C u' + K u = B w(t)`, `x = [u; v]`, `S = 2N` (`const fn`; see
     /// the module docs for the derivation). `M, C, K` are `N×N`, `B` is `N×I`, row-major
-    /// `f64`; `h` in s. The same data as the steppers' `from_rows`.
+    /// `f64`; `h` in s. The same data as the steppers' `from_rows`. The same numbers, bit
+    /// for bit, as [`StateSpace::newmark_from_rows`] with β = 1/4, γ = 1/2.
     ///
     /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`],
     /// [`Error::InvalidTimeStep`], [`Error::SingularEffectiveMatrix`],
@@ -314,10 +342,49 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         b: [[f64; I]; N],
         h: f64,
     ) -> Result<Self, Error> {
+        Self::newmark_from_rows(m, c, k, b, h, 0.25, 0.5)
+    }
+
+    /// [`StateSpace::aem_from_rows`] from `nalgebra` matrices (run time; same numbers).
+    ///
+    /// Errors and cost: as [`StateSpace::aem_from_rows`].
+    pub fn aem(
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        b: &SMatrix<f64, N, I>,
+        h: f64,
+    ) -> Result<Self, Error> {
+        Self::aem_from_rows(rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(b), h)
+    }
+
+    /// The full-state form of [`Newmark`](crate::Newmark) with parameters `beta` (β ≥ 0) and
+    /// `gamma` (γ ≥ 0) for `M u'' + C u' + K u = B w(t)`, `x = [u; v]`, `S = 2N`
+    /// (`const fn`; derivation in the module docs). `M, C, K` are `N×N`, `B` is `N×I`,
+    /// row-major `f64`; `h` in s. Reproduces the stepper driven with `p_n = B w_n` from
+    /// any state whose acceleration satisfies the equation of motion — its start
+    /// (`Stepper::start`) and every state after a step.
+    ///
+    /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`] (also for
+    /// `B`), then those of [`Newmark::new`](crate::Newmark::new) for the same data, in its
+    /// order ([`Error::InvalidTimeStep`], [`Error::InvalidParameter`],
+    /// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`]), and
+    /// [`Error::SingularMass`] (the state-space form needs `a = M⁻¹(…)`).
+    ///
+    /// Cost: about `12N³ + 4N²·I` `f64` flops and a few `N×N` temporaries on the stack.
+    pub const fn newmark_from_rows(
+        m: Rows<N>,
+        c: Rows<N>,
+        k: Rows<N>,
+        b: [[f64; I]; N],
+        h: f64,
+        beta: f64,
+        gamma: f64,
+    ) -> Result<Self, Error> {
         if S != 2 * N {
             return Err(Error::StateSizeMismatch);
         }
-        let bl = match aem_blocks(&m, &c, &k, &b, h) {
+        let bl = match newmark_blocks(&m, &c, &k, &b, h, beta, gamma) {
             Ok(bl) => bl,
             Err(e) => return Err(e),
         };
@@ -343,17 +410,213 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         }
     }
 
-    /// [`StateSpace::aem_from_rows`] from `nalgebra` matrices (run time; same numbers).
+    /// [`StateSpace::newmark_from_rows`] from `nalgebra` matrices (run time; same numbers).
     ///
-    /// Errors and cost: as [`StateSpace::aem_from_rows`].
-    pub fn aem(
+    /// Errors and cost: as [`StateSpace::newmark_from_rows`].
+    #[allow(clippy::too_many_arguments)] // the stepper's arguments, plus B
+    pub fn newmark(
         m: &SMatrix<f64, N, N>,
         c: &SMatrix<f64, N, N>,
         k: &SMatrix<f64, N, N>,
         b: &SMatrix<f64, N, I>,
         h: f64,
+        beta: f64,
+        gamma: f64,
     ) -> Result<Self, Error> {
-        Self::aem_from_rows(rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(b), h)
+        Self::newmark_from_rows(
+            rows_f64(m),
+            rows_f64(c),
+            rows_f64(k),
+            rows_f64(b),
+            h,
+            beta,
+            gamma,
+        )
+    }
+
+    /// The form of [`GeneralizedAlpha`](crate::GeneralizedAlpha) (and HHT-α) with
+    /// parameters `params` for `M u'' + C u' + K u = B w(t)`: `x = [u; v; a]`, `S = 3N`,
+    /// where `a` is the scheme's own acceleration variable, which does not satisfy the
+    /// equation of motion (`const fn`; derivation in the module docs). `M, C, K` are `N×N`,
+    /// `B` is `N×I`, row-major `f64`; `h` in s. Reproduces
+    /// [`Stepper::step_with_previous_input`](crate::Stepper::step_with_previous_input)
+    /// with `p_{n−1} = B w_{n−1}`, `p_n = B w_n` (the textbook scheme: the load at
+    /// `t_{n−α_f}`, so `Γ₀ ≠ 0`). The stepper's `step(p)` takes `p_{n−1} = p_n`: its form
+    /// has `Γ₀ + Γ₁` in place of `Γ₁` and no `Γ₀`. Start from
+    /// [`StateSpace::initial_state`], what the stepper's `start` computes.
+    ///
+    /// Outputs: the acceleration map `a = A_x x + A_w w` ([`StateSpace::outputs`]) is the
+    /// *physical* acceleration `M⁻¹ (B w − C v − K u)`, what an accelerometer measures (the
+    /// columns of the `a` block of `A_x` are zero). The scheme's acceleration variable is
+    /// the last `N` entries of `x`; read it with `H = [0 0 Y]` written by hand.
+    ///
+    /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 3N`), [`Error::NonFiniteInput`] (also for
+    /// `B`), then those of
+    /// [`GeneralizedAlpha::with_parameters`](crate::GeneralizedAlpha::with_parameters) for
+    /// the same data, in its order ([`Error::InvalidTimeStep`],
+    /// [`Error::InvalidParameter`], [`Error::SingularEffectiveMatrix`],
+    /// [`Error::OperatorOverflow`]), and [`Error::SingularMass`] (the acceleration output
+    /// and the start need `M⁻¹`).
+    ///
+    /// Cost: about `14N³ + 4N²·I` `f64` flops and a few `N×N` temporaries on the stack.
+    pub const fn generalized_alpha_from_rows(
+        m: Rows<N>,
+        c: Rows<N>,
+        k: Rows<N>,
+        b: [[f64; I]; N],
+        h: f64,
+        params: AlphaParameters,
+    ) -> Result<Self, Error> {
+        if S != 3 * N {
+            return Err(Error::StateSizeMismatch);
+        }
+        if !all_finite(&b) {
+            return Err(Error::NonFiniteInput);
+        }
+        let op = match alpha_operators(&m, &c, &k, h, &params, f64::MAX) {
+            Ok(op) => op,
+            Err(e) => return Err(e),
+        };
+        let (lu_m, st) = match op.start {
+            Some(s) => s,
+            None => return Err(Error::SingularMass),
+        };
+        let kin = op.kin;
+        let id: Mat<N, N> = identity();
+        // The new acceleration: a_n = −GK u + A_v v + A_a a + G p̄, p̄ = α_f B w_{n−1} +
+        // (1 − α_f) B w_n (G B by a solve).
+        let au = scaled(-1.0, &op.gk);
+        let gb = op.lu.solve(&b);
+        let a0 = scaled(params.alpha_f, &gb);
+        let a1 = scaled(1.0 - params.alpha_f, &gb);
+        // Predictor: v̂ = v + c_v a, û = u + h v̂ − c_u a (blocks on (u, v, a)).
+        let vh_a = scaled(kin.c_v, &id);
+        let uh_v = scaled(kin.h, &id);
+        let uh_a = axpy(&scaled(kin.h, &vh_a), -kin.c_u, &id);
+        // Corrector: u_n = û + β h² a_n, v_n = v̂ + γ h a_n.
+        let (bh2, gh) = (kin.beta_h2, kin.gamma_h);
+        let mut ss = Self::zero(h);
+        put(&mut ss.phi, &axpy(&id, bh2, &au), 0, 0);
+        put(&mut ss.phi, &axpy(&uh_v, bh2, &op.av), 0, N);
+        put(&mut ss.phi, &axpy(&uh_a, bh2, &op.aa), 0, 2 * N);
+        put(&mut ss.phi, &scaled(gh, &au), N, 0);
+        put(&mut ss.phi, &axpy(&id, gh, &op.av), N, N);
+        put(&mut ss.phi, &axpy(&vh_a, gh, &op.aa), N, 2 * N);
+        put(&mut ss.phi, &au, 2 * N, 0);
+        put(&mut ss.phi, &op.av, 2 * N, N);
+        put(&mut ss.phi, &op.aa, 2 * N, 2 * N);
+        put(&mut ss.gamma0, &scaled(bh2, &a0), 0, 0);
+        put(&mut ss.gamma0, &scaled(gh, &a0), N, 0);
+        put(&mut ss.gamma0, &a0, 2 * N, 0);
+        put(&mut ss.gamma1, &scaled(bh2, &a1), 0, 0);
+        put(&mut ss.gamma1, &scaled(gh, &a1), N, 0);
+        put(&mut ss.gamma1, &a1, 2 * N, 0);
+        put(&mut ss.dof_u, &id, 0, 0);
+        put(&mut ss.dof_v, &id, 0, N);
+        // The physical acceleration M⁻¹ (B w − C v − K u).
+        put(&mut ss.dof_a, &scaled(-1.0, &st.minv_k), 0, 0);
+        put(&mut ss.dof_a, &scaled(-1.0, &st.minv_c), 0, N);
+        ss.dof_a_input = lu_m.solve(&b);
+        if ss.all_finite() {
+            Ok(ss)
+        } else {
+            Err(Error::OperatorOverflow)
+        }
+    }
+
+    /// [`StateSpace::generalized_alpha_from_rows`] from `nalgebra` matrices (run time; same
+    /// numbers). `params` from [`AlphaParameters::chung_hulbert`] (the
+    /// [`GeneralizedAlpha::new`](crate::GeneralizedAlpha::new) of `ρ∞`),
+    /// [`AlphaParameters::hht`] or written out.
+    ///
+    /// ```
+    /// use aemstep::observer::StateSpace;
+    /// use aemstep::nalgebra::{matrix, vector};
+    /// use aemstep::{AlphaParameters, GeneralizedAlpha, Stepper};
+    /// let (m, c, k, b, h) = (matrix![2.0], matrix![0.3], matrix![50.0], matrix![1.0], 0.01);
+    /// let p = AlphaParameters::chung_hulbert(0.8)?;
+    /// let ss = StateSpace::<1, 3, 1>::generalized_alpha(&m, &c, &k, &b, h, p)?;
+    /// let sys = GeneralizedAlpha::<f64, 1>::with_parameters(&m, &c, &k, h, p)?;
+    /// // x = [u; v; a] with the stepper's start-up acceleration.
+    /// let (u0, v0, w0, w1) = (vector![0.1], vector![0.0], vector![1.0], vector![2.0]);
+    /// let mut x = ss.initial_state(&u0, &v0, &w0)?;
+    /// let mut s = sys.start(&u0, &v0, &(b * w0))?;
+    /// assert!((x[2] - s.a()[0]).abs() <= 1e-14); // a0 = −2 m/s², to rounding
+    /// x = ss.phi_matrix() * x + ss.gamma0_matrix() * w0 + ss.gamma1_matrix() * w1;
+    /// sys.step_with_previous_input(&mut s, &(b * w0), &(b * w1));
+    /// assert!((x[0] - s.u()[0]).abs() <= 1e-15 && (x[2] - s.a()[0]).abs() <= 1e-14);
+    /// # Ok::<(), aemstep::Error>(())
+    /// ```
+    ///
+    /// Errors and cost: as [`StateSpace::generalized_alpha_from_rows`].
+    pub fn generalized_alpha(
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        b: &SMatrix<f64, N, I>,
+        h: f64,
+        params: AlphaParameters,
+    ) -> Result<Self, Error> {
+        Self::generalized_alpha_from_rows(
+            rows_f64(m),
+            rows_f64(c),
+            rows_f64(k),
+            rows_f64(b),
+            h,
+            params,
+        )
+    }
+
+    /// The state at the start of a full-state model (every builder but the modal one) from
+    /// displacements `u0` (m), velocities `v0` (m/s) and input `w0`: `[u0; v0]`, and for
+    /// [`StateSpace::generalized_alpha`] (`S = 3N`) `[u0; v0; a0]` with
+    /// `a0 = M⁻¹ (B w0 − C v0 − K u0)` — what the steppers' `start` computes. For a modal
+    /// model use [`StateSpace::modal_coordinates`].
+    ///
+    /// Errors: [`Error::NonFiniteInput`]; [`Error::StateSizeMismatch`] for a model whose
+    /// state does not begin with `[u; v]` (a modal model, `U ≠ [I 0 …]`).
+    ///
+    /// Cost: `N·(S + I)` flops and a scan of `U`, `V`.
+    pub fn initial_state(
+        &self,
+        u0: &SVector<f64, N>,
+        v0: &SVector<f64, N>,
+        w0: &SVector<f64, I>,
+    ) -> Result<SVector<f64, S>, Error> {
+        if !u0
+            .iter()
+            .chain(v0.iter())
+            .chain(w0.iter())
+            .all(|x| x.is_finite())
+        {
+            return Err(Error::NonFiniteInput);
+        }
+        let one = |c: bool| if c { 1.0 } else { 0.0 };
+        let full = (0..N).all(|i| {
+            (0..S).all(|j| self.dof_u[i][j] == one(j == i) && self.dof_v[i][j] == one(j == N + i))
+        });
+        if !full {
+            return Err(Error::StateSizeMismatch);
+        }
+        let mut x = SVector::<f64, S>::zeros();
+        for i in 0..N {
+            x[i] = u0[i];
+            x[N + i] = v0[i];
+        }
+        if S == 3 * N {
+            // a0 = A_x x + A_w w0 (the a-block of A_x is zero, and so is that of x).
+            for i in 0..N {
+                let mut a = 0.0;
+                for j in 0..S {
+                    a += self.dof_a[i][j] * x[j];
+                }
+                for j in 0..I {
+                    a += self.dof_a_input[i][j] * w0[j];
+                }
+                x[2 * N + i] = a;
+            }
+        }
+        Ok(x)
     }
 
     /// The full-state form of [`Exact`] (matrix exponential, load `p = B w` linear over
@@ -434,11 +697,18 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         let mut ss = Self::zero(h);
         let mut r = 0;
         while r < R {
-            let bl =
-                match aem_blocks::<1, I>(&[[1.0]], &[[op.c[r]]], &[[op.k[r]]], &[op.gamma[r]], h) {
-                    Ok(bl) => bl,
-                    Err(e) => return Err(e),
-                };
+            let bl = match newmark_blocks::<1, I>(
+                &[[1.0]],
+                &[[op.c[r]]],
+                &[[op.k[r]]],
+                &[op.gamma[r]],
+                h,
+                0.25,
+                0.5,
+            ) {
+                Ok(bl) => bl,
+                Err(e) => return Err(e),
+            };
             ss.phi[r][r] = bl.uu[0][0];
             ss.phi[r][R + r] = bl.uv[0][0];
             ss.phi[R + r][r] = bl.vu[0][0];

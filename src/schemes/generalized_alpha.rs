@@ -24,10 +24,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, checked_rows, start_operators, terms_scales};
-use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step};
+use crate::kernel::{StartOps, start_operators, terms_scales};
+use crate::kinematics::{Kinematics, NewmarkKinematics};
 use crate::linalg::lu::{Lu, condition};
-use crate::linalg::{add_scaled, all_finite, finite_as, round_rows, scaled};
+use crate::linalg::{Mat, add_scaled, all_finite, finite_as, round_rows, rows_f64, scaled};
 use crate::{Error, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
@@ -46,9 +46,11 @@ pub struct AlphaParameters {
 impl AlphaParameters {
     /// Chung–Hulbert parameters for the high-frequency spectral radius `rho_inf ∈ [0, 1]`.
     ///
-    /// Errors: [`Error::InvalidParameter`] outside `[0, 1]` or not finite.
-    pub fn chung_hulbert(rho_inf: f64) -> Result<Self, Error> {
-        if !(0.0..=1.0).contains(&rho_inf) {
+    /// Errors: [`Error::InvalidParameter`] outside `[0, 1]` or not finite. `const fn`
+    /// (usable in a `static`); cost O(1).
+    pub const fn chung_hulbert(rho_inf: f64) -> Result<Self, Error> {
+        // Written as comparisons (`contains` is not `const`); NaN fails both.
+        if !(rho_inf >= 0.0 && rho_inf <= 1.0) {
             return Err(Error::InvalidParameter);
         }
         let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
@@ -65,9 +67,10 @@ impl AlphaParameters {
     /// Hilber–Hughes–Taylor parameters for `alpha ∈ [−1/3, 0]` (Hilber's sign):
     /// `α_m = 0`, `α_f = −α`, `γ = 1/2 − α`, `β = (1 − α)²/4`; `ρ∞ = (1 + α)/(1 − α)`.
     ///
-    /// Errors: [`Error::InvalidParameter`] outside `[−1/3, 0]` or not finite.
-    pub fn hht(alpha: f64) -> Result<Self, Error> {
-        if !(-1.0 / 3.0..=0.0).contains(&alpha) {
+    /// Errors: [`Error::InvalidParameter`] outside `[−1/3, 0]` or not finite. `const fn`
+    /// (usable in a `static`); cost O(1).
+    pub const fn hht(alpha: f64) -> Result<Self, Error> {
+        if !(alpha >= -1.0 / 3.0 && alpha <= 0.0) {
             return Err(Error::InvalidParameter);
         }
         Ok(Self {
@@ -77,6 +80,99 @@ impl AlphaParameters {
             gamma: 0.5 - alpha,
         })
     }
+}
+
+/// The `f64` operators of a generalized-α step, `a_n = G p̄ − GK u_{n−1} + A_v v_{n−1} +
+/// A_a a_{n−1}` with `p̄ = (1 − α_f) p_n + α_f p_{n−1}` and `G = M_eff⁻¹`, the kinematics,
+/// the factorization of `M_eff` (for further solves, e.g. `G B`) and the start-up
+/// operators: shared by [`GeneralizedAlpha`] (rounded to `T`) and the state-space form
+/// ([`StateSpace::generalized_alpha`](crate::observer::StateSpace::generalized_alpha)).
+pub(crate) struct AlphaOps<const N: usize> {
+    pub g: Mat<N, N>,
+    pub gk: Mat<N, N>,
+    pub av: Mat<N, N>,
+    pub aa: Mat<N, N>,
+    pub kin: NewmarkKinematics<f64>,
+    pub lu: Lu<N>,
+    /// `κ₁` of the row-equilibrated `M_eff` ([`condition`]).
+    pub condition: f64,
+    /// The factorization of `M` (if regular) and the start-up operators.
+    pub start: Option<(Lu<N>, StartOps<f64, N>)>,
+}
+
+/// Check `M, C, K, h` and the parameters and build the generalized-α operators by
+/// factorizing `M_eff = (1 − α_m) M + (1 − α_f)(γh C + βh² K)` and solving (`const fn`).
+/// `max`: the largest finite value of the scalar type the operators will be rounded to.
+///
+/// Errors, in this order: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
+/// [`Error::InvalidParameter`], [`Error::OperatorOverflow`] (`M_eff` not finite),
+/// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`].
+pub(crate) const fn alpha_operators<const N: usize>(
+    m: &Mat<N, N>,
+    c: &Mat<N, N>,
+    k: &Mat<N, N>,
+    h: f64,
+    p: &AlphaParameters,
+    max: f64,
+) -> Result<AlphaOps<N>, Error> {
+    if !(all_finite(m) && all_finite(c) && all_finite(k)) {
+        return Err(Error::NonFiniteInput);
+    }
+    let AlphaParameters {
+        alpha_m,
+        alpha_f,
+        beta,
+        gamma,
+    } = *p;
+    let finite =
+        alpha_m.is_finite() && alpha_f.is_finite() && beta.is_finite() && gamma.is_finite();
+    // The time step first (as the stepper always checked it), then the parameters.
+    let kin = match NewmarkKinematics::new(h, beta, gamma) {
+        Ok(kin) => kin,
+        Err(e) => return Err(e),
+    };
+    if !(finite && alpha_m < 1.0 && alpha_f < 1.0 && beta >= 0.0 && gamma >= 0.0) {
+        return Err(Error::InvalidParameter);
+    }
+    let hf = kin.h;
+    let f1 = 1.0 - alpha_f;
+    let (wm, wc, wk) = (1.0 - alpha_m, f1 * gamma * hf, f1 * beta * hf * hf);
+    let mm = scaled(wm, m);
+    let meff = add_scaled(&add_scaled(&mm, wc, c), wk, k);
+    let scales = terms_scales(&mm, c, k, wc, wk);
+    if !all_finite(&meff) {
+        return Err(Error::OperatorOverflow);
+    }
+    let lu = match Lu::new(&meff, &scales) {
+        Some(lu) => lu,
+        None => return Err(Error::SingularEffectiveMatrix),
+    };
+    let (g, gc, gk, gm) = (lu.inverse(), lu.solve(c), lu.solve(k), lu.solve(m));
+    // a_n = G p̄ − α_m GM a − (1−α_f) GC v̂ − (1−α_f) GK û − α_f (GC v + GK u), with
+    // v̂ = v + (1−γ)h a, û = u + h v + (1/2−β)h² a, collected on (u, v, a).
+    let av = add_scaled(&scaled(-1.0, &gc), -f1 * hf, &gk);
+    let aa = add_scaled(
+        &add_scaled(&scaled(-alpha_m, &gm), -f1 * (1.0 - gamma) * hf, &gc),
+        -f1 * (0.5 - beta) * hf * hf,
+        &gk,
+    );
+    if !(finite_as(&g, max) && finite_as(&gk, max) && finite_as(&av, max) && finite_as(&aa, max)) {
+        return Err(Error::OperatorOverflow);
+    }
+    let start = match start_operators(m, c, k, max) {
+        Ok(s) => s,
+        Err(e) => return Err(e),
+    };
+    Ok(AlphaOps {
+        g,
+        gk,
+        av,
+        aa,
+        kin,
+        lu,
+        condition: condition(&meff, &g, &scales),
+        start,
+    })
 }
 
 /// A generalized-α stepper for constant `M, C, K` (see the module docs for the
@@ -156,53 +252,19 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
         h: f64,
         p: AlphaParameters,
     ) -> Result<Self, Error> {
-        let (m, c, k) = checked_rows(m, c, k)?;
-        let hf = check_time_step(h)?;
-        let AlphaParameters {
-            alpha_m,
-            alpha_f,
-            beta,
-            gamma,
-        } = p;
-        let finite = [alpha_m, alpha_f, beta, gamma]
-            .iter()
-            .all(|x| x.is_finite());
-        if !(finite && alpha_m < 1.0 && alpha_f < 1.0 && beta >= 0.0 && gamma >= 0.0) {
-            return Err(Error::InvalidParameter);
-        }
-        let f1 = 1.0 - alpha_f;
-        let (wm, wc, wk) = (1.0 - alpha_m, f1 * gamma * hf, f1 * beta * hf * hf);
-        let meff = add_scaled(&add_scaled(&scaled(wm, &m), wc, &c), wk, &k);
-        let scales = terms_scales(&scaled(wm, &m), &c, &k, wc, wk);
-        if !all_finite(&meff) {
-            return Err(Error::OperatorOverflow);
-        }
-        let lu = Lu::new(&meff, &scales).ok_or(Error::SingularEffectiveMatrix)?;
-        let (g, gc, gk, gm) = (lu.inverse(), lu.solve(&c), lu.solve(&k), lu.solve(&m));
-        // a_n = G p̄ − α_m GM a − (1−α_f) GC v̂ − (1−α_f) GK û − α_f (GC v + GK u), with
-        // v̂ = v + (1−γ)h a, û = u + h v + (1/2−β)h² a, collected on (u, v, a).
-        let av = add_scaled(&scaled(-1.0, &gc), -f1 * hf, &gk);
-        let aa = add_scaled(
-            &add_scaled(&scaled(-alpha_m, &gm), -f1 * (1.0 - gamma) * hf, &gc),
-            -f1 * (0.5 - beta) * hf * hf,
-            &gk,
-        );
-        let max = T::MAX;
-        if ![&g, &gk, &av, &aa].iter().all(|x| finite_as(x, max)) {
-            return Err(Error::OperatorOverflow);
-        }
-        let start = start_operators(&m, &c, &k, max)?;
+        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+        let op = alpha_operators(&m, &c, &k, h, &p, T::MAX)?;
         Ok(Self {
             params: p,
-            w1: T::from_f64_rounded(f1),
-            w0: T::from_f64_rounded(alpha_f),
-            kin: NewmarkKinematics::new(hf, beta, gamma)?.round(),
-            g: round_rows(&g),
-            gk: round_rows(&gk),
-            av: round_rows(&av),
-            aa: round_rows(&aa),
-            start: start.map(|(_, s)| s.round()),
-            condition: condition(&meff, &g, &scales),
+            w1: T::from_f64_rounded(1.0 - p.alpha_f),
+            w0: T::from_f64_rounded(p.alpha_f),
+            kin: op.kin.round(),
+            g: round_rows(&op.g),
+            gk: round_rows(&op.gk),
+            av: round_rows(&op.av),
+            aa: round_rows(&op.aa),
+            start: op.start.map(|(_, s)| s.round()),
+            condition: op.condition,
         })
     }
 
