@@ -166,11 +166,9 @@ mod tests {
 pub struct Duffing;
 
 impl<T: crate::Real> crate::Model<T, 1> for Duffing {
-    #[inline]
     fn mass(&self) -> nalgebra::SMatrix<T, 1, 1> {
         nalgebra::matrix![T::one()]
     }
-    #[inline]
     fn force(
         &self,
         u: &nalgebra::SVector<T, 1>,
@@ -179,7 +177,6 @@ impl<T: crate::Real> crate::Model<T, 1> for Duffing {
         let (u, v) = (u[0], v[0]);
         nalgebra::vector![T::from_f64_rounded(0.2) * v + u + u * u * u]
     }
-    #[inline]
     fn tangent(
         &self,
         u: &nalgebra::SVector<T, 1>,
