@@ -58,6 +58,11 @@ pub enum Error {
     /// `f64`, or exceeds the largest finite value of `T` (e.g. `f32`) and would round to
     /// `∞`.
     OperatorOverflow,
+    /// An operator computed from nonzero data underflows the scalar type: it rounds to
+    /// zero, or its largest entry is subnormal (below `MIN_POSITIVE` of `T`), where it has
+    /// lost its precision (e.g. `M⁻¹K ≈ 1e-324` from data whose scales are 1e300 apart).
+    /// Rescale the units.
+    OperatorUnderflow,
     /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) is not finite or is
     /// outside its documented range.
     InvalidParameter,
@@ -123,6 +128,7 @@ impl Error {
             Error::EigenNotConverged => "the symmetric eigen-solver did not converge",
             Error::InvalidParameter => "a scheme parameter is not finite or out of range",
             Error::OperatorOverflow => "an operator overflows the scalar type",
+            Error::OperatorUnderflow => "an operator underflows the scalar type: rescale the units",
             Error::InvalidPeriod => {
                 "a period is not finite and > 0, or the periods are not in non-decreasing order"
             }

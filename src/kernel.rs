@@ -10,7 +10,7 @@ use nalgebra::SVector;
 use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics};
 use crate::linalg::lu::{Lu, condition, row_scales};
 use crate::linalg::op_rows::OpRows;
-use crate::linalg::{Mat, add_scaled, all_finite, finite_as, round_rows, rows_f64};
+use crate::linalg::{Mat, add_scaled, all_finite, finite_as, round_rows, rows_f64, underflows};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
@@ -331,11 +331,14 @@ pub(crate) const fn start_operators<const N: usize>(
         minv_c: lu.solve(c),
         minv_k: lu.solve(k),
     };
-    if finite_as(&s.minv, max) && finite_as(&s.minv_c, max) && finite_as(&s.minv_k, max) {
-        Ok(Some((lu, s)))
-    } else {
-        Err(Error::OperatorOverflow)
+    if !(finite_as(&s.minv, max) && finite_as(&s.minv_c, max) && finite_as(&s.minv_k, max)) {
+        return Err(Error::OperatorOverflow);
     }
+    if underflows(&s.minv, m, max) || underflows(&s.minv_c, c, max) || underflows(&s.minv_k, k, max)
+    {
+        return Err(Error::OperatorUnderflow);
+    }
+    Ok(Some((lu, s)))
 }
 
 /// The `f64` operators of the Newmark-family kernel: `G = M_eff⁻¹`, `G C`, `G K` with
@@ -387,7 +390,8 @@ pub(crate) const fn terms_scales<const N: usize>(
 ///
 /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
 /// [`Error::InvalidParameter`] (β or γ negative or not finite),
-/// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`].
+/// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`],
+/// [`Error::OperatorUnderflow`].
 pub(crate) const fn newmark_operators<const N: usize>(
     m: &Mat<N, N>,
     c: &Mat<N, N>,
@@ -424,6 +428,9 @@ pub(crate) const fn newmark_operators<const N: usize>(
     let (g, gc, gk) = (lu.inverse(), lu.solve(c), lu.solve(k));
     if !(finite_as(&g, max) && finite_as(&gc, max) && finite_as(&gk, max)) {
         return Err(Error::OperatorOverflow);
+    }
+    if underflows(&g, &meff, max) || underflows(&gc, c, max) || underflows(&gk, k, max) {
+        return Err(Error::OperatorUnderflow);
     }
     let start = match start_operators(m, c, k, max) {
         Ok(s) => s,

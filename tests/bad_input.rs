@@ -252,3 +252,39 @@ fn nan_load_is_the_same_error_everywhere() {
         nan,
     );
 }
+
+/// Operators that underflow (found by the property tests of `tests/properties.rs`): with
+/// `M = 1e212`, `K = 1e-112`, `h = 1e99`, `G K = M_eff⁻¹ K ≈ 1e-324` rounds to zero in
+/// `f64`, and a stepper built from it returned `q = 0` instead of `−G K û ≈ −1e-225`. Now
+/// `OperatorUnderflow` from every Newmark-family build, in `f64` and, for an operator
+/// subnormal in `f32`, in `f32`; ordinary data still build and step right. (In `f32` the same data are already refused: `M = 1e212` is not finite
+/// in `f32`.)
+#[test]
+fn operators_that_underflow_are_rejected() {
+    let (m, c, k, h) = (matrix![1e212], matrix![0.0], matrix![1e-112], 1e99);
+    let want = Some(Error::OperatorUnderflow);
+    assert_eq!(Linear::<f64, 1>::new(&m, &c, &k, h).err(), want);
+    assert_eq!(
+        Newmark::<f64, 1>::average_acceleration(&m, &c, &k, h).err(),
+        want
+    );
+    let b = matrix![1.0];
+    assert_eq!(LinearInput::<f64, 1, 1>::new(&m, &c, &k, &b, h).err(), want);
+    // f32: G = 1/M_eff with M_eff = 1e39 rounds to a subnormal f32 (1e-39 < 1.2e-38).
+    let m32 = matrix![1e39];
+    assert_eq!(
+        Linear::<f32, 1>::new(&m32, &matrix![0.0], &matrix![1.0], 0.01).err(),
+        Some(Error::OperatorUnderflow)
+    );
+    // The largest entry normal, a small one subnormal: accepted (normwise it keeps its
+    // precision), and the step agrees with the closed form of the undamped oscillator.
+    let sys = Linear::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![1.0], 0.01)
+        .expect("ordinary data");
+    let mut s = sys
+        .start(&vector![1.0], &vector![0.0], &vector![0.0])
+        .expect("start");
+    sys.try_step(&mut s, &vector![0.0]).expect("step");
+    // One AEM step of u'' + u = 0: u1 = (1 − h²/4)/(1 + h²/4).
+    let u1 = (1.0 - 0.25e-4) / (1.0 + 0.25e-4);
+    assert!((s.u()[0] - u1).abs() <= 4.0 * f64::EPSILON);
+}

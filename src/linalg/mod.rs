@@ -267,6 +267,29 @@ pub(crate) const fn is_symmetric<const N: usize>(a: &Mat<N, N>, rel: f64) -> boo
     true
 }
 
+/// Whether `a`, computed from `source`, lost its precision to underflow in the scalar type
+/// whose largest finite value is `max` (`f64::MAX` or `f32::MAX`): `a` is zero while
+/// `source` is not, or its largest entry is subnormal in that type. Normwise, an operator
+/// whose largest entry is normal keeps its precision: the absolute error of its subnormal
+/// entries is below `ε` times that entry. Cost: two passes over the entries.
+pub(crate) const fn underflows<const R: usize, const C: usize, const R2: usize, const C2: usize>(
+    a: &Mat<R, C>,
+    source: &Mat<R2, C2>,
+    max: f64,
+) -> bool {
+    let min_normal = if max > f32::MAX as f64 {
+        f64::MIN_POSITIVE
+    } else {
+        f32::MIN_POSITIVE as f64
+    };
+    let m = max_abs(a);
+    if m == 0.0 {
+        max_abs(source) != 0.0
+    } else {
+        m < min_normal
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -119,7 +119,7 @@ impl<T: Real, const N: usize, const I: usize> LinearInput<T, N, I> {
     /// in `f64`; computed in `f64`, rounded once to `T`.
     ///
     /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
-    /// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`].
+    /// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`].
     ///
     /// Cost: about `4N³ + 2N²·I` flops in `f64`, a few `N×N` `f64` temporaries on the stack.
     pub fn new(

@@ -64,7 +64,8 @@ impl<T: Real, const N: usize> Linear<T, N> {
     /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (`h ≤ 0`, not finite,
     /// or `h²` out of range), [`Error::SingularEffectiveMatrix`] (singular to working
     /// precision against the size of its terms `|M| + (h/2)|C| + (h²/4)|K|`),
-    /// [`Error::OperatorOverflow`] (an operator does not fit `T`).
+    /// [`Error::OperatorOverflow`] (an operator does not fit `T`), [`Error::OperatorUnderflow`]
+    /// (an operator from nonzero data is zero or subnormal in `T`).
     ///
     /// Cost: about `4N³` flops in `f64` and a few `N×N` `f64` temporaries on the stack.
     pub fn new(

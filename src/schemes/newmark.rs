@@ -56,7 +56,7 @@ impl<T: Real, const N: usize> Newmark<T, N> {
     /// [`Error::InvalidParameter`] (β or γ negative or not finite),
     /// [`Error::SingularEffectiveMatrix`] (`M + γh C + βh² K` singular to working
     /// precision against its terms; e.g. central difference with singular `M`),
-    /// [`Error::OperatorOverflow`].
+    /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`].
     ///
     /// Cost: about `5N³` flops in `f64`, four `N×N` `f64` temporaries on the stack.
     pub fn new(
