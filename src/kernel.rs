@@ -10,7 +10,7 @@ use nalgebra::SVector;
 use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics};
 use crate::linalg::lu::{Lu, condition, row_scales};
 use crate::linalg::op_rows::OpRows;
-use crate::linalg::{Mat, add_scaled, all_finite, finite_as, round_rows, rows_f64, underflows};
+use crate::linalg::{Mat, add_scaled, all_finite, fits, round_rows, rows_f64};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
@@ -313,6 +313,21 @@ impl<const N: usize> StartOps<f64, N> {
     }
 }
 
+/// The verdict of several [`fits`] checks: an overflow if any, else an underflow if any.
+const fn first_error(fit: [Result<(), Error>; 3]) -> Option<Error> {
+    let mut under = None;
+    let mut i = 0;
+    while i < 3 {
+        match fit[i] {
+            Err(Error::OperatorUnderflow) => under = Some(Error::OperatorUnderflow),
+            Err(e) => return Some(e),
+            Ok(()) => {}
+        }
+        i += 1;
+    }
+    under
+}
+
 /// The factorization of `M` and the `StartOps` of `(M, C, K)`; `None` when `M` is singular to working
 /// precision. Errors: [`Error::OperatorOverflow`] if an operator is not finite or exceeds
 /// `max` (the largest finite value of the scalar type it will be rounded to).
@@ -331,14 +346,16 @@ pub(crate) const fn start_operators<const N: usize>(
         minv_c: lu.solve(c),
         minv_k: lu.solve(k),
     };
-    if !(finite_as(&s.minv, max) && finite_as(&s.minv_c, max) && finite_as(&s.minv_k, max)) {
-        return Err(Error::OperatorOverflow);
+    // Overflow anywhere before underflow anywhere (the same verdict whatever the order).
+    let fit = [
+        fits(&s.minv, m, max),
+        fits(&s.minv_c, c, max),
+        fits(&s.minv_k, k, max),
+    ];
+    match first_error(fit) {
+        Some(e) => Err(e),
+        None => Ok(Some((lu, s))),
     }
-    if underflows(&s.minv, m, max) || underflows(&s.minv_c, c, max) || underflows(&s.minv_k, k, max)
-    {
-        return Err(Error::OperatorUnderflow);
-    }
-    Ok(Some((lu, s)))
 }
 
 /// The `f64` operators of the Newmark-family kernel: `G = M_eff⁻¹`, `G C`, `G K` with
@@ -426,11 +443,9 @@ pub(crate) const fn newmark_operators<const N: usize>(
         None => return Err(Error::SingularEffectiveMatrix),
     };
     let (g, gc, gk) = (lu.inverse(), lu.solve(c), lu.solve(k));
-    if !(finite_as(&g, max) && finite_as(&gc, max) && finite_as(&gk, max)) {
-        return Err(Error::OperatorOverflow);
-    }
-    if underflows(&g, &meff, max) || underflows(&gc, c, max) || underflows(&gk, k, max) {
-        return Err(Error::OperatorUnderflow);
+    let fit = [fits(&g, &meff, max), fits(&gc, c, max), fits(&gk, k, max)];
+    if let Some(e) = first_error(fit) {
+        return Err(e);
     }
     let start = match start_operators(m, c, k, max) {
         Ok(s) => s,

@@ -267,27 +267,45 @@ pub(crate) const fn is_symmetric<const N: usize>(a: &Mat<N, N>, rel: f64) -> boo
     true
 }
 
-/// Whether `a`, computed from `source`, lost its precision to underflow in the scalar type
-/// whose largest finite value is `max` (`f64::MAX` or `f32::MAX`): `a` is zero while
-/// `source` is not, or its largest entry is subnormal in that type. Normwise, an operator
-/// whose largest entry is normal keeps its precision: the absolute error of its subnormal
-/// entries is below `ε` times that entry. Cost: two passes over the entries.
-pub(crate) const fn underflows<const R: usize, const C: usize, const R2: usize, const C2: usize>(
+/// Whether `a`, computed from `source`, fits the scalar type whose largest finite value
+/// is `max` (`f64::MAX` or `f32::MAX`), in one pass over `a`:
+/// [`Error::OperatorOverflow`](crate::Error::OperatorOverflow) if an entry is not finite or
+/// exceeds `max`; [`Error::OperatorUnderflow`](crate::Error::OperatorUnderflow) if `a` is
+/// zero while `source` is not (`source` is read only then), or if its largest entry is
+/// subnormal in that type. Normwise, an operator whose largest entry is normal keeps its
+/// precision: the absolute error of its subnormal entries is below `ε` times that entry.
+pub(crate) const fn fits<const R: usize, const C: usize, const R2: usize, const C2: usize>(
     a: &Mat<R, C>,
     source: &Mat<R2, C2>,
     max: f64,
-) -> bool {
+) -> Result<(), crate::Error> {
+    let mut m = 0.0f64;
+    let mut i = 0;
+    while i < R {
+        let mut j = 0;
+        while j < C {
+            // Values within half an ulp above `max` would still round to it, and are
+            // rejected too (harmless).
+            let x = a[i][j].abs();
+            if !x.is_finite() || x > max {
+                return Err(crate::Error::OperatorOverflow);
+            }
+            if x > m {
+                m = x;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
     let min_normal = if max > f32::MAX as f64 {
         f64::MIN_POSITIVE
     } else {
         f32::MIN_POSITIVE as f64
     };
-    let m = max_abs(a);
-    if m == 0.0 {
-        max_abs(source) != 0.0
-    } else {
-        m < min_normal
+    if (m == 0.0 && max_abs(source) != 0.0) || (m != 0.0 && m < min_normal) {
+        return Err(crate::Error::OperatorUnderflow);
     }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -176,7 +176,7 @@ macro_rules! const_ctor {
             ///
             /// **Size limit at compile time**, as for
             /// [`Linear::from_rows`](crate::Linear::from_rows): measured with rustc 1.95,
-            /// `LinearInput<f32, N, 1>` compiles in a `static` up to `N = 64` and stops at 65
+            /// `LinearInput<f32, N, 1>` compiles in a `static` up to `N = 63` and stops at 64
             /// with the `long_running_const_eval` lint (allow it at the firmware's crate
             /// root, or build at run time with [`LinearInput::new`]).
             ///

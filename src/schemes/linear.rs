@@ -125,7 +125,7 @@ macro_rules! const_ctor {
             /// **Size limit at compile time.** The compiler evaluates about `4N³` flops;
             /// past a budget of evaluation steps rustc stops the build with the
             /// `long_running_const_eval` lint (deny by default). Measured with rustc 1.95:
-            /// `Linear<f32, N>` compiles in a `static` up to `N = 64` and stops at 65 (the
+            /// `Linear<f32, N>` compiles in a `static` up to `N = 63` and stops at 64 (the
             /// largest size is pinned by `tests/constructors.rs`). Larger `N` needs
             /// `#![allow(long_running_const_eval)]` at the crate root of the firmware, or
             /// [`Linear::new`] at run time.
