@@ -10,6 +10,10 @@
 //! `n · N · ε` times a factor 8 for the constant in front (measured ratios are quoted at
 //! each assertion).
 
+/// El Centro NS 1940 ground acceleration (m/s²) at dt = 0.02 s.
+#[path = "../examples/modal_fw/elcentro.rs"]
+mod elcentro;
+
 use aemstep::models::base_excitation;
 use aemstep::{Error, Linear, LinearInput, Stepper, models};
 use nalgebra::{SMatrix, SVector};
@@ -118,7 +122,7 @@ fn base_excitation_f32_matches_linear() {
     let lin = Linear::<f32, 5>::from_rows(m, c, k, h).unwrap();
     let inp = LinearInput::<f32, 5, 1>::from_rows(m, c, k, b, h).unwrap();
     let bv = SVector::<f32, 5>::from_fn(|i, _| b[i][0] as f32);
-    let ag = elcentro();
+    let ag = elcentro::AG_F32;
     let z = SVector::<f32, 5>::zeros();
     let mut sl = lin.start(&z, &z, &(bv * ag[0])).unwrap();
     let mut si = inp.start(&z, &z, &SVector::from([ag[0]])).unwrap();
@@ -140,15 +144,6 @@ fn base_excitation_f32_matches_linear() {
     assert!(rel <= bound, "{rel:e} > {bound:e}");
     // …and the f32 run is a real run: peak roof drift of order centimetres.
     assert!(peak > 0.01 && peak < 1.0, "{peak}");
-}
-
-/// El Centro NS 1940 ground acceleration (m/s²) at dt = 0.02 s.
-fn elcentro() -> Vec<f32> {
-    include_str!("../data/elcentro-ns-1940.txt")
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
-        .map(|l| (l.trim().parse::<f64>().unwrap() * 9.80665) as f32)
-        .collect()
 }
 
 #[test]

@@ -10,6 +10,10 @@
 
 #![allow(clippy::needless_range_loop)]
 
+/// El Centro NS 1940 ground acceleration (m/s²) at dt = 0.02 s.
+#[path = "../examples/modal_fw/elcentro.rs"]
+mod elcentro;
+
 use aemstep::modal::lowest_modes;
 use aemstep::models::{base_excitation, storey_drifts};
 use aemstep::{Damping, Error, Linear, LinearInput, Modal, Stepper, models};
@@ -308,15 +312,6 @@ fn building_frequencies_damping_and_mode_selection() {
     assert!((total - 5.0 * models::FIVE_STOREY_MASS).abs() < 1e-9 * total);
 }
 
-/// El Centro NS 1940 ground acceleration (m/s²) at dt = 0.02 s.
-fn elcentro() -> Vec<f64> {
-    include_str!("../data/elcentro-ns-1940.txt")
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
-        .map(|l| l.trim().parse::<f64>().unwrap() * 9.80665)
-        .collect()
-}
-
 /// (peak |roof drift| error, peak |inter-storey drift| error) of `R` modes against the
 /// full `LinearInput` model, f64, h = 0.02, both relative to the full model's peaks.
 fn truncation<const R: usize>(ag: &[f64]) -> (f64, f64) {
@@ -359,7 +354,7 @@ fn truncation<const R: usize>(ag: &[f64]) -> (f64, f64) {
 /// (its effective mass is 88 % of the total for this building).
 #[test]
 fn building_truncation_decreases_with_r() {
-    let ag = elcentro();
+    let ag = elcentro::AG_F64;
     let e = [
         truncation::<1>(&ag),
         truncation::<2>(&ag),
@@ -391,7 +386,7 @@ fn building_truncation_decreases_with_r() {
 /// Measured 6.7e-7 (the damped response forgets most of the drift).
 #[test]
 fn f32_modal_tracks_f64_modal() {
-    let ag = elcentro();
+    let ag = elcentro::AG_F64;
     let (m, c, k) = models::five_storey_building();
     let b = base_excitation(&m);
     let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
