@@ -9,14 +9,15 @@
 //! The tests in `tests/` assert bounds on the same quantities; this program only measures
 //! and prints. Everything here is deterministic IEEE arithmetic (no timing).
 
+#[path = "../tests/support/duffing.rs"]
+mod duffing;
 #[path = "../tests/support/runs.rs"]
 mod runs;
 #[path = "../tests/support/mod.rs"]
 mod support;
 
-use aemstep::models::Duffing;
 use aemstep::models::base_excitation;
-use aemstep::{Linear, LinearInput, NewtonSettings, Nonlinear, Real, Stepper, models};
+use aemstep::{Linear, LinearInput, Real, Stepper, models};
 use nalgebra::{SMatrix, SVector};
 use runs::{
     cross_check, example1_period, example2_error, example2_run, example3_error, example4_error,
@@ -133,28 +134,11 @@ fn tiny_step<T: Real>() -> f64 {
 
 // ------------------------------------------------------------------ nonlinear, time-varying
 
-fn duffing_load(t: f64) -> f64 {
-    -0.01 * (-0.1 * t).exp() * t.sin() + (-0.3 * t).exp() * t.sin().powi(3)
-}
-
-/// Duffing over 0 < t ≤ 20 s, exactly 2 Newton iterations a step (as the firmware):
-/// (max error, steps whose report was not "converged in 2").
+/// Duffing (`tests/support/duffing.rs`) over 0 < t ≤ 20 s, exactly 2 Newton iterations a
+/// step (as the firmware): (max error, steps whose report was not "converged in 2").
 fn duffing<T: Real>(h: f64) -> (f64, u32) {
-    let r = T::from_f64_rounded;
-    let st = Nonlinear::<T, 1>::new(h, NewtonSettings::exactly(2, r(1.5e-5))).unwrap();
-    let mut s = st
-        .start(&Duffing, &vec1(0.0), &vec1(1.0), &vec1(duffing_load(0.0)))
-        .unwrap();
-    let (mut err, mut bad) = (0.0f64, 0);
-    for n in 1..=(20.0 / h).round() as u64 {
-        let t = n as f64 * h;
-        match st.try_step(&Duffing, &mut s, &vec1(duffing_load(t))) {
-            Ok(rep) if rep.converged && rep.iterations == 2 => {}
-            _ => bad += 1,
-        }
-        err = err.max((s.u()[0].as_f64() - (-0.1 * t).exp() * t.sin()).abs());
-    }
-    (err, bad)
+    let (us, bad) = duffing::trajectory::<T>(h, (20.0 / h).round() as u32);
+    (duffing::max_error(&us, h), bad)
 }
 
 // ------------------------------------------------------------------ the page
