@@ -12,6 +12,7 @@
 mod checks;
 #[path = "support/pendulums.rs"]
 mod pendulums;
+mod support;
 
 use aemstep::{
     Error, Linear, Model, NewtonSettings, Nonlinear, Real, State, Stepper, Tangent, models,
@@ -22,6 +23,7 @@ use pendulums::{
     EL_KE0, EL_L, EL_M, Elastic, G, THETA0, elastic_run, max_and_first_tenth, pendulum_energy,
     pendulum_run,
 };
+use support::sm;
 
 fn r<T: Real>(x: f64) -> T {
     T::from_f64_rounded(x)
@@ -205,17 +207,13 @@ impl Model<f64, 5> for LinearModel {
     }
 }
 
-fn rows<const N: usize>(a: &models::Rows<N>) -> SMatrix<f64, N, N> {
-    SMatrix::from_fn(|i, j| a[i][j])
-}
-
 #[test]
 fn linear_force_reproduces_linear() {
     let (m, c, k) = models::five_storey_building();
     let model = LinearModel {
-        m: rows(&m),
-        c: rows(&c),
-        k: rows(&k),
+        m: sm(&m),
+        c: sm(&c),
+        k: sm(&k),
     };
     let h = 0.01;
     let lin = Linear::<f64, _>::new(&model.m, &model.c, &model.k, h).unwrap();

@@ -9,8 +9,9 @@ mod support;
 
 use aemstep::{Coefficients, Error, Linear, Stepper, Varying, models};
 use checks::bits;
-use nalgebra::{SMatrix, SVector, matrix, vector};
+use nalgebra::{SVector, matrix, vector};
 use runs::{Example3, example3_exact, example3_load, example3_start};
+use support::sm;
 
 // ---------------------------------------------------------------- Example 3
 // (`Example3`, `(1 + t²) u'' + t u' + e^{1/(1+t)} u = p(t)`, its exact solution and load:
@@ -79,14 +80,10 @@ fn example3_in_f32() {
 
 // ---------------------------------------------------------------- constant coefficients
 
-fn rows<const N: usize>(a: &models::Rows<N>) -> SMatrix<f64, N, N> {
-    SMatrix::from_fn(|i, j| a[i][j])
-}
-
 #[test]
 fn constant_coefficients_reproduce_linear() {
     let (m, c, k) = models::five_storey_building();
-    let (m, c, k) = (rows(&m), rows(&c), rows(&k));
+    let (m, c, k) = (sm(&m), sm(&c), sm(&k));
     let h = 0.01;
     let lin = Linear::<f64, _>::new(&m, &c, &k, h).unwrap();
     let var = Varying::<f64, 5>::new(h).unwrap();
