@@ -12,6 +12,8 @@ use aemstep::observer::{Kalman, Observer, Outputs, Readout, StateSpace, SteadySt
 use aemstep::{Damping, Error, Exact, LinearInput, Modal, StepState, Stepper};
 use nalgebra::{SMatrix, SVector};
 
+#[path = "support/checks.rs"]
+mod checks;
 #[path = "../examples/modal_fw/elcentro.rs"]
 mod elcentro;
 mod support;
@@ -798,18 +800,9 @@ fn scene_constants_and_firmware_reference_are_current() {
         "firmware reference: f32 vs f64 observer, max |Δ drift| = {measured:.3e} m ({:.2e} of the {peak_drift:.4} m peak), bound {bound:e} m",
         measured / peak_drift
     );
-    let text = generate_reference(&d64, bound);
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/observer_fw/reference.rs"
-    );
-    if std::env::var_os("AEMSTEP_WRITE_REFERENCE").is_some() {
-        std::fs::write(path, &text).unwrap();
-    }
-    assert_eq!(
-        std::fs::read_to_string(path).unwrap(),
-        text,
-        "examples/observer_fw/reference.rs is stale: rerun with AEMSTEP_WRITE_REFERENCE=1"
+    checks::reference_is_current(
+        "examples/observer_fw/reference.rs",
+        &generate_reference(&d64, bound),
     );
     assert_eq!(reference::EVERY, EVERY);
     // f32 against f64: a few f32 ulps of the drift scale, amplified by the observer's
