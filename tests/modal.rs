@@ -10,28 +10,18 @@
 
 #![allow(clippy::needless_range_loop)]
 
-/// El Centro NS 1940 ground acceleration (m/s²) at dt = 0.02 s.
 #[path = "support/checks.rs"]
 mod checks;
+/// El Centro NS 1940 ground acceleration (m/s²) at dt = 0.02 s.
 #[path = "../examples/modal_fw/elcentro.rs"]
 mod elcentro;
+mod support;
 
 use aemstep::modal::lowest_modes;
 use aemstep::models::{base_excitation, storey_drifts};
 use aemstep::{Damping, Error, Linear, LinearInput, Modal, Stepper, models};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
-
-/// xorshift64*: a deterministic test-local generator in [-1, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D);
-        (x >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-}
+use support::Rng;
 
 type Rows<const N: usize> = [[f64; N]; N];
 
@@ -57,7 +47,7 @@ fn reference_modes<const N: usize>(m: &Rows<N>, k: &Rows<N>) -> (Vec<f64>, DMatr
 
 /// Random SPD `M` and `K` (entries O(1) and O(40); well conditioned).
 fn random_mk<const N: usize>(rng: &mut Rng) -> (Rows<N>, Rows<N>) {
-    let r = |rng: &mut Rng| DMatrix::from_fn(N, N, |_, _| rng.next());
+    let r = |rng: &mut Rng| DMatrix::from_fn(N, N, |_, _| rng.uniform());
     let a = r(rng);
     let m = &a * a.transpose() + DMatrix::identity(N, N) * N as f64;
     let b = r(rng);
@@ -78,11 +68,11 @@ enum Kind {
 /// Max relative difference (u, v, a, outputs) between `Modal<f64, N, N, 2, 3>` and
 /// `Linear<f64, N>` over `steps` steps of a random classically damped system.
 fn modal_vs_linear<const N: usize>(seed: u64, kind: Kind, steps: usize) -> f64 {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::from_state(seed);
     let (m, k) = random_mk::<N>(&mut rng);
     let (lam, phi) = reference_modes(&m, &k);
     let (w1, wn) = (lam[0].sqrt(), lam[N - 1].sqrt());
-    let xi: [f64; N] = core::array::from_fn(|_| 0.11 + 0.09 * rng.next()); // 2 … 20 %
+    let xi: [f64; N] = core::array::from_fn(|_| 0.11 + 0.09 * rng.uniform()); // 2 … 20 %
     let (damping, c): (Damping<N>, Rows<N>) = match kind {
         Kind::Rayleigh => {
             let (a0, a1) = models::rayleigh_coefficients(w1, wn, 0.05);
@@ -104,8 +94,8 @@ fn modal_vs_linear<const N: usize>(seed: u64, kind: Kind, steps: usize) -> f64 {
             }
         }
     };
-    let b: [[f64; 2]; N] = core::array::from_fn(|_| [rng.next(), rng.next()]);
-    let y: [[f64; N]; 3] = core::array::from_fn(|_| core::array::from_fn(|_| rng.next()));
+    let b: [[f64; 2]; N] = core::array::from_fn(|_| [rng.uniform(), rng.uniform()]);
+    let y: [[f64; N]; 3] = core::array::from_fn(|_| core::array::from_fn(|_| rng.uniform()));
     let h = 2.0 * core::f64::consts::PI / w1 / 40.0;
 
     let sm = |a: &Rows<N>| SMatrix::<f64, N, N>::from_fn(|i, j| a[i][j]);
@@ -118,8 +108,8 @@ fn modal_vs_linear<const N: usize>(seed: u64, kind: Kind, steps: usize) -> f64 {
         let t = n as f64 * h;
         SVector::<f64, 2>::new((3.0 * t).sin() * 50.0, (t * 0.7).cos() * 30.0 + 10.0)
     };
-    let u0 = SVector::<f64, N>::from_fn(|_, _| rng.next());
-    let v0 = SVector::<f64, N>::from_fn(|_, _| rng.next() * 5.0);
+    let u0 = SVector::<f64, N>::from_fn(|_, _| rng.uniform());
+    let v0 = SVector::<f64, N>::from_fn(|_, _| rng.uniform() * 5.0);
     let mut sl = lin.start(&u0, &v0, &(bm * w_at(0))).unwrap();
     let mut sm_ = modal.start(&u0, &v0, &w_at(0)).unwrap();
     let (mut du, mut dv, mut da, mut dy) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);

@@ -17,6 +17,10 @@ impl Rng {
     pub fn new(seed: u64) -> Self {
         Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
     }
+    /// The generator started from the raw state `state` (no mixing of the seed).
+    pub fn from_state(state: u64) -> Self {
+        Rng(state)
+    }
     /// Uniform in [-1, 1).
     pub fn uniform(&mut self) -> f64 {
         self.0 ^= self.0 >> 12;
