@@ -721,22 +721,27 @@ fn branch_changes_are_reported_and_fixed_iterations_stay_available() {
     }
 }
 
-#[test]
-fn friction_damped_building_steps_and_converges() {
-    // Each storey: the bilinear frame with a friction damper across it slipping at 10 % of
-    // the frame's yield force, v_r = 1 cm/s.
+/// The bilinear building with a friction damper across each storey, slipping at 10 % of
+/// the frame's yield force, regularized over `v_r` (m/s).
+fn friction_damped(vr: f64) -> ShearBuilding<f64, Parallel<Bilinear<f64>, Friction<f64>>, 3> {
     let law = |i: usize| {
         Parallel(
             Bilinear::<f64>::new(building::STIFFNESS, building::YIELD[i], building::ALPHA).unwrap(),
-            Friction::<f64>::new(0.1 * building::YIELD[i], 1e-2).unwrap(),
+            Friction::<f64>::new(0.1 * building::YIELD[i], vr).unwrap(),
         )
     };
-    let b = ShearBuilding::new(
+    ShearBuilding::new(
         [building::MASS; 3],
-        [law(0), law(1), law(2)],
+        core::array::from_fn(law),
         &building::damping(),
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn friction_damped_building_steps_and_converges() {
+    // Each storey: the bilinear frame with a friction damper across it, v_r = 1 cm/s.
+    let b = friction_damped(1e-2);
     let yd = core::array::from_fn(hyst::yield_drift);
     let runs: Vec<hyst::Run> = RS
         .iter()
@@ -778,18 +783,7 @@ fn friction_damped_building_steps_and_converges() {
     // A sharper regularization (v_r = 1 mm/s) at h = 0.01 s puts (h/2) f_s/v_r = 3 M on the
     // Newton matrix and Newton, bouncing on the tanh, fails to converge at some step
     // (measured: step 353): the step is refused and state and history are unchanged.
-    let sharp = |i: usize| {
-        Parallel(
-            Bilinear::<f64>::new(building::STIFFNESS, building::YIELD[i], building::ALPHA).unwrap(),
-            Friction::<f64>::new(0.1 * building::YIELD[i], 1e-3).unwrap(),
-        )
-    };
-    let b = ShearBuilding::new(
-        [building::MASS; 3],
-        [sharp(0), sharp(1), sharp(2)],
-        &building::damping(),
-    )
-    .unwrap();
+    let b = friction_damped(1e-3);
     let stepper = Nonlinear::<f64, 3>::new(0.01, NewtonSettings::up_to(30, TOL)).unwrap();
     let (mut s, mut hist) = hyst::start(&stepper, &b, 2);
     let mut refused = None;
