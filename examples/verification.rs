@@ -21,7 +21,7 @@ use aemstep::{Linear, LinearInput, Real, Stepper, models};
 use nalgebra::{SMatrix, SVector};
 use runs::{
     cross_check, example1_period, example2_error, example2_run, example3_error, example4_error,
-    max_diff, rel_diff, sdof, vec1,
+    rel_diff, sdof, vec1,
 };
 use support::*;
 

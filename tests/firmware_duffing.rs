@@ -16,6 +16,7 @@
 
 #[path = "support/duffing.rs"]
 mod duffing;
+mod support;
 
 use duffing::{max_error, trajectory};
 
@@ -64,11 +65,7 @@ fn f32_error_within_the_firmware_bound_and_every_report_good() {
     // The f32 rounding part alone: both runs follow the same recurrence. Measured 1.139e-6
     // (≈ 20 f32 ulps of |u| ≈ 0.8: the increments h·v added to u each step, accumulated over
     // the damped response); 2e-6 leaves room for another valid summation order.
-    let rounding = u64_
-        .iter()
-        .zip(&u32_)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
+    let rounding = support::max_diff(&u64_, &u32_);
     let e32 = max_error(&u32_, H);
     println!("f32 max error {e32:.4e} (bound {FIRMWARE_BOUND:e}), rounding part {rounding:.4e}");
     assert!(rounding <= 2e-6, "{rounding:e}");

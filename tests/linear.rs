@@ -11,8 +11,7 @@ use aemstep::{Error, Linear, State, Stepper};
 use checks::bits;
 use nalgebra::{SMatrix, SVector, matrix, vector};
 use runs::{
-    CrossCheck, dm, example1_period, example2_error, example2_run, example4_error, max_diff,
-    rel_diff, sdof,
+    CrossCheck, dm, example1_period, example2_error, example2_run, example4_error, rel_diff, sdof,
 };
 use support::*;
 

@@ -23,7 +23,7 @@ use pendulums::{
     EL_KE0, EL_L, EL_M, Elastic, G, THETA0, elastic_run, max_and_first_tenth, pendulum_energy,
     pendulum_run,
 };
-use support::sm;
+use support::{max_diff, sm};
 
 fn r<T: Real>(x: f64) -> T {
     T::from_f64_rounded(x)
@@ -142,12 +142,7 @@ fn duffing_f32() {
     let f = duffing_run::<f32>(0.01, 25.0, true, exact);
     let g = duffing_run::<f32>(0.01, 25.0, true, NewtonSettings::default());
     let d = duffing_run::<f64>(0.01, 25.0, true, NewtonSettings::default());
-    let dev = f
-        .trajectory
-        .iter()
-        .zip(&d.trajectory)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
+    let dev = max_diff(&f.trajectory, &d.trajectory);
     println!(
         "Example 5 (f32, h = 0.01): max error fixed-2 {:.3e}, adaptive {:.3e} (max it {}); f64 {:.3e}; max |u32 − u64| {dev:.3e}",
         f.max_error, g.max_error, g.max_iterations, d.max_error
@@ -166,12 +161,7 @@ fn duffing_f32() {
 fn analytic_and_finite_difference_jacobians_agree() {
     let a = duffing_run::<f64>(0.01, 25.0, true, NewtonSettings::default());
     let f = duffing_run::<f64>(0.01, 25.0, false, NewtonSettings::default());
-    let dev = a
-        .trajectory
-        .iter()
-        .zip(&f.trajectory)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
+    let dev = max_diff(&a.trajectory, &f.trajectory);
     println!(
         "Duffing analytic vs FD Jacobian: max |Δu| {dev:.3e}, iterations {} vs {}",
         a.max_iterations, f.max_iterations

@@ -270,6 +270,14 @@ pub fn max_abs<'a, I: IntoIterator<Item = &'a f64>>(xs: I) -> f64 {
     xs.into_iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
+/// max |a_i − b_i| over the common length of two sampled histories.
+pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
 /// Observed order `log(e1/e2)/log(h1/h2)`.
 pub fn order(e1: f64, h1: f64, e2: f64, h2: f64) -> f64 {
     (e1 / e2).ln() / (h1 / h2).ln()

@@ -23,14 +23,6 @@ pub fn vec1<T: Real>(x: f64) -> SVector<T, 1> {
     vector![T::from_f64_rounded(x)]
 }
 
-/// max |a_i − b_i|.
-pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
-}
-
 // ------------------------------------------------------------------ paper examples 1, 2, 4
 
 /// Numerical period of paper Example 1 (u'' + 25u = 0, u0 = 1, v0 = 0) from the mean
