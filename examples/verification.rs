@@ -21,7 +21,7 @@ use aemstep::{Linear, LinearInput, Real, Stepper, models};
 use nalgebra::{SMatrix, SVector};
 use runs::{
     cross_check, example1_period, example2_error, example2_run, example3_error, example4_error,
-    rel_diff, sdof, vec1,
+    free_vibration, rel_diff, sdof, undamped_drift, vec1,
 };
 use support::*;
 
@@ -95,41 +95,11 @@ fn elcentro<T: Real>() -> Vec<T> {
 
 // ------------------------------------------------------------------ extremes
 
-/// 10⁷ undamped steps, ω = 2π, h = 0.01, u0 = 1: max |E/E0 − 1| and max |u − cos(nφ)|
-/// (every 1000th step) with φ the phase per step of the operators as rounded to T.
-fn ten_million<T: Real>() -> (f64, f64) {
-    let w = 2.0 * core::f64::consts::PI;
-    let h = 0.01;
-    let sys = sdof::<T>(w, 0.0, h);
-    let z = vec1::<T>(0.0);
-    let mut s = sys.start(&vec1(1.0), &z, &z).unwrap();
-    let a = aemstep::analysis::amplification_matrix(&sys);
-    let (_, phi) = aemstep::analysis::SdofProperties::from_matrix(a, w * h, 0.0)
-        .principal
-        .unwrap();
-    let (mut emax, mut umax) = (0.0f64, 0.0f64);
-    for i in 1..=10_000_000u64 {
-        sys.step(&mut s, &z);
-        let (u, v) = (s.u()[0].as_f64(), s.v()[0].as_f64());
-        emax = emax.max((u * u + v * v / (w * w) - 1.0).abs());
-        if i % 1000 == 0 {
-            umax = umax.max((u - (i as f64 * phi).cos()).abs());
-        }
-    }
-    (emax, umax)
-}
-
 /// h = 1e-9 s, 10⁶ steps of u'' + (2π)² u = 0 from u0 = 1: |u − cos(ωt)| at the end.
 fn tiny_step<T: Real>() -> f64 {
     let w = 2.0 * core::f64::consts::PI;
     let (h, n) = (1e-9, 1_000_000u64);
-    let sys = sdof::<T>(w, 0.0, h);
-    let z = vec1::<T>(0.0);
-    let mut s = sys.start(&vec1(1.0), &z, &z).unwrap();
-    for _ in 0..n {
-        sys.step(&mut s, &z);
-    }
-    (s.u()[0].as_f64() - (w * n as f64 * h).cos()).abs()
+    (free_vibration::<T>(w, h, n).u()[0].as_f64() - (w * n as f64 * h).cos()).abs()
 }
 
 // ------------------------------------------------------------------ nonlinear, time-varying
@@ -313,8 +283,9 @@ fn main() {
     println!("\n## Extremes\n");
     println!("| run | f64 | f32 |");
     println!("|---|---|---|");
-    let (e64, p64) = ten_million::<f64>();
-    let (e32, p32) = ten_million::<f32>();
+    // 10⁷ undamped steps, ω = 2π, h = 0.01, u0 = 1: max |E/E0 − 1| and max |u − cos(nφ)|.
+    let (e64, _, p64) = undamped_drift::<f64>(10_000_000);
+    let (e32, _, p32) = undamped_drift::<f32>(10_000_000);
     println!(
         "| 10⁷ undamped steps (ω = 2π, h = 0.01): energy drift max \\|E/E0 − 1\\| | {} | {} |",
         e(e64, 1),

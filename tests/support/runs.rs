@@ -88,6 +88,49 @@ pub fn example4_error<T: Real>(h: f64) -> (f64, f64) {
     (err, umax)
 }
 
+// ------------------------------------------------------------------ extremes
+
+/// `n` steps of the undamped `u'' + ω² u = 0` at step `h` from u0 = 1, v0 = 0: the final
+/// state.
+pub fn free_vibration<T: Real>(w: f64, h: f64, n: u64) -> State<T, 1> {
+    let sys = sdof::<T>(w, 0.0, h);
+    let z = vec1::<T>(0.0);
+    let mut s = sys.start(&vec1(1.0), &z, &z).unwrap();
+    for _ in 0..n {
+        sys.step(&mut s, &z);
+    }
+    s
+}
+
+/// `n` undamped steps of u'' + ω² u = 0, ω = 2π, h = 0.01 (s ≈ 0.063), u0 = 1, v0 = 0.
+/// Returns (max |E/E0 − 1|, final |E/E0 − 1|, max |u − cos(nφ)| over every 1000th step)
+/// with φ the phase per step of the operators as rounded to `T`, from the analysis module
+/// (its own rounding is f64), so that operator rounding is not counted as drift and the
+/// last figure is pure rounding.
+pub fn undamped_drift<T: Real>(n: u64) -> (f64, f64, f64) {
+    let w = 2.0 * core::f64::consts::PI;
+    let h = 0.01;
+    let sys = sdof::<T>(w, 0.0, h);
+    let z = vec1::<T>(0.0);
+    let mut s = sys.start(&vec1(1.0), &z, &z).unwrap();
+    let a = aemstep::analysis::amplification_matrix(&sys);
+    let (_, phi) = aemstep::analysis::SdofProperties::from_matrix(a, w * h, 0.0)
+        .principal
+        .unwrap();
+    let (mut emax, mut umax) = (0.0f64, 0.0f64);
+    let mut e = 0.0;
+    for i in 1..=n {
+        sys.step(&mut s, &z);
+        let (u, v) = (s.u()[0].as_f64(), s.v()[0].as_f64());
+        e = u * u + v * v / (w * w) - 1.0;
+        emax = emax.max(e.abs());
+        if i % 1000 == 0 {
+            umax = umax.max((u - (i as f64 * phi).cos()).abs());
+        }
+    }
+    (emax, e.abs(), umax)
+}
+
 // ------------------------------------------------------------------ paper example 3
 
 /// Paper Example 3, `(1 + t²) u'' + t u' + e^{1/(1+t)} u = p(t)`: coefficients computed in
