@@ -21,7 +21,7 @@ use aemstep::{Linear, LinearInput, Real, Stepper, models};
 use nalgebra::{SMatrix, SVector};
 use runs::{
     cross_check, example1_period, example2_error, example2_run, example3_error, example4_error,
-    free_vibration, rel_diff, sdof, undamped_drift, vec1,
+    free_vibration, rel_diff, undamped_drift,
 };
 use support::*;
 
@@ -34,11 +34,7 @@ fn e(x: f64, d: usize) -> String {
 
 /// Example 1: √(u² + (v/ω)²) − 1 after 10⁵ steps at h = 0.01.
 fn example1_amplitude() -> f64 {
-    let sys = sdof::<f64>(5.0, 0.0, 0.01);
-    let mut s = sys.start(&vec1(1.0), &vec1(0.0), &vec1(0.0)).unwrap();
-    for _ in 0..100_000 {
-        sys.step(&mut s, &vec1(0.0));
-    }
+    let s = free_vibration::<f64>(5.0, 0.01, 100_000);
     (s.u()[0].powi(2) + (s.v()[0] / 5.0).powi(2)).sqrt() - 1.0
 }
 

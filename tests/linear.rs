@@ -11,7 +11,8 @@ use aemstep::{Error, Linear, State, Stepper};
 use checks::bits;
 use nalgebra::{SMatrix, SVector, matrix, vector};
 use runs::{
-    CrossCheck, dm, example1_period, example2_error, example2_run, example4_error, rel_diff, sdof,
+    CrossCheck, dm, example1_period, example2_error, example2_run, example4_error, free_vibration,
+    rel_diff, sdof,
 };
 use support::*;
 
@@ -43,13 +44,7 @@ fn example1_no_amplitude_decay_over_1e5_steps() {
     // Undamped trapezoidal rule = Cayley transform of a generator that is skew in the energy
     // norm: ω²u² + v² is conserved exactly; only rounding (~√n·ε) can move it.
     let h = 0.01;
-    let sys = sdof::<f64>(5.0, 0.0, h);
-    let mut s = sys
-        .start(&vector![1.0], &vector![0.0], &vector![0.0])
-        .unwrap();
-    for _ in 0..100_000 {
-        sys.step(&mut s, &vector![0.0]);
-    }
+    let s = free_vibration::<f64>(5.0, h, 100_000);
     let amp = (s.u()[0].powi(2) + (s.v()[0] / 5.0).powi(2)).sqrt();
     eprintln!("amplitude after 1e5 steps: 1 + {:.3e}", amp - 1.0);
     assert!((amp - 1.0).abs() < 1e-9);
