@@ -12,6 +12,9 @@
 //! `python3 scripts/bench_spectrum.py` runs it beside `sdof.spectrum` and writes
 //! `docs/spectrum.md`.
 
+#[path = "../examples/modal_fw/elcentro.rs"]
+mod elcentro;
+
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -20,19 +23,6 @@ use criterion::Criterion;
 
 const P: usize = 100;
 const DT: f64 = 0.02;
-
-fn elcentro() -> Vec<f64> {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/data/elcentro-ns-1940.txt"
-    ))
-    .expect("data/elcentro-ns-1940.txt");
-    text.lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty() && !l.starts_with('#'))
-        .map(|l| l.parse::<f64>().expect("number") * 9.80665)
-        .collect()
-}
 
 fn log_periods() -> [f64; P] {
     core::array::from_fn(|i| 0.01 * 1000f64.powf(i as f64 / (P - 1) as f64))
@@ -48,8 +38,7 @@ fn main() {
         .measurement_time(Duration::from_secs(2))
         .sample_size(20)
         .configure_from_args();
-    let rec = elcentro();
-    let rec32: Vec<f32> = rec.iter().map(|&a| a as f32).collect();
+    let (rec, rec32) = (elcentro::AG_F64, elcentro::AG_F32);
     let mut fastest: Vec<(String, f64)> = Vec::new();
     let mut single = |id: String, f: &mut dyn FnMut()| {
         let mut best = f64::INFINITY;

@@ -8,61 +8,15 @@
 //!
 //! Run: `cargo run --release --example energy`
 
-use aemstep::{Model, NewtonSettings, Nonlinear, Real, Tangent};
-use nalgebra::{SMatrix, SVector, matrix, vector};
+#[path = "../tests/support/pendulums.rs"]
+mod pendulums;
 
-const G: f64 = 9.81;
-const L: f64 = 3.0443;
-const EA: f64 = 1.0e4;
-const MASS: f64 = 6.667;
-const X_SPEED: f64 = 7.72;
-
-fn r<T: Real>(x: f64) -> T {
-    T::from_f64_rounded(x)
-}
-
-/// `θ'' + (g/l) sin θ = 0` with `l = g`.
-struct Pendulum;
-
-impl Model<f64, 1> for Pendulum {
-    fn mass(&self) -> SMatrix<f64, 1, 1> {
-        matrix![1.0]
-    }
-    fn force(&self, u: &SVector<f64, 1>, _v: &SVector<f64, 1>) -> SVector<f64, 1> {
-        vector![u[0].sin()]
-    }
-    fn tangent(&self, u: &SVector<f64, 1>, _v: &SVector<f64, 1>) -> Option<Tangent<f64, 1>> {
-        Some(Tangent {
-            stiffness: matrix![u[0].cos()],
-            damping: matrix![0.0],
-        })
-    }
-}
-
-/// `m u'' + (EA/L)(1 − L/r) u = (0, m g)`, `y` downward from the pivot.
-struct Elastic;
-
-impl<T: Real> Model<T, 2> for Elastic {
-    fn mass(&self) -> SMatrix<T, 2, 2> {
-        SMatrix::identity() * r::<T>(MASS)
-    }
-    fn force(&self, u: &SVector<T, 2>, _v: &SVector<T, 2>) -> SVector<T, 2> {
-        u * (r::<T>(EA / L) * (T::one() - r::<T>(L) / u.norm()))
-    }
-    fn tangent(&self, u: &SVector<T, 2>, _v: &SVector<T, 2>) -> Option<Tangent<T, 2>> {
-        let (k, l, len) = (r::<T>(EA / L), r::<T>(L), u.norm());
-        Some(Tangent {
-            stiffness: SMatrix::<T, 2, 2>::identity() * (k * (T::one() - l / len))
-                + u * u.transpose() * (k * l / (len * len * len)),
-            damping: SMatrix::zeros(),
-        })
-    }
-}
-
-fn elastic_energy(u: &SVector<f64, 2>, v: &SVector<f64, 2>, g: f64) -> f64 {
-    let stretch = u.norm() - L;
-    0.5 * MASS * v.norm_squared() + 0.5 * EA / L * stretch * stretch - MASS * g * u[1]
-}
+use aemstep::Real;
+use nalgebra::vector;
+use pendulums::{
+    EL_EA, EL_KE0, EL_L, EL_M, EL_SPEED, Elastic, G, THETA0, elastic_energy, elastic_run,
+    max_and_first_tenth, pendulum_energy, pendulum_run,
+};
 
 /// Max |E − E0| (J) in each of `windows` equal windows of the run, or the step at which
 /// the run failed; and the first time the stretch |r − L| exceeds L.
@@ -74,67 +28,32 @@ struct Run {
 }
 
 fn elastic<T: Real>(h: f64, t_end: f64, g: f64, windows: usize) -> Run {
-    let st = Nonlinear::<T, 2>::new(
-        r(h),
-        NewtonSettings::up_to(50, NewtonSettings::<T>::default_tolerance()),
-    )
-    .expect("valid settings");
-    let p = vector![T::zero(), r::<T>(MASS * g)];
-    let (u0, v0) = (vector![0.0, L], vector![X_SPEED, 0.0]);
-    let mut s = st
-        .start(&Elastic, &u0.map(r::<T>), &v0.map(r::<T>), &p)
-        .expect("finite start");
-    let e0 = elastic_energy(&u0, &v0, g);
-    let steps = (t_end / h).round() as u64;
-    let mut run = Run {
-        window_max: vec![0.0; windows],
-        failed: None,
-        blow_up: None,
-        max_iterations: 0,
-    };
-    for n in 1..=steps {
-        match st.try_step(&Elastic, &mut s, &p) {
-            Ok(rep) => run.max_iterations = run.max_iterations.max(rep.iterations),
-            Err(e) => {
-                run.failed = Some((n, e));
-                break;
-            }
-        }
-        let (u, v) = (s.u().map(|x| x.as_f64()), s.v().map(|x| x.as_f64()));
-        let w = (((n - 1) * windows as u64) / steps) as usize;
-        let de = (elastic_energy(&u, &v, g) - e0).abs();
-        run.window_max[w] = run.window_max[w].max(de);
-        if run.blow_up.is_none() && (u.norm() - L).abs() > L {
-            run.blow_up = Some(n as f64 * h);
-        }
+    let run = elastic_run::<T>(&Elastic { analytic: true }, h, t_end, g);
+    let mut window_max = vec![0.0f64; windows];
+    for (i, de) in run.energy_error.iter().enumerate() {
+        let w = (i as u64 * windows as u64 / run.steps) as usize;
+        window_max[w] = window_max[w].max(*de);
     }
-    run
+    Run {
+        window_max,
+        failed: run.failed,
+        blow_up: run.blow_up(h),
+        max_iterations: run.max_iterations,
+    }
 }
 
 fn main() {
     println!("Energy behaviour of the nonlinear AEM step (measured, not claimed)\n");
 
     // Example 6: the pendulum.
-    let th0 = 0.4 * std::f64::consts::PI;
-    let energy = |th: f64, w: f64| -G * G * th.cos() + 0.5 * G * G * w * w;
-    let e0 = energy(th0, 0.0);
+    let e0 = pendulum_energy(THETA0, 0.0);
     println!("Example 6, pendulum (l = g, θ0 = 0.4π), E0 = {e0:.4} (paper: −29.74), t ≤ 100 s:");
     for h in [0.1, 0.01, 0.001] {
-        let st = Nonlinear::<f64, 1>::new(h, NewtonSettings::default()).expect("valid");
-        let mut s = st
-            .start(&Pendulum, &vector![th0], &vector![0.0], &vector![0.0])
-            .expect("finite start");
-        let steps = (100.0 / h).round() as u64;
-        let (mut first, mut all) = (0.0f64, 0.0f64);
-        for n in 1..=steps {
-            st.try_step(&Pendulum, &mut s, &vector![0.0])
-                .expect("converges");
-            let de = (energy(s.u()[0], s.v()[0]) - e0).abs();
-            all = all.max(de);
-            if n * 10 <= steps {
-                first = all;
-            }
-        }
+        let de: Vec<f64> = pendulum_run(h, 100.0)
+            .iter()
+            .map(|&(th, w)| (pendulum_energy(th, w) - e0).abs())
+            .collect();
+        let (all, first) = max_and_first_tenth(&de, de.len() as u64);
         println!(
             "  h = {h:<5}: max |E − E0| = {all:.3e} ({:.2e} of |E0|); first 10 s: {first:.3e}",
             all / e0.abs()
@@ -142,8 +61,8 @@ fn main() {
     }
 
     // Example 7 with gravity, the paper's run.
-    let ke0 = 0.5 * MASS * X_SPEED * X_SPEED;
-    let e0 = elastic_energy(&vector![0.0, L], &vector![X_SPEED, 0.0], G);
+    let ke0 = EL_KE0;
+    let e0 = elastic_energy(&vector![0.0, EL_L], &vector![EL_SPEED, 0.0], G);
     println!(
         "\nExample 7, elastic pendulum with gravity, h = 0.01 s, t ≤ 1000 s \
          (E0 = {e0:.3} J, initial kinetic energy KE0 = {ke0:.1} J):"
@@ -169,7 +88,7 @@ fn main() {
     println!(
         "\nExample 7 without gravity, t ≤ 100 s (axial period 2π√(mL/EA) = {:.3} s); \
          bounded = max |E − E0| ≤ KE0:",
-        2.0 * std::f64::consts::PI * (MASS * L / EA).sqrt()
+        2.0 * std::f64::consts::PI * (EL_M * EL_L / EL_EA).sqrt()
     );
     let mut first_unbounded: Option<f64> = None;
     let mut always_unbounded_from: Option<f64> = None;

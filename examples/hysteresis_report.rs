@@ -18,10 +18,6 @@ mod laws;
 
 use aemstep::NewtonSettings;
 
-fn uy(i: usize) -> f64 {
-    building::YIELD[i] / building::STIFFNESS
-}
-
 fn list(v: &[f64]) -> String {
     v.iter()
         .map(|x| format!("{x:.2e}"))
@@ -91,38 +87,12 @@ fn main() {
         "3 storeys (examples/hysteretic_fw/building.rs), the whole record, Newton to 1e-12; \
          closure = max over the run of |E_in − (E_k + E_s + E_v + E_h)| / max E_in.\n"
     );
-    let settings = NewtonSettings::up_to(30, 1e-12);
-    let yd = [uy(0), uy(1), uy(2)];
-    let hard = building::ALPHA * building::STIFFNESS / (1.0 - building::ALPHA);
-    let cz = |i: usize| (1.0 - building::ALPHA) * building::YIELD[i];
-    let bil = building::bilinear::<f64>().unwrap();
-    let bwb = building::bouc_wen::<f64>().unwrap();
     let rs = [1u64, 2, 4, 8, 16, 32];
-    for name in ["bilinear", "Bouc–Wen (β = γ = 0.5, n = 2)"] {
-        let runs: Vec<hyst::Run> = rs
-            .iter()
-            .map(|&r| {
-                if name == "bilinear" {
-                    hyst::run(
-                        &bil,
-                        r,
-                        settings,
-                        yd,
-                        |i, p, n, _, _| building::YIELD[i] * (n.plastic - p.plastic).abs(),
-                        |_, h| 0.5 * hard * h.plastic * h.plastic,
-                    )
-                } else {
-                    hyst::run(
-                        &bwb,
-                        r,
-                        settings,
-                        yd,
-                        |i, p, n, d0, d1| cz(i) * 0.5 * (p.z + n.z) * (d1 - d0),
-                        |i, h| -0.5 * cz(i) * uy(i) * h.z * h.z,
-                    )
-                }
-            })
-            .collect();
+    for (name, run) in [
+        ("bilinear", hyst::bilinear_run as fn(u64) -> hyst::Run),
+        ("Bouc–Wen (β = γ = 0.5, n = 2)", hyst::bouc_wen_run),
+    ] {
+        let runs: Vec<hyst::Run> = rs.iter().map(|&r| run(r)).collect();
         println!("### {name} storeys\n");
         for line in hyst::table(&rs, &runs) {
             println!("{line}");

@@ -13,6 +13,9 @@
 //! Timing: a loop over the record, best of 7 runs of 100 passes, `black_box` on the input
 //! and the output; ns per step, including reading the one output (roof drift).
 
+#[path = "modal_fw/elcentro.rs"]
+mod elcentro;
+
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -22,14 +25,6 @@ use aemstep::{Damping, Linear, LinearInput, Modal, Real, Stepper, models};
 use nalgebra::{SMatrix, SVector};
 
 const H: f64 = 0.02;
-
-fn elcentro() -> Vec<f64> {
-    include_str!("../data/elcentro-ns-1940.txt")
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
-        .map(|l| l.trim().parse::<f64>().unwrap() * 9.80665)
-        .collect()
-}
 
 /// Roof and inter-storey drift histories (`[u5, d1..d5]` per sample) of a run.
 type History = Vec<[f64; 6]>;
@@ -42,11 +37,19 @@ fn record(u: &SVector<f64, 5>) -> [f64; 6] {
     r
 }
 
-fn full_history(ag: &[f64], sub: usize) -> History {
+type M5 = SMatrix<f64, 5, 5>;
+
+/// The benchmark building: `M, C, K` and the influence vector `B = −M ι`.
+fn building() -> (M5, M5, M5, SVector<f64, 5>) {
     let (m, c, k) = models::five_storey_building();
-    let b = SVector::<f64, 5>::from_fn(|i, _| base_excitation(&m)[i][0]);
-    let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
-    let sys = Linear::<f64, _>::new(&sm(m), &sm(c), &sm(k), H / sub as f64).unwrap();
+    let sm = |a: [[f64; 5]; 5]| M5::from_fn(|i, j| a[i][j]);
+    let b = SVector::from_fn(|i, _| base_excitation(&m)[i][0]);
+    (sm(m), sm(c), sm(k), b)
+}
+
+fn full_history(ag: &[f64], sub: usize) -> History {
+    let (m, c, k, b) = building();
+    let sys = Linear::<f64, _>::new(&m, &c, &k, H / sub as f64).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &(b * ag[0])).unwrap();
     let mut out = vec![record(s.u())];
@@ -131,12 +134,10 @@ fn time_per_step(ag: &[f64], mut f: impl FnMut(f64) -> f64) -> f64 {
 }
 
 fn modal_ns<T: Real, const R: usize>(ag: &[f64]) -> f64 {
-    let (m, c, k) = models::five_storey_building();
-    let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
-    let b = SMatrix::<f64, 5, 1>::from_fn(|i, _| base_excitation(&m)[i][0]);
-    let y = SMatrix::<f64, 1, 5>::from_fn(|_, j| roof[0][j]);
-    let sys = Modal::<T, 5, R>::new(&sm(m), &sm(k), &Damping::Matrix(c), &b, &y, H).unwrap();
+    let (m, _, k, b) = building();
+    let c = Damping::Matrix(models::five_storey_building().1);
+    let roof = SMatrix::<f64, 1, 5>::new(0.0, 0.0, 0.0, 0.0, 1.0);
+    let sys = Modal::<T, 5, R>::new(&m, &k, &c, &b, &roof, H).unwrap();
     let mut s = sys.start_at_rest(&SVector::from([T::zero()])).unwrap();
     time_per_step(ag, |a| {
         sys.step(&mut s, &SVector::from([T::from_f64_rounded(a)]));
@@ -145,10 +146,9 @@ fn modal_ns<T: Real, const R: usize>(ag: &[f64]) -> f64 {
 }
 
 fn linear_ns<T: Real>(ag: &[f64]) -> f64 {
-    let (m, c, k) = models::five_storey_building();
-    let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
-    let b = SVector::<T, 5>::from_fn(|i, _| T::from_f64_rounded(base_excitation(&m)[i][0]));
-    let sys = Linear::<T, 5>::new(&sm(m), &sm(c), &sm(k), H).unwrap();
+    let (m, c, k, b) = building();
+    let b = b.map(T::from_f64_rounded);
+    let sys = Linear::<T, 5>::new(&m, &c, &k, H).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &z).unwrap();
     time_per_step(ag, |a| {
@@ -158,10 +158,8 @@ fn linear_ns<T: Real>(ag: &[f64]) -> f64 {
 }
 
 fn input_ns<T: Real>(ag: &[f64]) -> f64 {
-    let (m, c, k) = models::five_storey_building();
-    let sm = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
-    let b = SMatrix::<f64, 5, 1>::from_fn(|i, _| base_excitation(&m)[i][0]);
-    let sys = LinearInput::<T, 5, 1>::new(&sm(m), &sm(c), &sm(k), &b, H).unwrap();
+    let (m, c, k, b) = building();
+    let sys = LinearInput::<T, 5, 1>::new(&m, &c, &k, &b, H).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([T::zero()])).unwrap();
     time_per_step(ag, |a| {
@@ -171,7 +169,7 @@ fn input_ns<T: Real>(ag: &[f64]) -> f64 {
 }
 
 fn main() {
-    let ag = elcentro();
+    let ag = elcentro::AG_F64;
     let full = full_history(&ag, 1);
     let fine = full_history(&ag, 16);
     let histories = [
@@ -188,8 +186,14 @@ fn main() {
         (modal_ns::<f64, 4>(&ag), modal_ns::<f32, 4>(&ag)),
         (modal_ns::<f64, 5>(&ag), modal_ns::<f32, 5>(&ag)),
     ];
-    let pct = |x: f64, of: f64| 100.0 * x / of;
     let f = compare(&full, &fine);
+    // The four error cells of a row (`compare`'s errors), each in mm and in % of the full
+    // model's peak: roof errors of the peak roof drift, drift errors of the peak drift.
+    let errors = |e: &[f64; 6]| {
+        [(e[1], f[0]), (e[2], f[0]), (e[4], f[3]), (e[5], f[3])]
+            .map(|(x, of)| format!("{:.3} mm ({:.2} %)", 1e3 * x, 100.0 * x / of))
+            .join(" | ")
+    };
     println!(
         "5-storey building, El Centro 1940 NS ({} samples, h = {H} s); full model: peak roof drift {:.2} mm, peak inter-storey drift {:.2} mm",
         ag.len(),
@@ -205,15 +209,8 @@ fn main() {
         let e = compare(h, &full);
         let rr = r + 1;
         println!(
-            "| `Modal`, R = {rr} | {:.3} mm ({:.2} %) | {:.3} mm ({:.2} %) | {:.3} mm ({:.2} %) | {:.3} mm ({:.2} %) | {} | {:.1} | {:.1} |",
-            1e3 * e[1],
-            pct(e[1], f[0]),
-            1e3 * e[2],
-            pct(e[2], f[0]),
-            1e3 * e[4],
-            pct(e[4], f[3]),
-            1e3 * e[5],
-            pct(e[5], f[3]),
+            "| `Modal`, R = {rr} | {} | {} | {:.1} | {:.1} |",
+            errors(&e),
             // R·I + 7R for the modes, O·R for one output
             rr + 7 * rr + rr,
             ns[r].0,
@@ -233,15 +230,8 @@ fn main() {
         linear_ns::<f32>(&ag)
     );
     println!(
-        "| `Linear<5>` at h = 0.02 against h/16 (time-step error) | {:.3} mm ({:.2} %) | {:.3} mm ({:.2} %) | {:.3} mm ({:.2} %) | {:.3} mm ({:.2} %) | | | |",
-        1e3 * f[1],
-        pct(f[1], f[0]),
-        1e3 * f[2],
-        pct(f[2], f[0]),
-        1e3 * f[4],
-        pct(f[4], f[3]),
-        1e3 * f[5],
-        pct(f[5], f[3]),
+        "| `Linear<5>` at h = 0.02 against h/16 (time-step error) | {} | | | |",
+        errors(&f)
     );
     // Truncation bound for the firmware check (R = 2, roof, f64 on the host).
     let e2 = compare(&histories[1], &full);

@@ -20,6 +20,8 @@
 //! - Generalized-α and HHT get the load as the textbook scheme does,
 //!   `(1 − α_f) p_n + α_f p_{n−1}` (`step_with_previous_input`).
 
+#[path = "modal_fw/elcentro.rs"]
+mod elcentro;
 #[path = "../tests/support/mod.rs"]
 mod support;
 
@@ -231,12 +233,7 @@ fn example4() -> Problem<3> {
 // ---------- El Centro ----------
 
 fn elcentro() -> Problem<5> {
-    let text = include_str!("../data/elcentro-ns-1940.txt");
-    let ag: Vec<f64> = text
-        .lines()
-        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
-        .map(|l| l.trim().parse::<f64>().unwrap() * 9.80665)
-        .collect();
+    let ag = &elcentro::AG_F64;
     let (m, c, k) = five_storey_building();
     let to = |a: [[f64; 5]; 5]| SMatrix::<f64, 5, 5>::from_fn(|i, j| a[i][j]);
     let (m, c, k) = (to(m), to(c), to(k));
@@ -244,13 +241,12 @@ fn elcentro() -> Problem<5> {
     let mi = m * iota;
     let per = 40; // base-grid points per record sample (0.02 s / 0.5 ms)
     let n_base = (ag.len() - 1) * per;
-    let ag2 = ag.clone();
     let load = move |i: usize| {
         let (j, f) = (i / per, (i % per) as f64 / per as f64);
-        let a = if j + 1 < ag2.len() {
-            ag2[j] * (1.0 - f) + ag2[j + 1] * f
+        let a = if j + 1 < ag.len() {
+            ag[j] * (1.0 - f) + ag[j + 1] * f
         } else {
-            ag2[ag2.len() - 1]
+            ag[ag.len() - 1]
         };
         -mi * a
     };

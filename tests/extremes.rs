@@ -4,9 +4,14 @@
 //! Every bound is derived in a comment from the scheme's known error (spec §4) and the
 //! rounding unit; the measured values are printed (`--nocapture`) and quoted.
 
+#[path = "support/runs.rs"]
+mod runs;
+mod support;
+
 use aemstep::analysis::{Scheme, sdof};
 use aemstep::{Exact, GeneralizedAlpha, Linear, Newmark, State, Stepper};
 use nalgebra::{SMatrix, SVector, matrix, vector};
+use runs::{free_vibration, undamped_drift};
 
 const EPS: f64 = f64::EPSILON;
 const EPS32: f64 = f32::EPSILON as f64;
@@ -154,48 +159,14 @@ fn no_growth_over_a_million_steps() {
     }
 }
 
-/// 10⁷ undamped steps of u'' + ω² u = 0, ω = 2π, h = 0.01 (s ≈ 0.063), u0 = 1, v0 = 0.
-/// Returns (max |E/E0 − 1|, final |E/E0 − 1|, max |u − cos(nφ)|) with φ = 2 atan(s/2)
-/// the scheme's exact phase per step, so the last figure is pure rounding.
-fn ten_million<T: aemstep::Real>(n: usize) -> (f64, f64, f64) {
-    let w = 2.0 * core::f64::consts::PI;
-    let h = 0.01;
-    let sys = Linear::<T, 1>::new(
-        &SMatrix::from_element(1.0),
-        &SMatrix::from_element(0.0),
-        &SMatrix::from_element(w * w),
-        h,
-    )
-    .unwrap();
-    let z = SVector::<T, 1>::zeros();
-    let one = SVector::<T, 1>::from_element(T::from_f64_rounded(1.0));
-    let mut s = sys.start(&one, &z, &z).unwrap();
-    // The phase per step of the operators as rounded to T, from the analysis module (its
-    // own rounding is f64), so that operator rounding is not counted as drift.
-    let a = aemstep::analysis::amplification_matrix(&sys);
-    let (_, phi) = aemstep::analysis::SdofProperties::from_matrix(a, w * h, 0.0)
-        .principal
-        .unwrap();
-    let (mut emax, mut umax) = (0.0f64, 0.0f64);
-    let mut e = 0.0;
-    for i in 1..=n {
-        sys.step(&mut s, &z);
-        let (u, v) = (s.u()[0].as_f64(), s.v()[0].as_f64());
-        e = u * u + v * v / (w * w) - 1.0;
-        emax = emax.max(e.abs());
-        if i % 1000 == 0 {
-            umax = umax.max((u - (i as f64 * phi).cos()).abs());
-        }
-    }
-    (emax, e.abs(), umax)
-}
-
 #[test]
 #[ignore = "long: run in release by scripts/test.sh"]
 fn ten_million_undamped_steps_f64_and_f32() {
     let n = 10_000_000;
-    let (e64, f64_final, u64) = ten_million::<f64>(n);
-    let (e32, f32_final, u32_) = ten_million::<f32>(n);
+    // 10⁷ undamped steps, ω = 2π, h = 0.01: (max |E/E0 − 1|, final |E/E0 − 1|, max
+    // |u − cos(nφ)|) with φ the operators' own phase per step (tests/support/runs.rs).
+    let (e64, f64_final, u64) = undamped_drift::<f64>(n);
+    let (e32, f32_final, u32_) = undamped_drift::<f32>(n);
     println!("f64: max |ΔE/E| {e64:e}, final {f64_final:e}, max |u − cos(nφ)| {u64:e}");
     println!("f32: max |ΔE/E| {e32:e}, final {f32_final:e}, max |u − cos(nφ)| {u32_:e}");
     // f64: per step the energy picks up ≲ 2ε relative rounding; worst case linear growth
@@ -371,13 +342,7 @@ fn tiny_step_1e_minus9() {
     let t = n as f64 * h;
     // f64: the period error s²/12 = 3e-18 is nothing; u ≈ 1 takes a rounding of ≤ ε/2 each
     // step (u + h v with |h v| ≤ 6e-9): ≤ n ε/2 = 1.1e-10 on u.
-    let sys = Linear::<f64, _>::new(&matrix![1.0], &matrix![0.0], &matrix![w * w], h).unwrap();
-    let mut s = sys
-        .start(&vector![1.0], &vector![0.0], &vector![0.0])
-        .unwrap();
-    for _ in 0..n {
-        sys.step(&mut s, &vector![0.0]);
-    }
+    let s = free_vibration::<f64>(w, h, n);
     let e = (s.u()[0] - (w * t).cos()).abs();
     let ev = (s.v()[0] + w * (w * t).sin()).abs();
     println!(
@@ -389,13 +354,7 @@ fn tiny_step_1e_minus9() {
     // f32: a displacement increment h v ≤ 2.5e-13 is far below half an ulp of u ≈ 1
     // (6e-8): u stagnates at exactly 1, so the error is |1 − cos(ωt)| = 2e-5. This is the
     // expected f32 limit (use f64, or a larger h, when h·v ≪ ε₃₂·|u|).
-    let sys = Linear::<f32, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![w * w], h).unwrap();
-    let mut s = sys
-        .start(&vector![1.0f32], &vector![0.0f32], &vector![0.0f32])
-        .unwrap();
-    for _ in 0..n {
-        sys.step(&mut s, &vector![0.0f32]);
-    }
+    let s = free_vibration::<f32>(w, h, n);
     let e32 = (s.u()[0] as f64 - (w * t).cos()).abs();
     println!(
         "h = 1e-9, f32: u = {} (stagnates), |Δu| {e32:e}, v = {:e}",

@@ -3,6 +3,9 @@
 //! `p(t)` chosen so that the exact solution is `u = e^{−0.1t} sin t`; h = 0.01 s,
 //! 0 < t ≤ 20 s (2000 steps), `f32`, exactly 2 Newton iterations a step.
 //!
+//! The run itself (`trajectory`, Newton tolerance `TOL`, exact solution and load) is
+//! `tests/support/duffing.rs`, which `examples/verification.rs` prints from.
+//!
 //! This test is where the firmware's bound comes from: it measures the same f32 error and
 //! asserts the same bound (`FIRMWARE_BOUND`, copied into the firmware as `BOUND`), and
 //! checks the Newton report of every step as the firmware does.
@@ -11,9 +14,11 @@
 //! error 1.588e-5, 3.970e-6, 9.925e-7 at h, h/2, h/4 (ratios 4.000: second order);
 //! f32 max error 1.622e-5; max |u_f32 − u_f64| 1.139e-6; every report converged in 2.
 
-use aemstep::models::Duffing;
-use aemstep::{NewtonSettings, Nonlinear, Real};
-use nalgebra::vector;
+#[path = "support/duffing.rs"]
+mod duffing;
+mod support;
+
+use duffing::{max_error, trajectory};
 
 const H: f64 = 0.01;
 const STEPS: u32 = 2000;
@@ -21,51 +26,6 @@ const STEPS: u32 = 2000;
 /// method's error at h (≤ 1.05 × 16 × its value at h/4, by the O(h²) order verified
 /// below: 1.667e-5) plus the f32 rounding part (≤ 2e-6), i.e. 1.867e-5, rounded down.
 const FIRMWARE_BOUND: f64 = 1.85e-5;
-/// Newton tolerance of the firmware: `NewtonSettings::default_tolerance()` for f32.
-const TOL: f64 = 1.5e-5;
-
-/// The exact solution, written here.
-fn exact(t: f64) -> f64 {
-    (-0.1 * t).exp() * t.sin()
-}
-
-/// `p(t) = u'' + 0.2 u' + u + u³` for the exact `u`: the linear part reduces to
-/// `−0.01 e^{−0.1t} sin t`.
-fn load(t: f64) -> f64 {
-    -0.01 * (-0.1 * t).exp() * t.sin() + (-0.3 * t).exp() * t.sin().powi(3)
-}
-
-/// Every `u_n` (n = 1..=steps at step h) and the number of steps whose Newton report was
-/// not (converged, 2 iterations).
-fn trajectory<T: Real>(h: f64, steps: u32) -> (Vec<f64>, u32) {
-    let r = T::from_f64_rounded;
-    let stepper = Nonlinear::<T, 1>::new(h, NewtonSettings::exactly(2, r(TOL))).expect("settings");
-    let mut s = stepper
-        .start(
-            &Duffing,
-            &vector![r(0.0)],
-            &vector![r(1.0)],
-            &vector![r(load(0.0))],
-        )
-        .expect("start");
-    let (mut us, mut bad) = (Vec::new(), 0);
-    for n in 1..=steps {
-        let t = n as f64 * h;
-        match stepper.try_step(&Duffing, &mut s, &vector![r(load(t))]) {
-            Ok(rep) if rep.converged && rep.iterations == 2 => {}
-            _ => bad += 1,
-        }
-        us.push(s.u()[0].as_f64());
-    }
-    (us, bad)
-}
-
-fn max_error(us: &[f64], h: f64) -> f64 {
-    us.iter()
-        .enumerate()
-        .map(|(i, u)| (u - exact((i + 1) as f64 * h)).abs())
-        .fold(0.0, f64::max)
-}
 
 #[test]
 fn f64_error_is_second_order() {
@@ -105,11 +65,7 @@ fn f32_error_within_the_firmware_bound_and_every_report_good() {
     // The f32 rounding part alone: both runs follow the same recurrence. Measured 1.139e-6
     // (≈ 20 f32 ulps of |u| ≈ 0.8: the increments h·v added to u each step, accumulated over
     // the damped response); 2e-6 leaves room for another valid summation order.
-    let rounding = u64_
-        .iter()
-        .zip(&u32_)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
+    let rounding = support::max_diff(&u64_, &u32_);
     let e32 = max_error(&u32_, H);
     println!("f32 max error {e32:.4e} (bound {FIRMWARE_BOUND:e}), rounding part {rounding:.4e}");
     assert!(rounding <= 2e-6, "{rounding:e}");

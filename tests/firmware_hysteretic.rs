@@ -14,6 +14,8 @@
 
 #[path = "../examples/hysteretic_fw/building.rs"]
 mod building;
+#[path = "support/checks.rs"]
+mod checks;
 #[path = "../examples/modal_fw/elcentro.rs"]
 mod elcentro;
 #[path = "support/hyst.rs"]
@@ -66,14 +68,12 @@ fn generate(full: &[f64]) -> String {
         "/// Max |f32 − f64| roof displacement allowed (m).\npub const BOUND: f64 = {BOUND:?};\n"
     ));
     let roof: Vec<f32> = full.iter().step_by(EVERY).map(|&x| x as f32).collect();
-    s.push_str(&format!(
-        "/// f64 roof displacement (m) at steps 0, EVERY, 2·EVERY, …\npub static ROOF: [f32; {}] = [\n",
-        roof.len()
+    s.push_str(&checks::static_array(
+        "f64 roof displacement (m) at steps 0, EVERY, 2·EVERY, …",
+        "ROOF",
+        "f32",
+        &roof,
     ));
-    for x in &roof {
-        s.push_str(&format!("    {x:?},\n"));
-    }
-    s.push_str("];\n");
     s
 }
 
@@ -84,20 +84,7 @@ fn reference_is_current_and_host_f32_run_is_within_bound() {
     assert_eq!(unconverged, 0);
     // It yields: the firmware runs a hysteretic model, not a linear one (measured 5.7).
     assert!(ductility > 4.0, "ductility {ductility}");
-    let text = generate(&r64);
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/hysteretic_fw/reference.rs"
-    );
-    if std::env::var_os("AEMSTEP_WRITE_REFERENCE").is_some() {
-        std::fs::write(path, &text).unwrap();
-    }
-    assert_eq!(
-        std::fs::read_to_string(path).unwrap(),
-        text,
-        "examples/hysteretic_fw/reference.rs is stale: rewrite it with \
-         AEMSTEP_WRITE_REFERENCE=1 cargo test --release --test firmware_hysteretic"
-    );
+    checks::reference_is_current("examples/hysteretic_fw/reference.rs", &generate(&r64));
     // The f64 run with the firmware's fixed iteration count is the converged run.
     let (fixed, _, u) = roof::<f64>(
         NewtonSettings::exactly(ITERATIONS, 1e-12),

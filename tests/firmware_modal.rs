@@ -15,6 +15,8 @@ use aemstep::models::base_excitation;
 use aemstep::{Damping, Linear, Modal, Stepper, models};
 use nalgebra::{SMatrix, SVector};
 
+#[path = "support/checks.rs"]
+mod checks;
 #[path = "../examples/modal_fw/elcentro.rs"]
 mod elcentro;
 #[path = "../examples/modal_fw/reference.rs"]
@@ -84,15 +86,12 @@ fn generate(full: &[f64]) -> String {
         "/// Max |modal − full| allowed (m).\npub const BOUND: f64 = {BOUND:?};\n"
     ));
     let roof: Vec<f32> = full.iter().step_by(EVERY).map(|&x| x as f32).collect();
-    s.push_str(&format!(
-        "/// Full-model roof drift (m) at steps 0, EVERY, 2·EVERY, …\npub static ROOF: [f32; {}] = [\n",
-        roof.len()
+    s.push_str(&checks::static_array(
+        "Full-model roof drift (m) at steps 0, EVERY, 2·EVERY, …",
+        "ROOF",
+        "f32",
+        &roof,
     ));
-    // One value a line: the layout rustfmt keeps (the file is formatted with the tests).
-    for x in &roof {
-        s.push_str(&format!("    {x:?},\n"));
-    }
-    s.push_str("];\n");
     s
 }
 
@@ -114,19 +113,7 @@ fn const_parser_matches_str_parse() {
 #[test]
 fn reference_is_current_and_host_f32_run_is_within_bound() {
     let full = full_roof();
-    let text = generate(&full);
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/modal_fw/reference.rs"
-    );
-    if std::env::var_os("AEMSTEP_WRITE_REFERENCE").is_some() {
-        std::fs::write(path, &text).unwrap();
-    }
-    assert_eq!(
-        std::fs::read_to_string(path).unwrap(),
-        text,
-        "examples/modal_fw/reference.rs is stale: rerun with AEMSTEP_WRITE_REFERENCE=1"
-    );
+    checks::reference_is_current("examples/modal_fw/reference.rs", &generate(&full));
     assert_eq!(reference::EVERY, EVERY);
     assert_eq!(reference::BOUND, BOUND);
 

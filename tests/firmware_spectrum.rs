@@ -13,6 +13,8 @@
 
 use aemstep::spectrum::{Bank, Response};
 
+#[path = "support/checks.rs"]
+mod checks;
 #[path = "../examples/spectrum_fw/config.rs"]
 mod config;
 #[path = "../examples/modal_fw/elcentro.rs"]
@@ -73,12 +75,7 @@ fn worst<const P: usize>(a: &Response<f32, P>, b: &Response<f64, P>) -> f64 {
 }
 
 fn array(name: &str, doc: &str, xs: &[f64]) -> String {
-    let mut s = format!("/// {doc}\npub static {name}: [f64; {}] = [\n", xs.len());
-    for x in xs {
-        s.push_str(&format!("    {x:?},\n"));
-    }
-    s.push_str("];\n");
-    s
+    checks::static_array(doc, name, "f64", xs)
 }
 
 fn generate() -> String {
@@ -111,19 +108,7 @@ fn generate() -> String {
 
 #[test]
 fn reference_is_current_and_host_f32_run_is_within_bound() {
-    let text = generate();
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/spectrum_fw/reference.rs"
-    );
-    if std::env::var_os("AEMSTEP_WRITE_REFERENCE").is_some() {
-        std::fs::write(path, &text).unwrap();
-    }
-    assert_eq!(
-        std::fs::read_to_string(path).unwrap(),
-        text,
-        "examples/spectrum_fw/reference.rs is stale: rerun with AEMSTEP_WRITE_REFERENCE=1"
-    );
+    checks::reference_is_current("examples/spectrum_fw/reference.rs", &generate());
     assert_eq!(reference::BOUND, BOUND);
     let w100 = worst(&run_f32(config::PERIODS_100), &run_f64(config::PERIODS_100));
     let w10 = worst(&run_f32(config::PERIODS_10), &run_f64(config::PERIODS_10));

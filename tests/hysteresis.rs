@@ -9,6 +9,8 @@
 
 #[path = "../examples/hysteretic_fw/building.rs"]
 mod building;
+#[path = "support/checks.rs"]
+mod checks;
 #[path = "../examples/modal_fw/elcentro.rs"]
 mod elcentro;
 #[path = "support/hyst.rs"]
@@ -24,7 +26,10 @@ use aemstep::hysteresis::{
     Bilinear, BilinearHistory, BoucWen, Friction, HistoryModel, Law, Parallel, ShearBuilding, Trial,
 };
 use aemstep::nalgebra::{SMatrix, SVector, Vector3};
-use aemstep::{Error, Linear, NewtonSettings, Nonlinear, State, Stepper, Tangent, models};
+use aemstep::{
+    Error, Linear, NewtonReport, NewtonSettings, Nonlinear, State, Stepper, Tangent, models,
+};
+use checks::bits;
 use support::Rng;
 
 const EPS: f64 = f64::EPSILON;
@@ -415,52 +420,13 @@ struct Runs {
 
 const RS: [u64; 4] = [2, 4, 8, 16];
 /// Newton tolerance of the building runs.
-const TOL: f64 = 1e-12;
-
-fn uy(i: usize) -> f64 {
-    building::YIELD[i] / building::STIFFNESS
-}
+const TOL: f64 = hyst::TOL;
 
 fn runs() -> &'static Runs {
     static RUNS: OnceLock<Runs> = OnceLock::new();
-    RUNS.get_or_init(|| {
-        let settings = NewtonSettings::up_to(30, TOL);
-        let yd = [uy(0), uy(1), uy(2)];
-        let hard = building::ALPHA * building::STIFFNESS / (1.0 - building::ALPHA);
-        let bil = building::bilinear::<f64>().unwrap();
-        let bw = building::bouc_wen::<f64>().unwrap();
-        let cz = |i: usize| (1.0 - building::ALPHA) * building::YIELD[i];
-        Runs {
-            bilinear: RS
-                .iter()
-                .map(|&r| {
-                    hyst::run(
-                        &bil,
-                        r,
-                        settings,
-                        yd,
-                        // Plastic dissipation f_y |Δd_p|; hardening energy H d_p²/2 stored.
-                        |i, p, n, _, _| building::YIELD[i] * (n.plastic - p.plastic).abs(),
-                        |_, h| 0.5 * hard * h.plastic * h.plastic,
-                    )
-                })
-                .collect(),
-            bouc_wen: RS
-                .iter()
-                .map(|&r| {
-                    hyst::run(
-                        &bw,
-                        r,
-                        settings,
-                        yd,
-                        // (1 − α) f_y ∫ z dd (trapezoid in d), minus the recoverable
-                        // (1 − α) f_y u_y z²/2 held in z.
-                        |i, p, n, d0, d1| cz(i) * 0.5 * (p.z + n.z) * (d1 - d0),
-                        |i, h| -0.5 * cz(i) * uy(i) * h.z * h.z,
-                    )
-                })
-                .collect(),
-        }
+    RUNS.get_or_init(|| Runs {
+        bilinear: RS.iter().map(|&r| hyst::bilinear_run(r)).collect(),
+        bouc_wen: RS.iter().map(|&r| hyst::bouc_wen_run(r)).collect(),
     })
 }
 
@@ -573,15 +539,7 @@ fn elastic_building_is_the_linear_aem() {
     let lin = Linear::<f64, 3>::new(&sm(&m), &sm(&c), &sm(&k), h).unwrap();
     let nl = Nonlinear::<f64, 3>::new(h, NewtonSettings::up_to(5, 1e-13)).unwrap();
     let z = Vector3::zeros();
-    let (mut s, mut hist) = nl
-        .start_with_history(
-            &b,
-            &z,
-            &z,
-            &b.ground_load(hyst::ground(0, 2)),
-            &b.initial_history(),
-        )
-        .unwrap();
+    let (mut s, mut hist) = hyst::start(&nl, &b, 2);
     let mut sl = lin
         .start(&z, &z, &b.ground_load(hyst::ground(0, 2)))
         .unwrap();
@@ -644,37 +602,27 @@ impl<M: HistoryModel<f64, 3>> HistoryModel<f64, 3> for FailOnTrial<'_, M> {
     }
 }
 
-fn bits(s: &State<f64, 3>) -> Vec<u64> {
-    s.u()
-        .iter()
-        .chain(s.v().iter())
-        .chain(s.a().iter())
-        .map(|x| x.to_bits())
-        .chain([s.steps()])
-        .collect()
+/// Step `n` of the record at h = 0.01 s = DT/2.
+fn step<L: Law<f64>>(
+    stepper: &Nonlinear<f64, 3>,
+    b: &ShearBuilding<f64, L, 3>,
+    s: &mut State<f64, 3>,
+    hist: &mut [L::History; 3],
+    n: u64,
+) -> Result<NewtonReport<f64>, Error> {
+    stepper.try_step_with_history(b, s, hist, &b.ground_load(hyst::ground(n, 2)))
 }
 
 #[test]
 fn failed_and_refused_steps_leave_state_and_history_bit_identical() {
     let b = building::bouc_wen::<f64>().unwrap();
     let stepper = Nonlinear::<f64, 3>::new(0.01, NewtonSettings::up_to(30, 1e-12)).unwrap();
-    let z = Vector3::zeros();
-    let (mut s, mut hist) = stepper
-        .start_with_history(
-            &b,
-            &z,
-            &z,
-            &b.ground_load(hyst::ground(0, 2)),
-            &b.initial_history(),
-        )
-        .unwrap();
+    let (mut s, mut hist) = hyst::start(&stepper, &b, 2);
     // Into the strong motion, where every step changes the history.
     let mut n = 0;
     while n < 500 {
         n += 1;
-        stepper
-            .try_step_with_history(&b, &mut s, &mut hist, &b.ground_load(hyst::ground(n, 2)))
-            .unwrap();
+        step(&stepper, &b, &mut s, &mut hist, n).unwrap();
     }
     let p = b.ground_load(hyst::ground(n + 1, 2));
     let (s0, h0) = (bits(&s), format!("{hist:?}"));
@@ -727,24 +675,9 @@ fn failed_and_refused_steps_leave_state_and_history_bit_identical() {
     stepper
         .try_step_with_history(&b, &mut s, &mut hist, &p)
         .unwrap();
-    let mut fresh = stepper
-        .start_with_history(
-            &b,
-            &z,
-            &z,
-            &b.ground_load(hyst::ground(0, 2)),
-            &b.initial_history(),
-        )
-        .unwrap();
+    let mut fresh = hyst::start(&stepper, &b, 2);
     for m in 1..=n + 1 {
-        stepper
-            .try_step_with_history(
-                &b,
-                &mut fresh.0,
-                &mut fresh.1,
-                &b.ground_load(hyst::ground(m, 2)),
-            )
-            .unwrap();
+        step(&stepper, &b, &mut fresh.0, &mut fresh.1, m).unwrap();
     }
     assert_eq!(bits(&s), bits(&fresh.0));
     assert_eq!(hbits(&hist), hbits(&fresh.1));
@@ -763,21 +696,10 @@ fn branch_changes_are_reported_and_fixed_iterations_stay_available() {
     // (piecewise linear: once the branch has settled one iteration is exact).
     let b = building::bilinear::<f64>().unwrap();
     let stepper = Nonlinear::<f64, 3>::new(0.01, NewtonSettings::exactly(3, 1e-10)).unwrap();
-    let z = Vector3::zeros();
-    let (mut s, mut hist) = stepper
-        .start_with_history(
-            &b,
-            &z,
-            &z,
-            &b.ground_load(hyst::ground(0, 2)),
-            &b.initial_history(),
-        )
-        .unwrap();
+    let (mut s, mut hist) = hyst::start(&stepper, &b, 2);
     let (mut changed, mut total) = (0u32, 0u32);
     for n in 1..=3000 {
-        let rep = stepper
-            .try_step_with_history(&b, &mut s, &mut hist, &b.ground_load(hyst::ground(n, 2)))
-            .unwrap();
+        let rep = step(&stepper, &b, &mut s, &mut hist, n).unwrap();
         assert_eq!(rep.iterations, 3);
         assert!(rep.converged);
         if rep.branch_changes > 0 {
@@ -792,40 +714,35 @@ fn branch_changes_are_reported_and_fixed_iterations_stay_available() {
     // An elastic building never does.
     let law = Bilinear::<f64>::new(building::STIFFNESS, 1e12, building::ALPHA).unwrap();
     let e = ShearBuilding::new([building::MASS; 3], [law; 3], &building::damping()).unwrap();
-    let (mut s, mut hist) = stepper
-        .start_with_history(
-            &e,
-            &z,
-            &z,
-            &e.ground_load(hyst::ground(0, 2)),
-            &e.initial_history(),
-        )
-        .unwrap();
+    let (mut s, mut hist) = hyst::start(&stepper, &e, 2);
     for n in 1..=3000 {
-        let rep = stepper
-            .try_step_with_history(&e, &mut s, &mut hist, &e.ground_load(hyst::ground(n, 2)))
-            .unwrap();
+        let rep = step(&stepper, &e, &mut s, &mut hist, n).unwrap();
         assert_eq!(rep.branch_changes, 0);
     }
 }
 
-#[test]
-fn friction_damped_building_steps_and_converges() {
-    // Each storey: the bilinear frame with a friction damper across it slipping at 10 % of
-    // the frame's yield force, v_r = 1 cm/s.
+/// The bilinear building with a friction damper across each storey, slipping at 10 % of
+/// the frame's yield force, regularized over `v_r` (m/s).
+fn friction_damped(vr: f64) -> ShearBuilding<f64, Parallel<Bilinear<f64>, Friction<f64>>, 3> {
     let law = |i: usize| {
         Parallel(
             Bilinear::<f64>::new(building::STIFFNESS, building::YIELD[i], building::ALPHA).unwrap(),
-            Friction::<f64>::new(0.1 * building::YIELD[i], 1e-2).unwrap(),
+            Friction::<f64>::new(0.1 * building::YIELD[i], vr).unwrap(),
         )
     };
-    let b = ShearBuilding::new(
+    ShearBuilding::new(
         [building::MASS; 3],
-        [law(0), law(1), law(2)],
+        core::array::from_fn(law),
         &building::damping(),
     )
-    .unwrap();
-    let yd = [uy(0), uy(1), uy(2)];
+    .unwrap()
+}
+
+#[test]
+fn friction_damped_building_steps_and_converges() {
+    // Each storey: the bilinear frame with a friction damper across it, v_r = 1 cm/s.
+    let b = friction_damped(1e-2);
+    let yd = core::array::from_fn(hyst::yield_drift);
     let runs: Vec<hyst::Run> = RS
         .iter()
         .map(|&r| {
@@ -866,38 +783,13 @@ fn friction_damped_building_steps_and_converges() {
     // A sharper regularization (v_r = 1 mm/s) at h = 0.01 s puts (h/2) f_s/v_r = 3 M on the
     // Newton matrix and Newton, bouncing on the tanh, fails to converge at some step
     // (measured: step 353): the step is refused and state and history are unchanged.
-    let sharp = |i: usize| {
-        Parallel(
-            Bilinear::<f64>::new(building::STIFFNESS, building::YIELD[i], building::ALPHA).unwrap(),
-            Friction::<f64>::new(0.1 * building::YIELD[i], 1e-3).unwrap(),
-        )
-    };
-    let b = ShearBuilding::new(
-        [building::MASS; 3],
-        [sharp(0), sharp(1), sharp(2)],
-        &building::damping(),
-    )
-    .unwrap();
+    let b = friction_damped(1e-3);
     let stepper = Nonlinear::<f64, 3>::new(0.01, NewtonSettings::up_to(30, TOL)).unwrap();
-    let z = Vector3::zeros();
-    let (mut s, mut hist) = stepper
-        .start_with_history(
-            &b,
-            &z,
-            &z,
-            &b.ground_load(hyst::ground(0, 2)),
-            &b.initial_history(),
-        )
-        .unwrap();
+    let (mut s, mut hist) = hyst::start(&stepper, &b, 2);
     let mut refused = None;
     for n in 1..=2000 {
         let (s0, h0) = (bits(&s), format!("{hist:?}"));
-        match stepper.try_step_with_history(
-            &b,
-            &mut s,
-            &mut hist,
-            &b.ground_load(hyst::ground(n, 2)),
-        ) {
+        match step(&stepper, &b, &mut s, &mut hist, n) {
             Ok(_) => {}
             Err(e) => {
                 assert_eq!(e, Error::NotConverged);

@@ -1,37 +1,20 @@
 //! The linear AEM kernel (issue 2) against exact solutions, the paper's literal A-form,
 //! and an independent Newmark average-acceleration loop.
-#![allow(clippy::needless_range_loop, clippy::type_complexity)]
 
+#[path = "support/checks.rs"]
+mod checks;
+#[path = "support/runs.rs"]
+mod runs;
 mod support;
 
-use aemstep::{Error, Linear, Real, State, Stepper};
-use nalgebra::{DMatrix, DVector, SMatrix, SVector, matrix, vector};
+use aemstep::{Error, Linear, State, Stepper};
+use checks::bits;
+use nalgebra::{SMatrix, SVector, matrix, vector};
+use runs::{
+    CrossCheck, dm, example1_period, example2_error, example2_run, example4_error, free_vibration,
+    rel_diff, sdof,
+};
 use support::*;
-
-fn sdof<T: Real>(w: f64, xi: f64, h: f64) -> Linear<T, 1> {
-    let c = |x: f64| SMatrix::<f64, 1, 1>::new(x);
-    Linear::new(&c(1.0), &c(2.0 * xi * w), &c(w * w), h).unwrap()
-}
-
-/// Numerical period of paper Example 1 (u'' + 25u = 0, u0 = 1, v0 = 0) from the mean
-/// spacing of upward zero crossings (linearly interpolated) over `t_end`.
-fn example1_period(h: f64, t_end: f64) -> f64 {
-    let sys = sdof::<f64>(5.0, 0.0, h);
-    let mut s = sys
-        .start(&vector![1.0], &vector![0.0], &vector![0.0])
-        .unwrap();
-    let mut crossings = Vec::new();
-    let steps = (t_end / h).round() as u64;
-    for _ in 0..steps {
-        let (t0, u0) = (s.time(h), s.u()[0]);
-        sys.step(&mut s, &vector![0.0]);
-        let u1 = s.u()[0];
-        if u0 < 0.0 && u1 >= 0.0 {
-            crossings.push(t0 + h * (-u0) / (u1 - u0));
-        }
-    }
-    (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64
-}
 
 #[test]
 fn example1_period_matches_theory_and_paper() {
@@ -61,34 +44,12 @@ fn example1_no_amplitude_decay_over_1e5_steps() {
     // Undamped trapezoidal rule = Cayley transform of a generator that is skew in the energy
     // norm: ω²u² + v² is conserved exactly; only rounding (~√n·ε) can move it.
     let h = 0.01;
-    let sys = sdof::<f64>(5.0, 0.0, h);
-    let mut s = sys
-        .start(&vector![1.0], &vector![0.0], &vector![0.0])
-        .unwrap();
-    for _ in 0..100_000 {
-        sys.step(&mut s, &vector![0.0]);
-    }
+    let s = free_vibration::<f64>(5.0, h, 100_000);
     let amp = (s.u()[0].powi(2) + (s.v()[0] / 5.0).powi(2)).sqrt();
     eprintln!("amplitude after 1e5 steps: 1 + {:.3e}", amp - 1.0);
     assert!((amp - 1.0).abs() < 1e-9);
     assert_eq!(s.steps(), 100_000);
     assert_eq!(s.time(h), 1000.0);
-}
-
-/// Max |u − u_exact| over [0, 25] for paper Example 2 at h = 1/(500k).
-fn example2_error<T: Real>(p: f64, k: u32) -> f64 {
-    let (w, xi, u0, v0) = (2.0, 0.07, 1.0, 20.0);
-    let h = 1.0 / (500.0 * k as f64);
-    let sys = sdof::<T>(w, xi, h);
-    let f = |x: f64| vector![T::from_f64_rounded(x)];
-    let mut s = sys.start(&f(u0), &f(v0), &f(p)).unwrap();
-    let mut err: f64 = 0.0;
-    for n in 1..=(25 * 500 * k) {
-        sys.step(&mut s, &f(p));
-        let t = n as f64 * h;
-        err = err.max((s.u()[0].as_f64() - sdof_exact(w, xi, u0, v0, p, t).0).abs());
-    }
-    err
 }
 
 #[test]
@@ -99,7 +60,7 @@ fn example2_error_and_second_order_f64() {
     for (case, p, expect) in [("(i)", 0.0, 7.09e-5), ("(ii)", 10.0, 7.00e-5)] {
         let e: Vec<f64> = [1, 2, 4, 8]
             .iter()
-            .map(|&k| example2_error::<f64>(p, k))
+            .map(|&k| example2_error(&example2_run::<f64>(p, k), p, k))
             .collect();
         let orders: Vec<f64> = (1..4).map(|i| order(e[i - 1], 2.0, e[i], 1.0)).collect();
         let overall = order(e[0], 8.0, e[3], 1.0);
@@ -123,52 +84,17 @@ fn example2_f32() {
     // |u| ≤ 10), accumulating like a random walk over 12,500 steps (×√n ≈ 112) → ≈ 7e-5 at
     // worst. Measured: the f32 trajectory stays within 1e-5 of the f64 one.
     for p in [0.0, 10.0] {
-        let e32 = example2_error::<f32>(p, 1);
-        let e64 = example2_error::<f64>(p, 1);
-        let d = f32_vs_f64_sdof(p);
+        let (u32s, u64s) = (example2_run::<f32>(p, 1), example2_run::<f64>(p, 1));
+        let e32 = example2_error(&u32s, p, 1);
+        let e64 = example2_error(&u64s, p, 1);
+        // max |u_f32 − u_f64| over Example 2 at h = 1/500.
+        let d = max_diff(&u32s, &u64s);
         eprintln!(
             "Example 2 p = {p}: f32 max error {e32:.3e} (f64 {e64:.3e}), max |u32 − u64| {d:.3e}"
         );
         assert!(d < 7e-5, "f32 rounding {d:e}");
         assert!(e32 < e64 + 7e-5, "f32 error {e32:e}");
     }
-}
-
-/// max |u_f32 − u_f64| over Example 2 at h = 1/500.
-fn f32_vs_f64_sdof(p: f64) -> f64 {
-    let h = 1.0 / 500.0;
-    let (a, b) = (sdof::<f32>(2.0, 0.07, h), sdof::<f64>(2.0, 0.07, h));
-    let mut sa = a
-        .start(&vector![1.0], &vector![20.0], &vector![p as f32])
-        .unwrap();
-    let mut sb = b.start(&vector![1.0], &vector![20.0], &vector![p]).unwrap();
-    let mut d: f64 = 0.0;
-    for _ in 0..12_500 {
-        a.step(&mut sa, &vector![p as f32]);
-        b.step(&mut sb, &vector![p]);
-        d = d.max((sa.u()[0] as f64 - sb.u()[0]).abs());
-    }
-    d
-}
-
-/// Paper Example 4 with Caughey damping: (max error over [0, 5], max |u|) at step h.
-fn example4_error<T: Real>(h: f64) -> (f64, f64) {
-    let (m, k, xi, u0, v0, p) = example4();
-    let exact = ModalExact::new(&m, &k, xi, &u0, &v0, &p);
-    let sys = Linear::<T, 3>::new(&m, &exact.c, &k, h).unwrap();
-    let vv = |a: &SVector<f64, 3>| a.map(T::from_f64_rounded);
-    let mut s = sys.start(&vv(&u0), &vv(&v0), &vv(&p)).unwrap();
-    let (mut err, mut umax) = (0.0f64, 0.0f64);
-    let steps = (5.0 / h).round() as u64;
-    for n in 1..=steps {
-        sys.step(&mut s, &vv(&p));
-        let ue = exact.u(n as f64 * h);
-        for i in 0..3 {
-            err = err.max((s.u()[i].as_f64() - ue[i]).abs());
-            umax = umax.max(ue[i].abs());
-        }
-    }
-    (err, umax)
 }
 
 #[test]
@@ -207,75 +133,22 @@ fn example4_against_exact_modal_solution() {
     assert!((e32 - e1).abs() < 1e-4, "f32 {e32:e} vs f64 {e1:e}");
 }
 
-/// Runs `stepper` for `steps` steps under `test_load` from fixed initial conditions.
-fn trajectory<
-    T: Real,
-    const N: usize,
-    S: Stepper<T, N, Input = SVector<T, N>, State = State<T, N>>,
->(
-    sys: &S,
-    steps: usize,
-) -> Vec<State<T, N>> {
-    let h = sys.time_step().as_f64();
-    let load = |t: f64| SVector::<T, N>::from_fn(|i, _| T::from_f64_rounded(test_load(i, t)));
-    let u0 = SVector::<T, N>::from_fn(|i, _| T::from_f64_rounded(0.1 * (i as f64 + 1.0)));
-    let v0 = SVector::<T, N>::from_fn(|i, _| T::from_f64_rounded(-0.2 + 0.05 * i as f64));
-    let mut s = sys.start(&u0, &v0, &load(0.0)).unwrap();
-    let mut out = vec![s];
-    for n in 1..=steps {
-        sys.step(&mut s, &load(n as f64 * h));
-        out.push(s);
-    }
-    out
-}
-
-/// max |x − y| / max |y| over u, v, a separately; the worst of the three.
-fn rel_diff<const N: usize>(x: &[State<f64, N>], y: &[State<f64, N>]) -> f64 {
-    let parts: [fn(&State<f64, N>) -> &SVector<f64, N>; 3] = [|s| s.u(), |s| s.v(), |s| s.a()];
-    parts
-        .iter()
-        .map(|f| {
-            let scale = max_abs(y.iter().flat_map(|s| f(s).iter()));
-            let diff = x
-                .iter()
-                .zip(y)
-                .flat_map(|(a, b)| (f(a) - f(b)).map(f64::abs).data.0[0]);
-            max_abs(diff.collect::<Vec<_>>().iter()) / scale
-        })
-        .fold(0.0, f64::max)
-}
-
-fn cross_check<const N: usize>(seed: u64) {
-    let mut rng = Rng::new(seed);
-    let (m, c, k) = random_system::<N>(&mut rng);
-    let h = 0.01;
-    let fast = Linear::<f64, _>::new(&m, &c, &k, h).unwrap();
-    let aform = fast.a_form();
-    let steps = 10_000;
-    let tf = trajectory(&fast, steps);
-    let ta = trajectory(&aform, steps);
-    let d_fa = rel_diff(&tf, &ta);
-
-    // Independent Newmark-AA (displacement form, dense LU each step).
-    let dm = |a: &SMatrix<f64, N, N>| DMatrix::from_fn(N, N, |i, j| a[(i, j)]);
-    let nm = newmark_aa(
-        &dm(&m),
-        &dm(&c),
-        &dm(&k),
+/// Random system N (seed N): fast form, A-form and the independent Newmark-AA
+/// (displacement form, dense LU each step) over 10⁴ steps, and the A-form's blocks against
+/// the literal 3N×3N operators.
+fn cross_check<const N: usize>() {
+    let CrossCheck {
+        m,
+        c,
+        k,
         h,
-        &DVector::from_fn(N, |i, _| 0.1 * (i as f64 + 1.0)),
-        &DVector::from_fn(N, |i, _| -0.2 + 0.05 * i as f64),
-        |t| DVector::from_fn(N, |i, _| test_load(i, t)),
-        steps,
-    );
-    let tn: Vec<State<f64, N>> = nm
-        .iter()
-        .enumerate()
-        .map(|(n, (u, v, a))| {
-            let sv = |x: &DVector<f64>| SVector::<f64, N>::from_fn(|i, _| x[i]);
-            State::from_parts(sv(u), sv(v), sv(a), n as u64)
-        })
-        .collect();
+        aform,
+        tf,
+        ta,
+        tn,
+        t32,
+    } = runs::cross_check::<N>();
+    let d_fa = rel_diff(&tf, &ta);
     let d_fn = rel_diff(&tf, &tn);
     let d_an = rel_diff(&ta, &tn);
 
@@ -284,21 +157,11 @@ fn cross_check<const N: usize>(seed: u64) {
     let mut d_blocks: f64 = 0.0;
     for r in 0..3 {
         for cc in 0..3 {
-            let blk = aform.a_block(r, cc).unwrap();
             let lit = a_lit.view((r * N, cc * N), (N, N));
-            d_blocks = d_blocks.max(
-                (DMatrix::from_fn(N, N, |i, j| blk[(i, j)]) - lit)
-                    .abs()
-                    .max(),
-            );
+            d_blocks = d_blocks.max((dm(&aform.a_block(r, cc).unwrap()) - lit).abs().max());
         }
-        let blk = aform.b_block(r).unwrap();
         let lit = b_lit.view((r * N, 0), (N, N));
-        d_blocks = d_blocks.max(
-            (DMatrix::from_fn(N, N, |i, j| blk[(i, j)]) - lit)
-                .abs()
-                .max(),
-        );
+        d_blocks = d_blocks.max((dm(&aform.b_block(r).unwrap()) - lit).abs().max());
     }
     eprintln!(
         "N = {N:2}: fast vs A-form {d_fa:.2e}, fast vs Newmark {d_fn:.2e}, A-form vs Newmark {d_an:.2e}, A blocks vs literal L⁻¹R {d_blocks:.2e}"
@@ -312,18 +175,6 @@ fn cross_check<const N: usize>(seed: u64) {
     // f32 against f64: the operators rounded to f32 shift each frequency by ≈ ε₃₂ ≈ 6e-8
     // relative, i.e. a phase drift ω·t·ε₃₂ ≤ 9·100·6e-8 ≈ 5e-5 over the 100 s run (ω ≤ 9 rad/s
     // for these systems), plus per-step rounding; 1e-4 covers that, measured ≤ 4e-6.
-    let f32sys = Linear::<f32, N>::new(&m, &c, &k, h).unwrap();
-    let t32: Vec<State<f64, N>> = trajectory(&f32sys, steps)
-        .iter()
-        .map(|s| {
-            State::from_parts(
-                s.u().map(f64::from),
-                s.v().map(f64::from),
-                s.a().map(f64::from),
-                s.steps(),
-            )
-        })
-        .collect();
     let d_32 = rel_diff(&t32, &tf);
     eprintln!("N = {N:2}: f32 vs f64 fast form {d_32:.2e}");
     assert!(d_32 < 1e-4, "f32 {d_32:e}");
@@ -332,11 +183,11 @@ fn cross_check<const N: usize>(seed: u64) {
 
 #[test]
 fn fast_form_a_form_and_newmark_agree() {
-    cross_check::<1>(1);
-    cross_check::<2>(2);
-    cross_check::<3>(3);
-    cross_check::<6>(6);
-    cross_check::<12>(12);
+    cross_check::<1>();
+    cross_check::<2>();
+    cross_check::<3>();
+    cross_check::<6>();
+    cross_check::<12>();
 }
 
 // ---------------------------------------------------------------- errors, bad input
@@ -456,14 +307,6 @@ fn checked_step_keeps_state_bit_identical_on_bad_load() {
                 st.try_step(&mut s, &p).unwrap();
             }
             let before = s;
-            let bits = |s: &State<f64, 3>| {
-                s.u()
-                    .iter()
-                    .chain(s.v().iter())
-                    .chain(s.a().iter())
-                    .map(|x| x.to_bits())
-                    .collect::<Vec<_>>()
-            };
             // A non-finite load is refused as input (the same variant in every stepper).
             for bad in [
                 vector![f64::NAN, 0.0, 0.0],

@@ -10,19 +10,20 @@
 use aemstep::models::{self, base_excitation, storey_drifts};
 use aemstep::observer::{Kalman, Observer, Outputs, Readout, StateSpace, SteadyState};
 use aemstep::{Damping, Error, Exact, LinearInput, Modal, StepState, Stepper};
-use nalgebra::{DMatrix, SMatrix, SVector};
+use nalgebra::{SMatrix, SVector};
 
+#[path = "support/checks.rs"]
+mod checks;
 #[path = "../examples/modal_fw/elcentro.rs"]
 mod elcentro;
+mod support;
+
+use support::{max_abs, riccati_residual, sm, spectral_radius};
 
 const H: f64 = elcentro::DT;
 const EPS: f64 = f64::EPSILON;
 type Building = ([[f64; 5]; 5], [[f64; 5]; 5], [[f64; 5]; 5]);
 const B: Building = models::five_storey_building();
-
-fn sm<const R: usize, const C: usize>(a: &[[f64; C]; R]) -> SMatrix<f64, R, C> {
-    SMatrix::from_fn(|i, j| a[i][j])
-}
 
 /// The building's full model, ground acceleration in.
 fn building() -> StateSpace<5, 10, 1> {
@@ -45,10 +46,6 @@ fn force_noise(sigma_f: f64) -> SMatrix<f64, 10, 10> {
 
 fn identity5() -> [[f64; 5]; 5] {
     core::array::from_fn(|i| core::array::from_fn(|j| if i == j { 1.0 } else { 0.0 }))
-}
-
-fn max_abs<'a>(xs: impl IntoIterator<Item = &'a f64>) -> f64 {
-    xs.into_iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
 /// The bound on the difference of two f64 evaluations of the same stable linear recurrence
@@ -245,29 +242,6 @@ fn state_size_must_match() {
         StateSpace::<5, 10, 1>::aem_from_rows([[0.0; 5]; 5], B.1, B.2, base_excitation(&B.0), H),
         Err(Error::SingularMass)
     );
-}
-
-/// The Riccati residual `‖P − F(P)‖_max / ‖P‖_max`, `F(P) = ΦPΦᵀ − ΦPHᵀ(HPHᵀ+R)⁻¹HPΦᵀ + Q`,
-/// written here with nalgebra (independent of the library's const code).
-fn riccati_residual<const S: usize, const O: usize>(
-    phi: &SMatrix<f64, S, S>,
-    h: &SMatrix<f64, O, S>,
-    q: &SMatrix<f64, S, S>,
-    r: &SMatrix<f64, O, O>,
-    p: &SMatrix<f64, S, S>,
-) -> f64 {
-    let si = h * p * h.transpose() + r;
-    let k = phi * p * h.transpose() * si.try_inverse().unwrap();
-    let f = phi * p * phi.transpose() - k * h * p * phi.transpose() + q;
-    max_abs((p - f).iter()) / max_abs(p.iter())
-}
-
-/// Spectral radius of a real square matrix (complex eigenvalues, via nalgebra's Schur).
-fn spectral_radius<const S: usize>(a: &SMatrix<f64, S, S>) -> f64 {
-    let d = DMatrix::from_fn(S, S, |i, j| a[(i, j)]);
-    d.complex_eigenvalues()
-        .iter()
-        .fold(0.0, |m, z| m.max(z.norm()))
 }
 
 /// The scene's noise: forces `σ_f` on every floor, accelerometer noise `σ_y`.
@@ -826,18 +800,9 @@ fn scene_constants_and_firmware_reference_are_current() {
         "firmware reference: f32 vs f64 observer, max |Δ drift| = {measured:.3e} m ({:.2e} of the {peak_drift:.4} m peak), bound {bound:e} m",
         measured / peak_drift
     );
-    let text = generate_reference(&d64, bound);
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/observer_fw/reference.rs"
-    );
-    if std::env::var_os("AEMSTEP_WRITE_REFERENCE").is_some() {
-        std::fs::write(path, &text).unwrap();
-    }
-    assert_eq!(
-        std::fs::read_to_string(path).unwrap(),
-        text,
-        "examples/observer_fw/reference.rs is stale: rerun with AEMSTEP_WRITE_REFERENCE=1"
+    checks::reference_is_current(
+        "examples/observer_fw/reference.rs",
+        &generate_reference(&d64, bound),
     );
     assert_eq!(reference::EVERY, EVERY);
     // f32 against f64: a few f32 ulps of the drift scale, amplified by the observer's

@@ -7,27 +7,17 @@
 //! `sin`/`cos`/`exp`, where the library uses a `const fn` matrix exponential.
 #![allow(clippy::needless_range_loop)]
 
+/// The El Centro 1940 NS record (m/s²); `tests/firmware_modal.rs` checks its parser against
+/// `str::parse` bit for bit.
+#[path = "../examples/modal_fw/elcentro.rs"]
+mod elcentro;
+
 use aemstep::Error;
 use aemstep::spectrum::{Bank, MAX_SUBSTEPS, RotD, Scheme, Substeps};
 
-const G: f64 = 9.80665;
 const DT: f64 = 0.02;
 const P: usize = 100;
 const ZETA: f64 = 0.05;
-
-/// The El Centro 1940 NS record (m/s²), parsed with `str::parse`.
-fn elcentro() -> Vec<f64> {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/data/elcentro-ns-1940.txt"
-    ))
-    .expect("data/elcentro-ns-1940.txt");
-    text.lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty() && !l.starts_with('#'))
-        .map(|l| l.parse::<f64>().expect("number") * G)
-        .collect()
-}
 
 /// 100 periods, log-spaced from 0.01 s to 10 s.
 fn periods() -> [f64; P] {
@@ -323,7 +313,7 @@ fn harmonic_input_every_period() {
 /// written above, oscillator by oscillator on the same sub-steps: rounding level.
 #[test]
 fn elcentro_against_closed_form_steps_at_rounding_level() {
-    let rec = elcentro();
+    let rec = elcentro::AG_F64;
     assert_eq!(rec.len(), 3995);
     let b = bank(Scheme::Exact, Substeps::AUTO);
     let (sd, sv, sa) = run(&b, &rec, 0);
@@ -351,7 +341,7 @@ fn elcentro_against_closed_form_steps_at_rounding_level() {
 /// peak (both take peaks at the same instants, so what remains is RK4's own error).
 #[test]
 fn elcentro_against_small_step_rk4() {
-    let rec = elcentro();
+    let rec = elcentro::AG_F64;
     let b = bank(Scheme::Exact, Substeps::AUTO);
     let (sd, sv, sa) = run(&b, &rec, 0);
     let mut worst = [0.0f64; 3];
@@ -412,7 +402,7 @@ fn elcentro_against_small_step_rk4() {
 /// worst is printed (about 0.4 of it).
 #[test]
 fn elcentro_f32_within_its_rounding() {
-    let rec = elcentro();
+    let rec = elcentro::AG_F64;
     let b64 = bank(Scheme::Exact, Substeps::AUTO);
     let b32 = Bank::<f32, P>::new(periods(), [ZETA; P], DT).unwrap();
     let (sd64, ..) = run(&b64, &rec, 0);
@@ -441,7 +431,7 @@ fn elcentro_f32_within_its_rounding() {
 /// 2e-5). And the rule is needed: one sub-step misses by several per cent.
 #[test]
 fn substep_rule_meets_its_criterion() {
-    let rec = elcentro();
+    let rec = elcentro::AG_F64;
     let (rd, rv, ra) = run(&bank(Scheme::Exact, Substeps::Fixed(MAX_SUBSTEPS)), &rec, 0);
     let worst = |s: Substeps| {
         let (sd, sv, sa) = run(&bank(Scheme::Exact, s), &rec, 0);
@@ -471,7 +461,7 @@ fn substep_rule_meets_its_criterion() {
 /// after the last sample; on its first 5 s the long-period peaks do.
 #[test]
 fn free_vibration_after_the_record() {
-    let rec = elcentro();
+    let rec = elcentro::AG_F64;
     let b = bank(Scheme::Exact, Substeps::AUTO);
     let fv = b.free_vibration_samples();
     assert_eq!(fv, 500); // ⌈10 s / 0.02 s⌉
@@ -506,7 +496,7 @@ fn free_vibration_after_the_record() {
 fn rotd_against_rotated_records_and_closed_form() {
     const Q: usize = 8;
     const K: usize = 12;
-    let rec = elcentro();
+    let rec = elcentro::AG_F64;
     // second component: the record reversed in time (synthetic, uncorrelated enough)
     let y: Vec<f64> = rec.iter().rev().map(|a| 0.7 * a).collect();
     let per: [f64; Q] = core::array::from_fn(|i| 0.05 * 2f64.powi(i as i32));
@@ -599,10 +589,9 @@ fn bad_periods_damping_and_time_step_are_typed_errors() {
 /// held, so the result equals feeding that held value; the peaks stay finite.
 #[test]
 fn nan_samples_are_skipped_counted_and_held() {
-    let rec = elcentro();
+    let rec = elcentro::AG_F64;
     let b = bank(Scheme::Exact, Substeps::AUTO);
-    let mut bad = rec.clone();
-    let mut held = rec.clone();
+    let (mut bad, mut held) = (rec, rec);
     for (i, x) in [
         (0usize, f64::NAN),
         (100, f64::NAN),
@@ -641,7 +630,7 @@ fn nan_samples_are_skipped_counted_and_held() {
 #[test]
 fn batch_equals_one_record_at_a_time() {
     use aemstep::spectrum::batch;
-    let rec = elcentro();
+    let rec = elcentro::AG_F64;
     let recs: Vec<Vec<f64>> = (0..7)
         .map(|i| rec.iter().map(|a| a * (1.0 + 0.1 * i as f64)).collect())
         .collect();

@@ -18,14 +18,11 @@ use aemstep::models::{self, base_excitation};
 use aemstep::observer::{Kalman, Observer, Outputs, StateSpace, SteadyState};
 use aemstep::{AlphaParameters, Error, GeneralizedAlpha, Newmark, State, Stepper};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
+use support::{riccati_residual, sm, spectral_radius};
 
 const EPS: f64 = f64::EPSILON;
 /// Steps of every comparison (the brief's 2000; El Centro has 3995 samples).
 const STEPS: usize = 2000;
-
-fn sm<const R: usize, const C: usize>(a: &[[f64; C]; R]) -> SMatrix<f64, R, C> {
-    SMatrix::from_fn(|i, j| a[i][j])
-}
 
 /// A system and its load: `M, C, K`, `B` (`N×I`), the initial state, the step and the input
 /// samples `w_n`.
@@ -688,28 +685,6 @@ fn zero_gain_observer_on_the_generalized_alpha_model_is_the_open_loop_stepper() 
     report("zero-gain observer, gen-α 0.8", case.name, &a);
     assert_eq!(e.missing(), 0);
     assert_eq!(e.steps(), STEPS as u64);
-}
-
-/// Spectral radius of a real square matrix (complex eigenvalues, via nalgebra's Schur).
-fn spectral_radius<const S: usize>(a: &SMatrix<f64, S, S>) -> f64 {
-    let d = DMatrix::from_fn(S, S, |i, j| a[(i, j)]);
-    d.complex_eigenvalues()
-        .iter()
-        .fold(0.0, |m, z| m.max(z.norm()))
-}
-
-/// `‖P − F(P)‖_max / ‖P‖_max`, `F(P) = ΦPΦᵀ − ΦPHᵀ(HPHᵀ+R)⁻¹HPΦᵀ + Q` (nalgebra).
-fn riccati_residual<const S: usize, const O: usize>(
-    phi: &SMatrix<f64, S, S>,
-    h: &SMatrix<f64, O, S>,
-    q: &SMatrix<f64, S, S>,
-    r: &SMatrix<f64, O, O>,
-    p: &SMatrix<f64, S, S>,
-) -> f64 {
-    let si = h * p * h.transpose() + r;
-    let k = phi * p * h.transpose() * si.try_inverse().unwrap();
-    let f = phi * p * phi.transpose() - k * h * p * phi.transpose() + q;
-    (p - f).abs().max() / p.abs().max()
 }
 
 #[test]

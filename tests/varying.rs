@@ -1,48 +1,21 @@
 //! The time-varying stepper against paper Example 3's exact solution, against `Linear`
 //! for constant coefficients, and on its failure paths.
 
-use aemstep::{Coefficients, Error, Linear, State, Stepper, TimeVarying, Varying, models};
-use nalgebra::{SMatrix, SVector, matrix, vector};
+#[path = "support/checks.rs"]
+mod checks;
+#[path = "support/runs.rs"]
+mod runs;
+mod support;
 
-/// Bit patterns of a state, so "unchanged" means bit-identical.
-fn bits<const N: usize>(s: &State<f64, N>) -> Vec<u64> {
-    s.u()
-        .iter()
-        .chain(s.v().iter())
-        .chain(s.a().iter())
-        .map(|x| x.to_bits())
-        .chain([s.steps()])
-        .collect()
-}
+use aemstep::{Coefficients, Error, Linear, Stepper, Varying, models};
+use checks::bits;
+use nalgebra::{SVector, matrix, vector};
+use runs::{Example3, example3_exact, example3_load, example3_start};
+use support::sm;
 
 // ---------------------------------------------------------------- Example 3
-
-/// `(1 + t²) u'' + t u' + e^{1/(1+t)} u = p(t)`.
-struct Example3;
-
-impl TimeVarying<f64, 1> for Example3 {
-    fn coefficients(&self, t: f64) -> Coefficients<f64, 1> {
-        Coefficients {
-            mass: matrix![1.0 + t * t],
-            damping: matrix![t],
-            stiffness: matrix![(1.0 / (1.0 + t)).exp()],
-        }
-    }
-}
-
-/// `u = e^{−0.1t} cos t`, `u' = e^{−0.1t}(−0.1 cos t − sin t)`,
-/// `u'' = e^{−0.1t}(−0.99 cos t + 0.2 sin t)`.
-fn example3_exact(t: f64) -> (f64, f64, f64) {
-    let e = (-0.1 * t).exp();
-    let (s, c) = t.sin_cos();
-    (e * c, e * (-0.1 * c - s), e * (-0.99 * c + 0.2 * s))
-}
-
-/// The load, by substituting the exact solution into the equation.
-fn example3_load(t: f64) -> f64 {
-    let (u, v, a) = example3_exact(t);
-    (1.0 + t * t) * a + t * v + (1.0 / (1.0 + t)).exp() * u
-}
+// (`Example3`, `(1 + t²) u'' + t u' + e^{1/(1+t)} u = p(t)`, its exact solution and load:
+// tests/support/runs.rs)
 
 #[test]
 fn example3_exact_solution_and_load_are_right() {
@@ -67,30 +40,10 @@ fn example3_exact_solution_and_load_are_right() {
     }
 }
 
-fn example3_max_error(h: f64, t_end: f64) -> f64 {
-    let st = Varying::<f64, 1>::new(h).unwrap();
-    let mut s = st
-        .start(
-            &Example3,
-            &vector![1.0],
-            &vector![-0.1],
-            &vector![example3_load(0.0)],
-        )
-        .unwrap();
-    let mut err = 0.0f64;
-    for n in 1..=(t_end / h).round() as u64 {
-        let t = n as f64 * h;
-        st.try_step(&Example3, &mut s, &vector![example3_load(t)])
-            .unwrap();
-        err = err.max((s.u()[0] - example3_exact(t).0).abs());
-    }
-    err
-}
-
 #[test]
 fn example3_error_and_order() {
-    let e1 = example3_max_error(0.01, 20.0);
-    let e2 = example3_max_error(0.005, 20.0);
+    let e1 = runs::example3_error::<f64>(0.01, 20.0);
+    let e2 = runs::example3_error::<f64>(0.005, 20.0);
     let order = (e1 / e2).log2();
     println!("Example 3 (T = 20): max error h=0.01: {e1:.3e}, h=0.005: {e2:.3e}, order {order:.3}");
     // Measured 3.132e-5 and 7.831e-6, order 2.000: error = C h² with C = 0.313 at both
@@ -127,14 +80,10 @@ fn example3_in_f32() {
 
 // ---------------------------------------------------------------- constant coefficients
 
-fn rows<const N: usize>(a: &models::Rows<N>) -> SMatrix<f64, N, N> {
-    SMatrix::from_fn(|i, j| a[i][j])
-}
-
 #[test]
 fn constant_coefficients_reproduce_linear() {
     let (m, c, k) = models::five_storey_building();
-    let (m, c, k) = (rows(&m), rows(&c), rows(&k));
+    let (m, c, k) = (sm(&m), sm(&c), sm(&k));
     let h = 0.01;
     let lin = Linear::<f64, _>::new(&m, &c, &k, h).unwrap();
     let var = Varying::<f64, 5>::new(h).unwrap();
@@ -297,14 +246,7 @@ fn start_and_construction_errors() {
     };
     assert_eq!(st.start(&nan_m, &z, &z, &z), Err(Error::NonFiniteInput));
     // q0 = M(0)⁻¹ (p0 − C(0) v0 − K(0) u0): Example 3 at t = 0: M = 1, C = 0, K = e.
-    let s = st
-        .start(
-            &Example3,
-            &vector![1.0],
-            &vector![-0.1],
-            &vector![example3_load(0.0)],
-        )
-        .unwrap();
+    let s = example3_start(&st);
     assert!((s.a()[0] - example3_exact(0.0).2).abs() < 1e-15);
 }
 

@@ -6,9 +6,12 @@
 
 use aemstep::hysteresis::{HistoryModel, Law, ShearBuilding};
 use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::{NewtonSettings, Nonlinear, Real};
+use aemstep::{NewtonSettings, Nonlinear, Real, State};
 
-use super::elcentro;
+use super::{building, elcentro};
+
+/// Newton tolerance of the building runs.
+pub const TOL: f64 = 1e-12;
 
 /// Ground acceleration (m/s²) at step `n` of step `h = DT / r`: the record linear between
 /// its samples (0 after its end).
@@ -22,6 +25,29 @@ pub fn ground(n: u64, r: u64) -> f64 {
         let th = k as f64 / r as f64;
         (1.0 - th) * a(i) + th * a(i + 1)
     }
+}
+
+/// Yield drift `u_y` of storey `i` (m).
+pub fn yield_drift(i: usize) -> f64 {
+    building::YIELD[i] / building::STIFFNESS
+}
+
+/// The building at rest, started with step `h = DT / r` under the record's first sample.
+pub fn start<L: Law<f64>>(
+    stepper: &Nonlinear<f64, 3>,
+    b: &ShearBuilding<f64, L, 3>,
+    r: u64,
+) -> (State<f64, 3>, [L::History; 3]) {
+    let zero = SVector::<f64, 3>::zeros();
+    stepper
+        .start_with_history(
+            b,
+            &zero,
+            &zero,
+            &b.ground_load(ground(0, r)),
+            &b.initial_history(),
+        )
+        .unwrap()
 }
 
 /// What one run gives.
@@ -63,16 +89,7 @@ pub fn run<L: Law<f64>>(
     let stepper = Nonlinear::<f64, 3>::new(h, settings).unwrap();
     let m: SMatrix<f64, 3, 3> = b.mass();
     let c = *b.damping();
-    let zero = SVector::<f64, 3>::zeros();
-    let (mut s, mut hist) = stepper
-        .start_with_history(
-            b,
-            &zero,
-            &zero,
-            &b.ground_load(ground(0, r)),
-            &b.initial_history(),
-        )
-        .unwrap();
+    let (mut s, mut hist) = start(&stepper, b, r);
     let steps = (elcentro::SAMPLES as u64 - 1) * r;
     let mut out = Run {
         u: vec![[0.0; 3]],
@@ -135,6 +152,35 @@ pub fn run<L: Law<f64>>(
     out
 }
 
+/// The bilinear building (`building::bilinear`) at `h = DT / r`, Newton to [`TOL`]:
+/// plastic dissipation `f_y |Δd_p|`; hardening energy `H d_p²/2` stored.
+pub fn bilinear_run(r: u64) -> Run {
+    let hard = building::ALPHA * building::STIFFNESS / (1.0 - building::ALPHA);
+    run(
+        &building::bilinear::<f64>().unwrap(),
+        r,
+        NewtonSettings::up_to(30, TOL),
+        core::array::from_fn(yield_drift),
+        |i, p, n, _, _| building::YIELD[i] * (n.plastic - p.plastic).abs(),
+        |_, h| 0.5 * hard * h.plastic * h.plastic,
+    )
+}
+
+/// The Bouc–Wen building (`building::bouc_wen`) at `h = DT / r`, Newton to [`TOL`]:
+/// `(1 − α) f_y ∫ z dd` (trapezoid in d), minus the recoverable `(1 − α) f_y u_y z²/2`
+/// held in z.
+pub fn bouc_wen_run(r: u64) -> Run {
+    let cz = |i: usize| (1.0 - building::ALPHA) * building::YIELD[i];
+    run(
+        &building::bouc_wen::<f64>().unwrap(),
+        r,
+        NewtonSettings::up_to(30, TOL),
+        core::array::from_fn(yield_drift),
+        |i, p, n, d0, d1| cz(i) * 0.5 * (p.z + n.z) * (d1 - d0),
+        |i, h| -0.5 * cz(i) * yield_drift(i) * h.z * h.z,
+    )
+}
+
 /// max over the common samples and floors of |a − b|.
 pub fn max_diff(a: &Run, b: &Run) -> f64 {
     a.u.iter()
@@ -163,7 +209,7 @@ pub fn table(rs: &[u64], runs: &[Run]) -> Vec<String> {
     ];
     let order = |a: f64, b: f64| format!("{:.2}", (a / b).log2());
     for (j, run) in runs.iter().enumerate() {
-        let h = super::elcentro::DT / rs[j] as f64;
+        let h = elcentro::DT / rs[j] as f64;
         let c_order = if j > 0 {
             order(runs[j - 1].closure, run.closure)
         } else {
@@ -191,8 +237,8 @@ pub fn table(rs: &[u64], runs: &[Run]) -> Vec<String> {
 /// Roof displacement at every step, the largest storey ductility, and how many steps did
 /// not converge within the settings.
 pub fn roof<T: Real>(settings: NewtonSettings<T>, ag: &[T]) -> (Vec<f64>, f64, usize) {
-    let b = super::building::bilinear::<T>().unwrap();
-    let stepper = Nonlinear::<T, 3>::new(super::elcentro::DT, settings).unwrap();
+    let b = building::bilinear::<T>().unwrap();
+    let stepper = Nonlinear::<T, 3>::new(elcentro::DT, settings).unwrap();
     let z = SVector::zeros();
     let (mut s, mut h) = stepper
         .start_with_history(&b, &z, &z, &b.ground_load(ag[0]), &b.initial_history())
@@ -210,8 +256,8 @@ pub fn roof<T: Real>(settings: NewtonSettings<T>, ag: &[T]) -> (Vec<f64>, f64, u
         (s, h) = (next, hist);
         out.push(s.u()[2].as_f64());
         let d = [s.u()[0], s.u()[1] - s.u()[0], s.u()[2] - s.u()[1]];
-        for (di, fy) in d.iter().zip(super::building::YIELD) {
-            ductility = ductility.max(di.as_f64().abs() * super::building::STIFFNESS / fy);
+        for (di, fy) in d.iter().zip(building::YIELD) {
+            ductility = ductility.max(di.as_f64().abs() * building::STIFFNESS / fy);
         }
     }
     (out, ductility, unconverged)

@@ -17,6 +17,10 @@ impl Rng {
     pub fn new(seed: u64) -> Self {
         Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
     }
+    /// The generator started from the raw state `state` (no mixing of the seed).
+    pub fn from_state(state: u64) -> Self {
+        Rng(state)
+    }
     /// Uniform in [-1, 1).
     pub fn uniform(&mut self) -> f64 {
         self.0 ^= self.0 >> 12;
@@ -233,9 +237,45 @@ pub fn literal_a_b(
     (&li * r, li * e)
 }
 
+/// Row-major rows as a matrix.
+pub fn sm<const R: usize, const C: usize>(a: &[[f64; C]; R]) -> SMatrix<f64, R, C> {
+    SMatrix::from_fn(|i, j| a[i][j])
+}
+
+/// The Riccati residual `‖P − F(P)‖_max / ‖P‖_max`, `F(P) = ΦPΦᵀ − ΦPHᵀ(HPHᵀ+R)⁻¹HPΦᵀ + Q`,
+/// written here with nalgebra (independent of the library's const code).
+pub fn riccati_residual<const S: usize, const O: usize>(
+    phi: &SMatrix<f64, S, S>,
+    h: &SMatrix<f64, O, S>,
+    q: &SMatrix<f64, S, S>,
+    r: &SMatrix<f64, O, O>,
+    p: &SMatrix<f64, S, S>,
+) -> f64 {
+    let si = h * p * h.transpose() + r;
+    let k = phi * p * h.transpose() * si.try_inverse().unwrap();
+    let f = phi * p * phi.transpose() - k * h * p * phi.transpose() + q;
+    max_abs((p - f).iter()) / max_abs(p.iter())
+}
+
+/// Spectral radius of a real square matrix (complex eigenvalues, via nalgebra's Schur).
+pub fn spectral_radius<const S: usize>(a: &SMatrix<f64, S, S>) -> f64 {
+    let d = DMatrix::from_fn(S, S, |i, j| a[(i, j)]);
+    d.complex_eigenvalues()
+        .iter()
+        .fold(0.0, |m, z| m.max(z.norm()))
+}
+
 /// `max_i |x_i|` over a trajectory of vectors.
 pub fn max_abs<'a, I: IntoIterator<Item = &'a f64>>(xs: I) -> f64 {
     xs.into_iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
+/// max |a_i − b_i| over the common length of two sampled histories.
+pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 /// Observed order `log(e1/e2)/log(h1/h2)`.
