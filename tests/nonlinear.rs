@@ -704,7 +704,7 @@ fn elastic_pendulum_f32() {
         a.max_iterations
     );
     assert_eq!((a.trajectory.len(), a.failed), (100_000, None));
-    // Measured: f32 1.784e-1 J, f64 1.756e-1 J; gap 1.04e-5 m at t ≤ 10, 2.2e-2 m at
+    // Measured: f32 1.754e-1 J, f64 1.756e-1 J; gap 4.4e-6 m at t ≤ 10, 1.2e-2 m at
     // t ≤ 1000 (an f32 phase drift: the swing keeps its amplitude, the timing slides).
     // Energy: the f64 bound (0.19 J) plus rounding, a random walk of ε_f32 × 200 J over
     // 1e5 steps ≈ 4e-3 J, allowed 0.01 J. Position to t = 10: a random walk of ε_f32 × L
