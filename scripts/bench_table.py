@@ -86,7 +86,8 @@ for n in [25, 50, 100]:
 SIZE = {"f64": 8, "f32": 4}
 for ty in ["f64", "f32"]:
     peak = fast.get(("floor", f"compute-{ty}", None)) or fast.get(("floor", f"compute-{ty}", ""))
-    peak = 48 * 256 / peak if peak else None  # multiply-adds per ns
+    lanes = {"f64": 24, "f32": 48}[ty]  # benches/steps.rs: floor_compute::<T, LANES>
+    peak = lanes * 256 / peak if peak else None  # multiply-adds per ns
     print(f"\n`Linear<{ty}, N>` against the floor (fastest sample; compute peak of this build "
           f"{peak:.1f} multiply-adds per ns; operators {3 * SIZE[ty]}N² bytes):\n" if peak else "")
     print("| N | `Linear` | multiply-adds / ns | floor: read operators | floor: compute | share of floor | "
