@@ -7,7 +7,7 @@
 
 use nalgebra::SVector;
 
-use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics};
+use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition, row_scales};
 use crate::linalg::{Mat, add_scaled, all_finite, finite_as, round_rows, rows_f64};
 use crate::scalar::initial_inputs_finite;
@@ -512,6 +512,13 @@ pub(crate) const fn newmark_operators<const N: usize>(
         Ok(kin) => kin,
         Err(e) => return Err(e),
     };
+    // The kinematics must fit the scalar type too (found by fuzzing: `h = 1e58` in f32).
+    if let Err(e) = check_time_step_as(h, max) {
+        return Err(e);
+    }
+    if !kin.fits(max) {
+        return Err(Error::OperatorOverflow);
+    }
     let (wc, wk) = (kin.gamma_h, kin.beta_h2);
     let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
     if !all_finite(&meff) {

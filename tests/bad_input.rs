@@ -252,3 +252,96 @@ fn nan_load_is_the_same_error_everywhere() {
         nan,
     );
 }
+
+// Found by fuzzing (`scripts/fuzz.sh`; the inputs in `fuzz/regressions/`): each got `Ok`
+// with non-finite or vanishing operators before.
+
+/// A time step that is fine in `f64` but not in `f32`: `h = 1e58` overflows `f32` and
+/// `h = 1e-30` has `h²/4` round to zero. An `f32` stepper built from either had infinite or
+/// vanishing kinematics (the fuzzer found `AForm` blocks of `∞`); now every `f32`
+/// constructor says `InvalidTimeStep`, the `f64` ones keep them.
+#[test]
+fn f32_time_step_that_does_not_fit_is_invalid() {
+    use aemstep::{CompensatedLinear, NewtonSettings, Nonlinear};
+    let (m, z, k) = (matrix![1.0], matrix![0.0], matrix![1.0]);
+    let want = Some(Error::InvalidTimeStep);
+    for h in [1e58, 1e-30] {
+        assert_eq!(
+            Linear::<f32, 1>::new(&m, &z, &k, h).err(),
+            want,
+            "h = {h:e}"
+        );
+        assert_eq!(
+            Linear::<f32, 1>::from_rows([[1.0]], [[0.0]], [[1.0]], h).err(),
+            want
+        );
+        assert_eq!(CompensatedLinear::<f32, 1>::new(&m, &z, &k, h).err(), want);
+        assert_eq!(
+            LinearInput::<f32, 1, 1>::new(&m, &z, &k, &matrix![1.0], h).err(),
+            want
+        );
+        assert_eq!(
+            Newmark::<f32, 1>::average_acceleration(&m, &z, &k, h).err(),
+            want
+        );
+        assert_eq!(
+            GeneralizedAlpha::<f32, 1>::new(&m, &z, &k, h, 0.8).err(),
+            want
+        );
+        assert_eq!(Exact::<f32, 1>::new(&m, &z, &k, h).err(), want);
+        assert_eq!(
+            Modal::<f32, 1, 1, 1, 1>::new(&m, &k, &Damping::None, &m, &m, h).err(),
+            want
+        );
+        assert_eq!(
+            Nonlinear::<f32, 1>::new(h, NewtonSettings::default()).err(),
+            want
+        );
+        assert_eq!(Varying::<f32, 1>::new(h).err(), want);
+        // The same h in f64: a valid step.
+        let sys = Linear::<f64, 1>::new(&m, &z, &k, h).unwrap();
+        assert_eq!(sys.time_step(), h);
+        assert!(Varying::<f64, 1>::new(h).is_ok());
+    }
+}
+
+/// Newmark coefficients that overflow although `h²` does not: `β = 1e300`, `h = 1e10` has
+/// `β h² = ∞`. With `K = 0` no operator showed it and the stepper was built; now it is an
+/// overflow (and `β = 1e30` fits `f64` but not `f32`).
+#[test]
+fn newmark_coefficients_that_overflow_are_rejected() {
+    let (m, z) = (matrix![1.0], matrix![0.0]);
+    assert_eq!(
+        Newmark::<f64, 1>::new(&m, &z, &z, 1e10, 1e300, 0.5).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert_eq!(
+        Newmark::<f32, 1>::new(&m, &z, &z, 1.0, 1e39, 0.5).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert!(Newmark::<f64, 1>::new(&m, &z, &z, 1.0, 1e39, 0.5).is_ok());
+}
+
+/// A reduced stepper's start from known values can overflow in `f32`: the projection
+/// `Φᵀ M u` of `u = (10, 10)` with `M = 1e76 I` is about `1.4e39`. That is
+/// `NonFiniteState` (documented now), and a start from rest still works.
+#[test]
+fn modal_f32_projection_overflow_is_non_finite_state() {
+    let m = SMatrix::<f64, 2, 2>::identity() * 1e76;
+    let k = SMatrix::<f64, 2, 2>::identity();
+    let sys = Modal::<f32, 2, 2, 1, 1>::new(
+        &m,
+        &k,
+        &Damping::None,
+        &SMatrix::repeat(1.0),
+        &SMatrix::repeat(1.0),
+        0.01,
+    )
+    .unwrap();
+    let (ten, z) = (vector![10.0f32, 10.0], vector![0.0f32, 0.0]);
+    assert_eq!(
+        sys.start_with_acceleration(&ten, &z, &z).err(),
+        Some(Error::NonFiniteState)
+    );
+    assert!(sys.start_with_acceleration(&z, &z, &z).is_ok());
+}

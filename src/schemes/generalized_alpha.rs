@@ -25,7 +25,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::kernel::{StartOps, checked_rows, start_operators, terms_scales};
-use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step};
+use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition};
 use crate::linalg::{add_scaled, all_finite, finite_as, round_rows, scaled};
 use crate::{Error, Real, State, Stepper};
@@ -157,7 +157,7 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
         p: AlphaParameters,
     ) -> Result<Self, Error> {
         let (m, c, k) = checked_rows(m, c, k)?;
-        let hf = check_time_step(h)?;
+        let hf = check_time_step_as(h, T::MAX)?;
         let AlphaParameters {
             alpha_m,
             alpha_f,
@@ -192,11 +192,15 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
             return Err(Error::OperatorOverflow);
         }
         let start = start_operators(&m, &c, &k, max)?;
+        let kin = NewmarkKinematics::new(hf, beta, gamma)?;
+        if !kin.fits(max) {
+            return Err(Error::OperatorOverflow);
+        }
         Ok(Self {
             params: p,
             w1: T::from_f64_rounded(f1),
             w0: T::from_f64_rounded(alpha_f),
-            kin: NewmarkKinematics::new(hf, beta, gamma)?.round(),
+            kin: kin.round(),
             g: round_rows(&g),
             gk: round_rows(&gk),
             av: round_rows(&av),
