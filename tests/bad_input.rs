@@ -322,6 +322,31 @@ fn newmark_coefficients_that_overflow_are_rejected() {
     assert!(Newmark::<f64, 1>::new(&m, &z, &z, 1.0, 1e39, 0.5).is_ok());
 }
 
+/// Hysteretic laws and buildings whose coefficients do not fit `f32`: `Bilinear::<f32>`
+/// with `k = 1.6e293` had an infinite stiffness; now an overflow, as a Bouc–Wen `k/f_y` of
+/// `1e41`, a `1/v_r` of `1e40` and a floor mass of `1e39` are.
+#[test]
+fn hysteresis_coefficients_that_overflow_f32_are_rejected() {
+    use aemstep::hysteresis::{Bilinear, BoucWen, Friction, ShearBuilding};
+    let want = Some(Error::OperatorOverflow);
+    assert_eq!(Bilinear::<f32>::new(1.6e293, 1e2, 0.0).err(), want);
+    assert!(Bilinear::<f64>::new(1.6e293, 1e2, 0.0).is_ok());
+    assert_eq!(
+        BoucWen::<f32>::new(1e39, 1e-2, 0.05, 0.5, 0.5, 1.0).err(),
+        want
+    );
+    assert_eq!(Friction::<f32>::new(1.0, 1e-40).err(), want);
+    let law = Bilinear::<f32>::new(1e8, 1e5, 0.05).unwrap();
+    assert_eq!(
+        ShearBuilding::<f32, _, 2>::new([1e39, 1.0], [law; 2], &[[0.0; 2]; 2]).err(),
+        want
+    );
+    // f64: huge but finite coefficients, and a coefficient that overflows f64 itself.
+    let law64 = Bilinear::<f64>::new(1e8, 1e5, 0.05).unwrap();
+    assert!(ShearBuilding::<f64, _, 2>::new([1e39, 1.0], [law64; 2], &[[0.0; 2]; 2]).is_ok());
+    assert_eq!(Bilinear::<f64>::new(1e308, 1.0, 0.99).err(), want);
+}
+
 /// A reduced stepper's start from known values can overflow in `f32`: the projection
 /// `Φᵀ M u` of `u = (10, 10)` with `M = 1e76 I` is about `1.4e39`. That is
 /// `NonFiniteState` (documented now), and a start from rest still works.
@@ -344,4 +369,25 @@ fn modal_f32_projection_overflow_is_non_finite_state() {
         Some(Error::NonFiniteState)
     );
     assert!(sys.start_with_acceleration(&z, &z, &z).is_ok());
+}
+
+/// Bouc–Wen with a large exponent (`n = 951`, β = 1, γ = 0.5) at a step of 3 `u_y` from
+/// rest: the unsafeguarded Newton's first iterate had `|z|ⁿ = ∞` and the force came out
+/// NaN (the stepper then refused every such step). Newton safeguarded by bisection on its
+/// bracket converges: the force is finite and the hysteretic variable solves its update.
+#[test]
+fn bouc_wen_large_exponent_converges() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (k, fy, alpha, n) = (1e9, 1e7, 0.99, 951.2660600471733);
+    let law = BoucWen::<f64>::new(k, fy, alpha, 1.0, 0.5, n).unwrap();
+    let uy = fy / k;
+    for d in [2.98797607421875 * uy, -4.9493408203125 * uy, 0.5 * uy] {
+        let t = law.trial(&law.initial_history(), d, 1.0);
+        assert!(t.force.is_finite() && t.stiffness.is_finite(), "{t:?}");
+        // z solves z = (Δ/2u_y)(g(0) + g(z)), g(z) = 1 − |z|ⁿ (β + γ) loading.
+        let z = t.history.z;
+        let g = |z: f64| 1.0 - z.abs().powf(n) * 1.5;
+        let r = z - 0.5 * (d / uy) * (1.0 + g(z));
+        assert!(r.abs() <= 1e-12, "d = {d:e}: z = {z}, residual {r:e}");
+    }
 }

@@ -1,11 +1,13 @@
 //! Bouc–Wen smooth hysteresis, its internal variable integrated by the trapezoidal rule in
 //! the deformation.
 
-use super::{Law, LawTrial, positive, unit_ratio};
+use super::{Law, LawTrial, fits, positive, unit_ratio};
 use crate::{Error, Real};
 
-/// Scalar Newton iterations allowed for the internal variable of one trial.
-const MAX_ITERATIONS: u32 = 30;
+/// Iterations allowed for the internal variable of one trial: Newton, with bisection steps
+/// where it leaves its bracket or crawls (a bracket of width `|Δ|/u_y` halves to rounding
+/// within about 120 of them).
+const MAX_ITERATIONS: u32 = 200;
 
 /// Bouc–Wen hysteresis: `f = α k d + (1 − α) f_y z`, with the dimensionless hysteretic
 /// variable `z` governed (rate-independently, `A = 1`) by
@@ -26,8 +28,11 @@ const MAX_ITERATIONS: u32 = 30;
 /// ```
 ///
 /// second order in `Δ` and so in the time step, solved for `z` by a scalar Newton from the
-/// explicit Euler predictor (converged to `4ε` relative, at most 30 iterations). Its
-/// residual has slope `≥ 1` in `z` whenever `|γ| ≤ β` (required), so the root is unique.
+/// explicit Euler predictor (converged to `4ε` relative). Its residual has slope `≥ 1` in
+/// `z` whenever `|γ| ≤ β` (required), so the root is unique; it lies between `z₀` and the
+/// predictor (`g` is monotone in `z`), and an iterate that leaves that bracket, or a Newton
+/// step that does not halve, is replaced by bisection, so the solve converges for any
+/// exponent and step.
 /// The consistent tangent is the exact derivative of that update,
 ///
 /// ```text
@@ -35,8 +40,9 @@ const MAX_ITERATIONS: u32 = 30;
 /// ```
 ///
 /// **Cost per trial**: a few Newton iterations of ~15 flops (`n = 1` or `2`; otherwise two
-/// `powf` each); no panic. A trial whose inner Newton does not converge (not seen with
-/// `|Δ|` up to several `u_y`) returns a NaN force, which the stepper reports as
+/// `powf` each; at most 200 with bisection steps); no panic. A trial whose solve does not
+/// converge (not seen: the bracket of width `|Δ|/u_y` halves to rounding within the budget)
+/// or whose data is not finite returns a NaN force, which the stepper reports as
 /// [`Error::NonFiniteForce`] without taking the step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWen<T> {
@@ -67,8 +73,8 @@ impl<T: Real> BoucWen<T> {
     /// (finite, `≥ 1`; `1` and `2` avoid `powf`). A common choice is `β = γ = 1/2`, `n = 1`
     /// (unloading is then linear with stiffness `k`).
     ///
-    /// Errors: [`Error::InvalidMaterial`] for any parameter out of its range or not finite.
-    /// Cost: O(1).
+    /// Errors: [`Error::InvalidMaterial`] for any parameter out of its range or not finite;
+    /// [`Error::OperatorOverflow`] if a coefficient does not fit `T`. Cost: O(1).
     pub fn new(k: f64, fy: f64, alpha: f64, beta: f64, gamma: f64, n: f64) -> Result<Self, Error> {
         if !(positive(k)
             && positive(fy)
@@ -81,15 +87,25 @@ impl<T: Real> BoucWen<T> {
         {
             return Err(Error::InvalidMaterial);
         }
+        let c = [
+            alpha * k,
+            (1.0 - alpha) * fy,
+            k / fy,
+            0.5 * k / fy,
+            beta,
+            gamma,
+            n,
+        ];
+        fits::<T>(&c)?;
         let r = T::from_f64_rounded;
         Ok(Self {
-            ak: r(alpha * k),
-            cz: r((1.0 - alpha) * fy),
-            inv_uy: r(k / fy),
-            half_inv_uy: r(0.5 * k / fy),
-            beta: r(beta),
-            gamma: r(gamma),
-            n: r(n),
+            ak: r(c[0]),
+            cz: r(c[1]),
+            inv_uy: r(c[2]),
+            half_inv_uy: r(c[3]),
+            beta: r(c[4]),
+            gamma: r(c[5]),
+            n: r(c[6]),
             n_kind: if n == 1.0 {
                 1
             } else if n == 2.0 {
@@ -158,13 +174,39 @@ impl<T: Real> Law<T> for BoucWen<T> {
         } else {
             let c = delta * self.half_inv_uy;
             let tol = T::from_f64_rounded(4.0) * T::default_epsilon();
+            let half = T::from_f64_rounded(0.5);
             let mut z = z0 + (c + c) * g0;
+            // The root lies between z0 and the predictor (g is monotone in z, against the
+            // step's direction, so the residual changes sign between them): Newton safeguarded
+            // by bisection on that bracket. (Unsafeguarded, a large exponent n sent an iterate
+            // to |z|ⁿ = ∞ and the force to NaN at Δ = 3 u_y; found by fuzzing.)
+            // Bisection also where Newton crawls (steps not halving: with n ≈ 950 each
+            // Newton step from above shrinks z by only a factor 1 − 1/n), as `rtsafe`.
+            let (mut lo, mut hi) = if z < z0 { (z, z0) } else { (z0, z) };
+            let mut last = hi - lo;
             let mut converged = false;
             for _ in 0..MAX_ITERATIONS {
                 let (g, dg) = self.g(z, s);
-                let step = (z - z0 - c * (g0 + g)) / (one - c * dg);
-                z -= step;
-                if step.abs() <= tol * z.abs().max(one) {
+                let r = z - z0 - c * (g0 + g);
+                if r > T::zero() {
+                    hi = z;
+                } else {
+                    lo = z;
+                }
+                let step = r / (one - c * dg);
+                let next = z - step;
+                if next >= lo && next <= hi && (step + step).abs() <= last {
+                    last = step.abs();
+                    z = next;
+                    if last <= tol * z.abs().max(one) {
+                        converged = true;
+                        break;
+                    }
+                } else {
+                    last = half * (hi - lo);
+                    z = lo + last;
+                }
+                if hi - lo <= tol * lo.abs().max(hi.abs()).max(one) {
                     converged = true;
                     break;
                 }
