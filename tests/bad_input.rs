@@ -391,3 +391,48 @@ fn bouc_wen_large_exponent_converges() {
         assert!(r.abs() <= 1e-12, "d = {d:e}: z = {z}, residual {r:e}");
     }
 }
+
+/// A response-spectrum bank whose operators are not finite: period `1.06e-109` s at
+/// `dt = 1e-4` (`ω dt ≈ 6e105`) gave NaN in the exact map over `dt`, and the bank stepped
+/// every sample to NaN; in `f32`, period `1e-20` s gives `ω² ≈ 4e41`, beyond `f32`. Both
+/// are `OperatorOverflow` now.
+#[test]
+fn spectrum_bank_operators_that_are_not_finite_are_rejected() {
+    use aemstep::spectrum::Bank;
+    let periods = [
+        1.0644899600020377e-109,
+        5.232991146814947,
+        999.7892142570423,
+    ];
+    assert_eq!(
+        Bank::<f64, 3>::new(periods, [0.0; 3], 1e-4).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert_eq!(
+        Bank::<f32, 1>::new([1e-20], [0.05], 0.01).err(),
+        Some(Error::OperatorOverflow)
+    );
+    // The AEM's sub-step overflows there too (`ω⁴ h²` in its formula): an error, not NaN.
+    assert_eq!(
+        Bank::<f64, 3>::with(
+            periods,
+            [0.0; 3],
+            1e-4,
+            aemstep::spectrum::Scheme::Aem,
+            aemstep::spectrum::Substeps::AUTO
+        )
+        .err(),
+        Some(Error::OperatorOverflow)
+    );
+    // f64 holds ω² = 4e41.
+    assert!(
+        Bank::<f64, 1>::with(
+            [1e-20],
+            [0.05],
+            0.01,
+            aemstep::spectrum::Scheme::Aem,
+            aemstep::spectrum::Substeps::Fixed(1)
+        )
+        .is_ok()
+    );
+}
