@@ -436,3 +436,20 @@ fn spectrum_bank_operators_that_are_not_finite_are_rejected() {
         .is_ok()
     );
 }
+
+/// The paper's literal form can overflow where the stepper does not: `M = −9.7e-252`,
+/// `C = K = 0`, `h = 1e147` give `G = −1e251` (finite) but the block `(h/2) G = ∞`.
+/// `try_a_form` reports it; `a_form` documents it.
+#[test]
+fn a_form_blocks_that_overflow_are_reported() {
+    let z = matrix![0.0];
+    let sys = Linear::<f64, 1>::new(&matrix![-9.715100097656247e-252], &z, &z, 1e147).unwrap();
+    assert!(sys.effective_inverse()[(0, 0)].is_finite());
+    assert_eq!(sys.try_a_form().err(), Some(Error::OperatorOverflow));
+    assert!(!sys.a_form().b_block(1).unwrap()[(0, 0)].is_finite());
+    let ok = Linear::<f64, 1>::new(&matrix![1.0], &z, &matrix![4.0], 0.01).unwrap();
+    assert_eq!(
+        format!("{:?}", ok.try_a_form().unwrap()),
+        format!("{:?}", ok.a_form())
+    );
+}

@@ -86,6 +86,16 @@ impl<T: Real, const N: usize> AForm<T, N> {
         Some(SMatrix::from_fn(|i, j| blk[i][c][j]))
     }
 
+    /// Every entry of every block is finite.
+    pub(crate) fn is_finite(&self) -> bool {
+        self.rows
+            .iter()
+            .flatten()
+            .flatten()
+            .flatten()
+            .all(|x| x.is_finite())
+    }
+
     /// Block `b_r` (`r` in `0..3`), or `None` if out of range.
     pub fn b_block(&self, r: usize) -> Option<SMatrix<T, N, N>> {
         let blk = self.rows.get(r)?;
