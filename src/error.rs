@@ -63,8 +63,9 @@ pub enum Error {
     /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) is not finite or is
     /// outside its documented range.
     InvalidParameter,
-    /// A response-spectrum period is not finite and strictly positive, or the periods of
-    /// a bank are not in non-decreasing order (`spectrum::Bank`).
+    /// A response-spectrum period is not finite and at least `1e-150` s (shorter ones have
+    /// an `ω²` that overflows), or the periods of a bank are not in non-decreasing order
+    /// (`spectrum::Bank`).
     InvalidPeriod,
     /// A damping ratio is NaN or outside `[0, 1)` (`spectrum::Bank`).
     InvalidDamping,

@@ -453,3 +453,45 @@ fn a_form_blocks_that_overflow_are_reported() {
         format!("{:?}", ok.a_form())
     );
 }
+
+/// Bouc–Wen in `f32` with `n = 984`: the Newton slope `1 − c ∂g/∂z` overflowed to `∞`, the
+/// step `r/∞ = 0` looked converged at `z = −1.09` (not the root near `−1.003`), and the next
+/// trial's stiffness was `−∞`. A slope that overflows is now a bisection step.
+#[test]
+fn bouc_wen_overflowing_slope_is_not_convergence() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let law =
+        BoucWen::<f32>::new(1e9, 1e2, 0.0, 0.1, 9.796142578125e-3, 983.8988194023956).unwrap();
+    let t = law.trial(&law.initial_history(), -1e-6, -10.0);
+    let z = t.history.z;
+    assert!(t.force.is_finite() && z > -1.01 && z < -1.0, "{t:?}");
+    let again = law.trial(&t.history, -1e-6, -10.0);
+    assert!(
+        again.force.is_finite() && again.stiffness.is_finite(),
+        "{again:?}"
+    );
+}
+
+/// An observer in `f32` of a model whose time step does not fit `f32` (`h = 1e147`): its
+/// `time_step()` was `∞`; now `InvalidTimeStep`, as for every `f32` stepper.
+#[test]
+fn f32_observer_of_a_model_with_an_f64_only_time_step_is_invalid() {
+    use aemstep::observer::{Observer, Outputs, StateSpace};
+    let m = SMatrix::<f64, 2, 2>::identity();
+    let k = m * 4.0;
+    for h in [1e147, 0.01] {
+        let ss =
+            StateSpace::<2, 4, 1>::aem(&m, &M2::zeros(), &k, &SMatrix::repeat(1.0), h).unwrap();
+        let meas = ss
+            .outputs(&Outputs::displacements(Outputs::<2, 1, 1>::select([0])))
+            .unwrap();
+        let r32 = Observer::<f32, 4, 1, 1>::new(&ss, &meas, &SMatrix::zeros());
+        let r64 = Observer::<f64, 4, 1, 1>::new(&ss, &meas, &SMatrix::zeros());
+        if h > 1.0 {
+            assert_eq!(r32.err(), Some(Error::InvalidTimeStep));
+        } else {
+            assert!(r32.is_ok());
+        }
+        assert!(r64.is_ok());
+    }
+}

@@ -193,9 +193,12 @@ impl<T: Real> Law<T> for BoucWen<T> {
                 } else {
                     lo = z;
                 }
-                let step = r / (one - c * dg);
+                // (A slope that overflows is no Newton step: r/∞ = 0 looked converged; found
+                // by fuzzing with n = 984 in f32.)
+                let slope = one - c * dg;
+                let step = r / slope;
                 let next = z - step;
-                if next >= lo && next <= hi && (step + step).abs() <= last {
+                if slope.is_finite() && next >= lo && next <= hi && (step + step).abs() <= last {
                     last = step.abs();
                     z = next;
                     if last <= tol * z.abs().max(one) {

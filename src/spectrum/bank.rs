@@ -230,7 +230,8 @@ pub(super) const fn build_f64<const P: usize>(
 macro_rules! bank_ctor {
     ($t:ident) => {
         impl<const P: usize> Bank<$t, P> {
-            /// A bank of oscillators with periods `period` (s, finite, `> 0`, in
+            /// A bank of oscillators with periods `period` (s, finite, at least `1e-150`
+            /// — shorter ones, whose `ω²` overflows, are `InvalidPeriod` too — in
             /// non-decreasing order), damping ratios `damping` (in `[0, 1)`), sample
             /// interval `dt` (s, finite, `> 0`), the exact scheme, and the sub-step rule
             /// [`Substeps::AUTO`].
