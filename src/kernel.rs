@@ -516,9 +516,6 @@ pub(crate) const fn newmark_operators<const N: usize>(
     if let Err(e) = check_time_step_as(h, max) {
         return Err(e);
     }
-    if !kin.fits(max) {
-        return Err(Error::OperatorOverflow);
-    }
     let (wc, wk) = (kin.gamma_h, kin.beta_h2);
     let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
     if !all_finite(&meff) {
@@ -530,7 +527,7 @@ pub(crate) const fn newmark_operators<const N: usize>(
         None => return Err(Error::SingularEffectiveMatrix),
     };
     let (g, gc, gk) = (lu.inverse(), lu.solve(c), lu.solve(k));
-    if !(finite_as(&g, max) && finite_as(&gc, max) && finite_as(&gk, max)) {
+    if !(finite_as(&g, max) && finite_as(&gc, max) && finite_as(&gk, max) && kin.fits(max)) {
         return Err(Error::OperatorOverflow);
     }
     let start = match start_operators(m, c, k, max) {
