@@ -412,17 +412,45 @@ fn spectrum_bank_operators_that_are_not_finite_are_rejected() {
         Bank::<f32, 1>::new([1e-20], [0.05], 0.01).err(),
         Some(Error::OperatorOverflow)
     );
-    // The AEM's sub-step overflows there too (`ω⁴ h²` in its formula): an error, not NaN.
-    assert_eq!(
-        Bank::<f64, 3>::with(
-            periods,
-            [0.0; 3],
-            1e-4,
-            aemstep::spectrum::Scheme::Aem,
-            aemstep::spectrum::Substeps::AUTO
-        )
-        .err(),
-        Some(Error::OperatorOverflow)
+    // The AEM's sub-step in closed form stays finite and bounded there (formed from unit
+    // inputs it was NaN, and at ωh ≈ 5e14 finite but off by 1e13: 10 m/s² stepped to a
+    // displacement of 1e98).
+    let aem = Bank::<f64, 3>::with(
+        periods,
+        [0.0; 3],
+        1e-4,
+        aemstep::spectrum::Scheme::Aem,
+        aemstep::spectrum::Substeps::AUTO,
+    )
+    .unwrap();
+    let mut r = aem.at_rest();
+    for _ in 0..12 {
+        aem.step(&mut r, -10.0);
+    }
+    assert!(
+        r.sd().iter().all(|x| x.is_finite() && *x < 1e3),
+        "{:?}",
+        r.sd()
+    );
+    let stiff = Bank::<f64, 3>::with(
+        [
+            2.220446049250313e-16,
+            0.6660419550143868,
+            0.6660419550143868,
+        ],
+        [0.18235015869140625; 3],
+        1.643114108127686e-2,
+        aemstep::spectrum::Scheme::Aem,
+        aemstep::spectrum::Substeps::Fixed(1),
+    )
+    .unwrap();
+    let mut r = stiff.at_rest();
+    for a in [2.15667724609375, -10.0, -10.0, -10.0, -10.0] {
+        stiff.step(&mut r, a);
+    }
+    assert!(
+        r.sd()[0] < 1e-20 && r.sa().iter().all(|x| *x < 1e3),
+        "{r:?}"
     );
     // f64 holds ω² = 4e41.
     assert!(
@@ -494,4 +522,28 @@ fn f32_observer_of_a_model_with_an_f64_only_time_step_is_invalid() {
         }
         assert!(r64.is_ok());
     }
+}
+
+/// Bouc–Wen with a huge `β` (`3e94`, so `z_max = 6e-48`): the inner solve's tolerance was
+/// absolute (`4ε`), it stopped at `z = 3e-16`, 1e31 times `z_max`, and the next trial
+/// overflowed to a NaN force. The tolerance is now relative to `min(1, z_max)`.
+#[test]
+fn bouc_wen_tiny_z_max_is_resolved() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (beta, gamma) = (2.989215087890625e94, -0.5);
+    let law = BoucWen::<f64>::new(1e9, 1e7, 0.99, beta, gamma, 2.0).unwrap();
+    let uy = 1e-2;
+    let t1 = law.trial(&law.initial_history(), 2.9290771484375 * uy, -10.0);
+    // The trapezoidal update saturates at √2 z_max for n = 2 (z = c (g(0) + g(z)), c ≫ 1):
+    // z solves it to rounding, on z's own scale.
+    let (z, z_max) = (t1.history.z, (beta + gamma).powf(-0.5));
+    let c = 0.5 * 2.9290771484375;
+    let r = z - c * (2.0 - z * z * (beta + gamma));
+    let slope = 1.0 + 2.0 * c * z * (beta + gamma);
+    assert!(
+        z > 0.0 && z <= 1.4143 * z_max && (r / slope).abs() <= 1e-12 * z,
+        "{t1:?}, r = {r:e}"
+    );
+    let t2 = law.trial(&t1.history, 2.98736572265625 * uy, -10.0);
+    assert!(t2.force.is_finite() && t2.stiffness.is_finite(), "{t2:?}");
 }

@@ -1,6 +1,8 @@
 //! Bouc–Wen smooth hysteresis, its internal variable integrated by the trapezoidal rule in
 //! the deformation.
 
+use nalgebra::ComplexField;
+
 use super::{Law, LawTrial, fits, positive, unit_ratio};
 use crate::{Error, Real};
 
@@ -55,6 +57,9 @@ pub struct BoucWen<T> {
     n: T,
     /// `1` or `2` for the exponents computed without `powf`, else `0`.
     n_kind: u8,
+    /// `min(1, z_max)`, `z_max = (β + γ)^{−1/n}`: the scale of `z` the inner solve's
+    /// tolerance is relative to.
+    z_scale: T,
 }
 
 /// The history of a [`BoucWen`] law: the committed deformation and hysteretic variable.
@@ -97,6 +102,15 @@ impl<T: Real> BoucWen<T> {
             n,
         ];
         fits::<T>(&c)?;
+        // z lives on the scale of z_max (tiny for a huge β + γ: a tolerance of 4ε in
+        // absolute terms stopped at z = 3e-16 where z_max = 6e-48; found by fuzzing). Kept
+        // above 1e-37 so that it is a normal number in f32 too.
+        let z_max = if beta + gamma > 0.0 {
+            <f64 as ComplexField>::powf(beta + gamma, -1.0 / n)
+        } else {
+            f64::INFINITY
+        };
+        let z_scale = T::from_f64_rounded(z_max.min(1.0).max(1e-37));
         let r = T::from_f64_rounded;
         Ok(Self {
             ak: r(c[0]),
@@ -113,6 +127,7 @@ impl<T: Real> BoucWen<T> {
             } else {
                 0
             },
+            z_scale,
         })
     }
 
@@ -201,7 +216,7 @@ impl<T: Real> Law<T> for BoucWen<T> {
                 if slope.is_finite() && next >= lo && next <= hi && (step + step).abs() <= last {
                     last = step.abs();
                     z = next;
-                    if last <= tol * z.abs().max(one) {
+                    if last <= tol * z.abs().max(self.z_scale) {
                         converged = true;
                         break;
                     }
@@ -209,7 +224,7 @@ impl<T: Real> Law<T> for BoucWen<T> {
                     last = half * (hi - lo);
                     z = lo + last;
                 }
-                if hi - lo <= tol * lo.abs().max(hi.abs()).max(one) {
+                if hi - lo <= tol * lo.abs().max(hi.abs()).max(self.z_scale) {
                     converged = true;
                     break;
                 }
