@@ -569,10 +569,11 @@ pub(crate) fn initial_state<T: Real, const N: usize>(
     v0: &SVector<T, N>,
     p0: &SVector<T, N>,
 ) -> Result<State<T, N>, Error> {
-    let ops = ops.ok_or(Error::SingularMass)?;
+    // A non-finite input first, as every start in the crate (found by fuzzing).
     if !initial_inputs_finite(u0, v0, p0) {
         return Err(Error::NonFiniteInput);
     }
+    let ops = ops.ok_or(Error::SingularMass)?;
     let a0 = mat_vec(&ops.minv, p0) - mat_vec(&ops.minv_c, v0) - mat_vec(&ops.minv_k, u0);
     State::initial_computed(u0, v0, a0)
 }

@@ -547,3 +547,39 @@ fn bouc_wen_tiny_z_max_is_resolved() {
     let t2 = law.trial(&t1.history, 2.98736572265625 * uy, -10.0);
     assert!(t2.force.is_finite() && t2.stiffness.is_finite(), "{t2:?}");
 }
+
+/// A start with a non-finite initial value is `NonFiniteInput` from every stepper: the
+/// full-order ones said `SingularMass` first when `M` was singular too (`Nonlinear`,
+/// `Modal`, `Varying` checked the input first).
+#[test]
+fn non_finite_start_is_non_finite_input_before_singular_mass() {
+    let (m, z, k) = (M2::zeros(), M2::zeros(), M2::identity());
+    let sys = Linear::<f64, 2>::new(&m, &z, &k, 0.01).unwrap();
+    let nan = vector![f64::NAN, 0.0];
+    let zero = vector![0.0, 0.0];
+    assert_eq!(
+        sys.start(&nan, &zero, &zero).err(),
+        Some(Error::NonFiniteInput)
+    );
+    assert_eq!(
+        sys.start(&zero, &zero, &zero).err(),
+        Some(Error::SingularMass)
+    );
+}
+
+/// The exact response-spectrum map over `dt` for a period of `2e-22` s at `dt = 1e-4`
+/// (`ω dt ≈ 3e18`): finite, but `uu = 6e134` where an oscillator's map is bounded by 1 —
+/// the matrix exponential's squarings amplified rounding by `ω dt`. Rejected now
+/// (`OperatorOverflow`); the AEM's closed form is bounded there.
+#[test]
+fn spectrum_exact_map_that_is_not_bounded_is_rejected() {
+    use aemstep::spectrum::{Bank, Scheme, Substeps};
+    let periods = [2.117582368135751e-22, 6.94091796875, 7.602937936467169];
+    assert_eq!(
+        Bank::<f64, 3>::new(periods, [0.0; 3], 1e-4).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert!(Bank::<f64, 3>::with(periods, [0.0; 3], 1e-4, Scheme::Aem, Substeps::AUTO).is_ok());
+    // Ordinary banks are untouched.
+    assert!(Bank::<f64, 3>::new([0.02, 1.0, 10.0], [0.05; 3], 0.02).is_ok());
+}

@@ -101,9 +101,23 @@ const fn fits(x: f64, max: f64) -> bool {
     x.is_finite() && x.abs() <= max
 }
 
+/// The homogeneous part of a map is bounded as a damped oscillator's must be: the energy
+/// `(ω²u² + v²)/2` never grows, so `|uu|, |vv|, ω|uv|, |vu|/ω ≤ 1` (exactly for both
+/// schemes; here within `1e-6`). The exact scheme's matrix exponential loses that, and all
+/// accuracy, far beyond `ω dt ≈ 1e10` (its squarings amplify rounding by about `ω dt`):
+/// the fuzzer found a whole-interval `uu = 6e134` at `ω dt ≈ 3e18`.
+const fn contractive(m: &SdofOps, w: f64) -> bool {
+    let b = 1.0 + 1e-6;
+    m.uu.abs() <= b && m.vv.abs() <= b && (m.uv * w).abs() <= b && (m.vu / w).abs() <= b
+}
+
 /// Every operator of one oscillator, and `1/dt`, fits the scalar type (largest finite value
-/// `max`), the coefficients the bank derives from `ω` and `ζ` included.
+/// `max`), the coefficients the bank derives from `ω` and `ζ` included, and both maps are
+/// [`contractive`].
 const fn oscillator_fits(op: &SdofOps, whole: &SdofOps, w: f64, z: f64, ka: f64, max: f64) -> bool {
+    if !(contractive(op, w) && contractive(whole, w)) {
+        return false;
+    }
     let xs = [
         op.uu,
         op.uv,
@@ -241,8 +255,9 @@ macro_rules! bank_ctor {
             ///
             /// Errors: [`Error::InvalidPeriod`], [`Error::InvalidDamping`],
             /// [`Error::InvalidTimeStep`], [`Error::OperatorOverflow`] (an operator is not
-            /// finite in the scalar type, e.g. `T/dt` so small that the exact map over
-            /// `dt` cannot be formed, or `ω²` beyond `f32`).
+            /// finite in the scalar type, e.g. `ω²` beyond `f32`, or not bounded as an
+            /// oscillator's map must be: `T/dt` so small that the exact map over `dt`
+            /// cannot be formed, `ω dt` far beyond `1e10`).
             pub const fn new(period: [f64; P], damping: [f64; P], dt: f64) -> Result<Self, Error> {
                 Self::with(period, damping, dt, Scheme::Exact, Substeps::AUTO)
             }
