@@ -583,3 +583,43 @@ fn spectrum_exact_map_that_is_not_bounded_is_rejected() {
     // Ordinary banks are untouched.
     assert!(Bank::<f64, 3>::new([0.02, 1.0, 10.0], [0.05; 3], 0.02).is_ok());
 }
+
+/// A steady-state Kalman gain for a model with an unobservable marginal mode (two free
+/// masses, only the sum of their displacements measured, process noise on every state):
+/// the covariance grows without bound, yet the doubling algorithm stopped at a "solution"
+/// with diagonal entries of `−4e10` and returned it. Not a covariance: now
+/// `RiccatiNotConverged`, as documented for an undetectable model.
+#[test]
+fn riccati_solution_that_is_not_a_covariance_is_rejected() {
+    use aemstep::observer::{Outputs, StateSpace, SteadyState};
+    let m = matrix![1.7976931348623157e308, 0.0; 0.0, -2.1559570312499998e-48];
+    let ss = StateSpace::<2, 4, 1>::exact(
+        &m,
+        &M2::zeros(),
+        &M2::zeros(),
+        &matrix![1.0; 0.0],
+        1.4508452551555398e-1,
+    )
+    .unwrap();
+    let mut out = Outputs::<2, 1, 2>::zero();
+    out.u = [[-10.0, -10.0], [-10.0, -10.0]];
+    let meas = ss.outputs(&out).unwrap();
+    let q = SMatrix::<f64, 4, 4>::identity() * 1e-6;
+    let r = SMatrix::<f64, 2, 2>::identity() * 1e-6;
+    assert_eq!(
+        SteadyState::new(&ss, &meas, &q, &r).err(),
+        Some(Error::RiccatiNotConverged)
+    );
+}
+
+/// Friction with `v_r = 1.25e-308`: `1/v_r` fits `f64` but `f_s/v_r` does not, and the
+/// trial's damping `(f_s/v_r)(1 − tanh²)` was `∞ · 0 = NaN`. Now `OperatorOverflow`.
+#[test]
+fn friction_damping_coefficient_that_overflows_is_rejected() {
+    use aemstep::hysteresis::Friction;
+    assert_eq!(
+        Friction::<f64>::new(143777.64739990234, 1.2510781e-308).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert!(Friction::<f64>::new(1e5, 1e-3).is_ok());
+}

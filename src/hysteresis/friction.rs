@@ -36,7 +36,9 @@ impl<T: Real> Friction<T> {
         if !(positive(fs) && positive(vr)) {
             return Err(Error::InvalidMaterial);
         }
-        fits::<T>(&[fs, 1.0 / vr, vr])?;
+        // `f_s / v_r` too: the trial's damping `(f_s / v_r)(1 − tanh²)` was `∞ · 0 = NaN`
+        // with `v_r = 1.25e-308` (found by fuzzing).
+        fits::<T>(&[fs, 1.0 / vr, vr, fs / vr])?;
         Ok(Self {
             fs: T::from_f64_rounded(fs),
             inv_vr: T::from_f64_rounded(1.0 / vr),
