@@ -159,6 +159,11 @@ impl<T: Real> BoucWen<T> {
         } else {
             T::zero()
         };
+        // |z|ⁿ · 0 is 0 even where |z|ⁿ overflows (γ = β makes the unloading shape 0; an
+        // ∞ · 0 there gave a NaN slope, found by fuzzing).
+        if shape == T::zero() {
+            return (T::one(), T::zero());
+        }
         (T::one() - an * shape, -self.n * an1 * sz * shape)
     }
 }
