@@ -247,7 +247,7 @@ impl<T: Real, const N: usize, const I: usize> Stepper<T, N> for LinearInput<T, N
         v0: &SVector<T, N>,
         w0: &SVector<T, I>,
     ) -> Result<State<T, N>, Error> {
-                // A non-finite input first, as every start in the crate (found by fuzzing).
+        // A non-finite input first, as every start in the crate (found by fuzzing).
         if !initial_inputs_finite(u0, v0, w0) {
             return Err(Error::NonFiniteInput);
         }
