@@ -104,13 +104,14 @@ impl<T: Real> BoucWen<T> {
         fits::<T>(&c)?;
         // z lives on the scale of z_max (tiny for a huge β + γ: a tolerance of 4ε in
         // absolute terms stopped at z = 3e-16 where z_max = 6e-48; found by fuzzing). Kept
-        // above 1e-37 so that it is a normal number in f32 too.
+        // a normal number of `T` (above 1e-37 in f32, 1e-300 in f64).
         let z_max = if beta + gamma > 0.0 {
             <f64 as ComplexField>::powf(beta + gamma, -1.0 / n)
         } else {
             f64::INFINITY
         };
-        let z_scale = T::from_f64_rounded(z_max.min(1.0).max(1e-37));
+        let floor = if T::MAX < f64::MAX { 1e-37 } else { 1e-300 };
+        let z_scale = T::from_f64_rounded(z_max.min(1.0).max(floor));
         let r = T::from_f64_rounded;
         Ok(Self {
             ak: r(c[0]),
