@@ -25,12 +25,15 @@ pub fn init() {
     }
 }
 
-/// One fuzz input: the checks of `target` on `data`. A build with
-/// `--cfg aemstep_fuzz_inject_panic` (`bash scripts/fuzz.sh --self-test`) panics on every
-/// input whose first byte is `0x2a`, to show that a panic fails the fuzz run.
+/// One fuzz input: the checks of `target` on `data`. With `AEMSTEP_FUZZ_INJECT_PANIC=1`
+/// in the environment (`bash scripts/fuzz.sh --self-test`) it panics on every input whose
+/// first byte is `0x2a`, to show that a panic fails the fuzz run (the variable is read
+/// once).
 pub fn fuzz(target: &str, data: &[u8]) {
-    #[cfg(aemstep_fuzz_inject_panic)]
-    if data.first() == Some(&0x2a) {
+    static INJECT: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let inject = *INJECT
+        .get_or_init(|| std::env::var_os("AEMSTEP_FUZZ_INJECT_PANIC").is_some_and(|v| v == "1"));
+    if inject && data.first() == Some(&0x2a) {
         panic!("injected panic (scripts/fuzz.sh --self-test)");
     }
     run(target, data);
