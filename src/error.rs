@@ -11,7 +11,9 @@ use core::fmt;
 pub enum Error {
     /// An input matrix, vector or load has a NaN or infinite entry.
     NonFiniteInput,
-    /// The time step `h` is not finite and strictly positive.
+    /// The time step `h` is not finite and strictly positive, or `h²` under- or overflows;
+    /// or `h` or `h²/4` is not representable (finite and nonzero) in the stepper's scalar
+    /// type (e.g. `h = 1e58` or `1e-30` in `f32`).
     InvalidTimeStep,
     /// The effective matrix `M + (h/2) C + (h²/4) K` is singular to working precision,
     /// so no step can be taken.
@@ -66,8 +68,9 @@ pub enum Error {
     /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) is not finite or is
     /// outside its documented range.
     InvalidParameter,
-    /// A response-spectrum period is not finite and strictly positive, or the periods of
-    /// a bank are not in non-decreasing order (`spectrum::Bank`).
+    /// A response-spectrum period is not finite and at least `1e-150` s (shorter ones have
+    /// an `ω²` that overflows), or the periods of a bank are not in non-decreasing order
+    /// (`spectrum::Bank`).
     InvalidPeriod,
     /// A damping ratio is NaN or outside `[0, 1)` (`spectrum::Bank`).
     InvalidDamping,

@@ -7,7 +7,7 @@
 
 use nalgebra::SVector;
 
-use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics};
+use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition, row_scales};
 use crate::linalg::op_rows::OpRows;
 use crate::linalg::{Mat, add_scaled, all_finite, fits, round_rows, rows_f64};
@@ -432,6 +432,10 @@ pub(crate) const fn newmark_operators<const N: usize>(
         Ok(kin) => kin,
         Err(e) => return Err(e),
     };
+    // The kinematics must fit the scalar type too (found by fuzzing: `h = 1e58` in f32).
+    if let Err(e) = check_time_step_as(h, max) {
+        return Err(e);
+    }
     let (wc, wk) = (kin.gamma_h, kin.beta_h2);
     let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
     if !all_finite(&meff) {
@@ -444,8 +448,12 @@ pub(crate) const fn newmark_operators<const N: usize>(
     };
     let (g, gc, gk) = (lu.inverse(), lu.solve(c), lu.solve(k));
     let fit = [fits(&g, &meff, max), fits(&gc, c, max), fits(&gk, k, max)];
-    if let Some(e) = first_error(fit) {
-        return Err(e);
+    // Overflow (of an operator or of a kinematic coefficient) before underflow.
+    match first_error(fit) {
+        Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
+        _ if !kin.fits(max) => return Err(Error::OperatorOverflow),
+        Some(e) => return Err(e),
+        None => {}
     }
     let start = match start_operators(m, c, k, max) {
         Ok(s) => s,
@@ -486,10 +494,11 @@ pub(crate) fn initial_state<T: Real, const N: usize>(
     v0: &SVector<T, N>,
     p0: &SVector<T, N>,
 ) -> Result<State<T, N>, Error> {
-    let ops = ops.ok_or(Error::SingularMass)?;
+    // A non-finite input first, as every start in the crate (found by fuzzing).
     if !initial_inputs_finite(u0, v0, p0) {
         return Err(Error::NonFiniteInput);
     }
+    let ops = ops.ok_or(Error::SingularMass)?;
     let a0 = mat_vec(&ops.minv, p0) - mat_vec(&ops.minv_c, v0) - mat_vec(&ops.minv_k, u0);
     State::initial_computed(u0, v0, a0)
 }

@@ -34,6 +34,36 @@ pub(crate) const fn check_time_step(h: f64) -> Result<f64, Error> {
     }
 }
 
+/// `x` rounded to the scalar type whose largest finite value is `max` (`f32` or `f64`, the
+/// only [`Real`] types), in `const` contexts.
+const fn rounded_as(x: f64, max: f64) -> f64 {
+    if max < f64::MAX { x as f32 as f64 } else { x }
+}
+
+/// [`check_time_step`] in the scalar type the kinematics are rounded to (largest finite
+/// value `max`, e.g. [`Real::MAX`]): also `h`, `h/2` and `h²/4` finite, at most `max` and
+/// nonzero once rounded. (`h = 1e58` and `h = 1e-30` pass in `f64` but not in `f32`, where
+/// `h` overflows or `h²/4` rounds to zero: an `f32` stepper built from them had infinite or
+/// vanishing kinematics. Found by fuzzing.)
+///
+/// Errors: [`Error::InvalidTimeStep`].
+pub(crate) const fn check_time_step_as(h: f64, max: f64) -> Result<f64, Error> {
+    let h = match check_time_step(h) {
+        Ok(h) => h,
+        Err(e) => return Err(e),
+    };
+    let xs = [h, 0.5 * h, 0.25 * h * h];
+    let mut i = 0;
+    while i < xs.len() {
+        let r = rounded_as(xs[i], max);
+        if !(r.is_finite() && r != 0.0 && xs[i] <= max) {
+            return Err(Error::InvalidTimeStep);
+        }
+        i += 1;
+    }
+    Ok(h)
+}
+
 /// The predictor–corrector of the Newmark family, written once: every stepper calls these
 /// provided methods. Implemented by [`AemKinematics`] (β = 1/4, γ = 1/2: three stored
 /// coefficients, so a step loads three) and [`NewmarkKinematics`] (any β, γ: five).
@@ -188,6 +218,21 @@ impl NewmarkKinematics<f64> {
             }),
             Err(e) => Err(e),
         }
+    }
+
+    /// Every coefficient finite and at most `max` in size (the largest finite value of the
+    /// scalar type they will be rounded to): with a large β or γ, `β h²` can overflow where
+    /// `h²` does not.
+    pub(crate) const fn fits(&self, max: f64) -> bool {
+        let xs = [self.h, self.c_v, self.c_u, self.gamma_h, self.beta_h2];
+        let mut i = 0;
+        while i < xs.len() {
+            if !(xs[i].is_finite() && xs[i].abs() <= max) {
+                return false;
+            }
+            i += 1;
+        }
+        true
     }
 
     /// Rounded once to `T` (run time).

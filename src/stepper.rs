@@ -90,7 +90,8 @@ pub trait Stepper<T: Real, const N: usize> {
     /// state handed over from another scheme). A reduced stepper projects `u0, v0, a0` on
     /// its basis.
     ///
-    /// Errors: [`Error::NonFiniteInput`].
+    /// Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] where a reduced
+    /// stepper's projection overflows.
     fn start_with_acceleration(
         &self,
         u0: &SVector<T, N>,

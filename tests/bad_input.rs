@@ -257,8 +257,8 @@ fn nan_load_is_the_same_error_everywhere() {
 /// `M = 1e212`, `K = 1e-112`, `h = 1e99`, `G K = M_eff⁻¹ K ≈ 1e-324` rounds to zero in
 /// `f64`, and a stepper built from it returned `q = 0` instead of `−G K û ≈ −1e-225`. Now
 /// `OperatorUnderflow` from every Newmark-family build, in `f64` and, for an operator
-/// subnormal in `f32`, in `f32`; ordinary data still build and step right. (In `f32` the same data are already refused: `M = 1e212` is not finite
-/// in `f32`.)
+/// subnormal in `f32`, in `f32`; ordinary data still build and step right. (In `f32` the
+/// first data are refused earlier: `M = 1e212` does not fit `f32`.)
 #[test]
 fn operators_that_underflow_are_rejected() {
     let (m, c, k, h) = (matrix![1e212], matrix![0.0], matrix![1e-112], 1e99);
@@ -276,8 +276,8 @@ fn operators_that_underflow_are_rejected() {
         Linear::<f32, 1>::new(&m32, &matrix![0.0], &matrix![1.0], 0.01).err(),
         Some(Error::OperatorUnderflow)
     );
-    // The largest entry normal, a small one subnormal: accepted (normwise it keeps its
-    // precision), and the step agrees with the closed form of the undamped oscillator.
+    // Ordinary data: accepted, and the step agrees with the closed form of the undamped
+    // oscillator.
     let sys = Linear::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![1.0], 0.01)
         .expect("ordinary data");
     let mut s = sys
@@ -287,4 +287,375 @@ fn operators_that_underflow_are_rejected() {
     // One AEM step of u'' + u = 0: u1 = (1 − h²/4)/(1 + h²/4).
     let u1 = (1.0 - 0.25e-4) / (1.0 + 0.25e-4);
     assert!((s.u()[0] - u1).abs() <= 4.0 * f64::EPSILON);
+}
+
+// Found by fuzzing (`scripts/fuzz.sh`; the inputs in `fuzz/regressions/`): each got `Ok`
+// with non-finite or vanishing operators before.
+
+/// A time step that is fine in `f64` but not in `f32`: `h = 1e58` overflows `f32` and
+/// `h = 1e-30` has `h²/4` round to zero. An `f32` stepper built from either had infinite or
+/// vanishing kinematics (the fuzzer found `AForm` blocks of `∞`); now every `f32`
+/// constructor says `InvalidTimeStep`, the `f64` ones keep them.
+#[test]
+fn f32_time_step_that_does_not_fit_is_invalid() {
+    use aemstep::{CompensatedLinear, NewtonSettings, Nonlinear};
+    let (m, z, k) = (matrix![1.0], matrix![0.0], matrix![1.0]);
+    let want = Some(Error::InvalidTimeStep);
+    for h in [1e58, 1e-30] {
+        assert_eq!(
+            Linear::<f32, 1>::new(&m, &z, &k, h).err(),
+            want,
+            "h = {h:e}"
+        );
+        assert_eq!(
+            Linear::<f32, 1>::from_rows([[1.0]], [[0.0]], [[1.0]], h).err(),
+            want
+        );
+        assert_eq!(CompensatedLinear::<f32, 1>::new(&m, &z, &k, h).err(), want);
+        assert_eq!(
+            LinearInput::<f32, 1, 1>::new(&m, &z, &k, &matrix![1.0], h).err(),
+            want
+        );
+        assert_eq!(
+            Newmark::<f32, 1>::average_acceleration(&m, &z, &k, h).err(),
+            want
+        );
+        assert_eq!(
+            GeneralizedAlpha::<f32, 1>::new(&m, &z, &k, h, 0.8).err(),
+            want
+        );
+        assert_eq!(Exact::<f32, 1>::new(&m, &z, &k, h).err(), want);
+        assert_eq!(
+            Modal::<f32, 1, 1, 1, 1>::new(&m, &k, &Damping::None, &m, &m, h).err(),
+            want
+        );
+        assert_eq!(
+            Nonlinear::<f32, 1>::new(h, NewtonSettings::default()).err(),
+            want
+        );
+        assert_eq!(Varying::<f32, 1>::new(h).err(), want);
+        // The same h in f64: a valid step.
+        let sys = Linear::<f64, 1>::new(&m, &z, &k, h).unwrap();
+        assert_eq!(sys.time_step(), h);
+        assert!(Varying::<f64, 1>::new(h).is_ok());
+    }
+}
+
+/// Newmark coefficients that overflow although `h²` does not: `β = 1e300`, `h = 1e10` has
+/// `β h² = ∞`. With `K = 0` no operator showed it and the stepper was built; now it is an
+/// overflow (and `β = 1e30` fits `f64` but not `f32`).
+#[test]
+fn newmark_coefficients_that_overflow_are_rejected() {
+    let (m, z) = (matrix![1.0], matrix![0.0]);
+    assert_eq!(
+        Newmark::<f64, 1>::new(&m, &z, &z, 1e10, 1e300, 0.5).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert_eq!(
+        Newmark::<f32, 1>::new(&m, &z, &z, 1.0, 1e39, 0.5).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert!(Newmark::<f64, 1>::new(&m, &z, &z, 1.0, 1e39, 0.5).is_ok());
+}
+
+/// Hysteretic laws and buildings whose coefficients do not fit `f32`: `Bilinear::<f32>`
+/// with `k = 1.6e293` had an infinite stiffness; now an overflow, as a Bouc–Wen `k/f_y` of
+/// `1e41`, a `1/v_r` of `1e40` and a floor mass of `1e39` are.
+#[test]
+fn hysteresis_coefficients_that_overflow_f32_are_rejected() {
+    use aemstep::hysteresis::{Bilinear, BoucWen, Friction, ShearBuilding};
+    let want = Some(Error::OperatorOverflow);
+    assert_eq!(Bilinear::<f32>::new(1.6e293, 1e2, 0.0).err(), want);
+    assert!(Bilinear::<f64>::new(1.6e293, 1e2, 0.0).is_ok());
+    assert_eq!(
+        BoucWen::<f32>::new(1e39, 1e-2, 0.05, 0.5, 0.5, 1.0).err(),
+        want
+    );
+    assert_eq!(Friction::<f32>::new(1.0, 1e-40).err(), want);
+    let law = Bilinear::<f32>::new(1e8, 1e5, 0.05).unwrap();
+    assert_eq!(
+        ShearBuilding::<f32, _, 2>::new([1e39, 1.0], [law; 2], &[[0.0; 2]; 2]).err(),
+        want
+    );
+    // f64: huge but finite coefficients, and a coefficient that overflows f64 itself.
+    let law64 = Bilinear::<f64>::new(1e8, 1e5, 0.05).unwrap();
+    assert!(ShearBuilding::<f64, _, 2>::new([1e39, 1.0], [law64; 2], &[[0.0; 2]; 2]).is_ok());
+    assert_eq!(Bilinear::<f64>::new(1e308, 1.0, 0.99).err(), want);
+}
+
+/// A reduced stepper's start from known values can overflow in `f32`: the projection
+/// `Φᵀ M u` of `u = (10, 10)` with `M = 1e76 I` is about `1.4e39`. That is
+/// `NonFiniteState` (documented now), and a start from rest still works.
+#[test]
+fn modal_f32_projection_overflow_is_non_finite_state() {
+    let m = SMatrix::<f64, 2, 2>::identity() * 1e76;
+    let k = SMatrix::<f64, 2, 2>::identity();
+    let sys = Modal::<f32, 2, 2, 1, 1>::new(
+        &m,
+        &k,
+        &Damping::None,
+        &SMatrix::repeat(1.0),
+        &SMatrix::repeat(1.0),
+        0.01,
+    )
+    .unwrap();
+    let (ten, z) = (vector![10.0f32, 10.0], vector![0.0f32, 0.0]);
+    assert_eq!(
+        sys.start_with_acceleration(&ten, &z, &z).err(),
+        Some(Error::NonFiniteState)
+    );
+    assert!(sys.start_with_acceleration(&z, &z, &z).is_ok());
+}
+
+/// Bouc–Wen with a large exponent (`n = 951`, β = 1, γ = 0.5) at a step of 3 `u_y` from
+/// rest: the unsafeguarded Newton's first iterate had `|z|ⁿ = ∞` and the force came out
+/// NaN (the stepper then refused every such step). Newton safeguarded by bisection on its
+/// bracket converges: the force is finite and the hysteretic variable solves its update.
+#[test]
+fn bouc_wen_large_exponent_converges() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (k, fy, alpha, n) = (1e9, 1e7, 0.99, 951.2660600471733);
+    let law = BoucWen::<f64>::new(k, fy, alpha, 1.0, 0.5, n).unwrap();
+    let uy = fy / k;
+    for d in [2.98797607421875 * uy, -4.9493408203125 * uy, 0.5 * uy] {
+        let t = law.trial(&law.initial_history(), d, 1.0);
+        assert!(t.force.is_finite() && t.stiffness.is_finite(), "{t:?}");
+        // z solves z = (Δ/2u_y)(g(0) + g(z)), g(z) = 1 − |z|ⁿ (β + γ) loading.
+        let z = t.history.z;
+        let g = |z: f64| 1.0 - z.abs().powf(n) * 1.5;
+        let r = z - 0.5 * (d / uy) * (1.0 + g(z));
+        assert!(r.abs() <= 1e-12, "d = {d:e}: z = {z}, residual {r:e}");
+    }
+}
+
+/// A response-spectrum bank whose operators are not finite: period `1.06e-109` s at
+/// `dt = 1e-4` (`ω dt ≈ 6e105`) gave NaN in the exact map over `dt`, and the bank stepped
+/// every sample to NaN; in `f32`, period `1e-20` s gives `ω² ≈ 4e41`, beyond `f32`. Both
+/// are `OperatorOverflow` now.
+#[test]
+fn spectrum_bank_operators_that_are_not_finite_are_rejected() {
+    use aemstep::spectrum::Bank;
+    let periods = [
+        1.0644899600020377e-109,
+        5.232991146814947,
+        999.7892142570423,
+    ];
+    assert_eq!(
+        Bank::<f64, 3>::new(periods, [0.0; 3], 1e-4).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert_eq!(
+        Bank::<f32, 1>::new([1e-20], [0.05], 0.01).err(),
+        Some(Error::OperatorOverflow)
+    );
+    // The AEM's sub-step in closed form stays finite and bounded there (formed from unit
+    // inputs it was NaN, and at ωh ≈ 5e14 finite but off by 1e13: 10 m/s² stepped to a
+    // displacement of 1e98).
+    let aem = Bank::<f64, 3>::with(
+        periods,
+        [0.0; 3],
+        1e-4,
+        aemstep::spectrum::Scheme::Aem,
+        aemstep::spectrum::Substeps::AUTO,
+    )
+    .unwrap();
+    let mut r = aem.at_rest();
+    for _ in 0..12 {
+        aem.step(&mut r, -10.0);
+    }
+    assert!(
+        r.sd().iter().all(|x| x.is_finite() && *x < 1e3),
+        "{:?}",
+        r.sd()
+    );
+    let stiff = Bank::<f64, 3>::with(
+        [
+            2.220446049250313e-16,
+            0.6660419550143868,
+            0.6660419550143868,
+        ],
+        [0.18235015869140625; 3],
+        1.643114108127686e-2,
+        aemstep::spectrum::Scheme::Aem,
+        aemstep::spectrum::Substeps::Fixed(1),
+    )
+    .unwrap();
+    let mut r = stiff.at_rest();
+    for a in [2.15667724609375, -10.0, -10.0, -10.0, -10.0] {
+        stiff.step(&mut r, a);
+    }
+    assert!(
+        r.sd()[0] < 1e-20 && r.sa().iter().all(|x| *x < 1e3),
+        "{r:?}"
+    );
+    // f64 holds ω² = 4e41.
+    assert!(
+        Bank::<f64, 1>::with(
+            [1e-20],
+            [0.05],
+            0.01,
+            aemstep::spectrum::Scheme::Aem,
+            aemstep::spectrum::Substeps::Fixed(1)
+        )
+        .is_ok()
+    );
+}
+
+/// The paper's literal form can overflow where the stepper does not: `M = −9.7e-252`,
+/// `C = K = 0`, `h = 1e147` give `G = −1e251` (finite) but the block `(h/2) G = ∞`.
+/// `try_a_form` reports it; `a_form` documents it.
+#[test]
+fn a_form_blocks_that_overflow_are_reported() {
+    let z = matrix![0.0];
+    let sys = Linear::<f64, 1>::new(&matrix![-9.715100097656247e-252], &z, &z, 1e147).unwrap();
+    assert!(sys.effective_inverse()[(0, 0)].is_finite());
+    assert_eq!(sys.try_a_form().err(), Some(Error::OperatorOverflow));
+    assert!(!sys.a_form().b_block(1).unwrap()[(0, 0)].is_finite());
+    let ok = Linear::<f64, 1>::new(&matrix![1.0], &z, &matrix![4.0], 0.01).unwrap();
+    assert_eq!(
+        format!("{:?}", ok.try_a_form().unwrap()),
+        format!("{:?}", ok.a_form())
+    );
+}
+
+/// Bouc–Wen in `f32` with `n = 984`: the Newton slope `1 − c ∂g/∂z` overflowed to `∞`, the
+/// step `r/∞ = 0` looked converged at `z = −1.09` (not the root near `−1.003`), and the next
+/// trial's stiffness was `−∞`. A slope that overflows is now a bisection step.
+#[test]
+fn bouc_wen_overflowing_slope_is_not_convergence() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let law =
+        BoucWen::<f32>::new(1e9, 1e2, 0.0, 0.1, 9.796142578125e-3, 983.8988194023956).unwrap();
+    let t = law.trial(&law.initial_history(), -1e-6, -10.0);
+    let z = t.history.z;
+    assert!(t.force.is_finite() && z > -1.01 && z < -1.0, "{t:?}");
+    let again = law.trial(&t.history, -1e-6, -10.0);
+    assert!(
+        again.force.is_finite() && again.stiffness.is_finite(),
+        "{again:?}"
+    );
+}
+
+/// An observer in `f32` of a model whose time step does not fit `f32` (`h = 1e147`): its
+/// `time_step()` was `∞`; now `InvalidTimeStep`, as for every `f32` stepper.
+#[test]
+fn f32_observer_of_a_model_with_an_f64_only_time_step_is_invalid() {
+    use aemstep::observer::{Observer, Outputs, StateSpace};
+    let m = SMatrix::<f64, 2, 2>::identity();
+    let k = m * 4.0;
+    for h in [1e147, 0.01] {
+        let ss =
+            StateSpace::<2, 4, 1>::aem(&m, &M2::zeros(), &k, &SMatrix::repeat(1.0), h).unwrap();
+        let meas = ss
+            .outputs(&Outputs::displacements(Outputs::<2, 1, 1>::select([0])))
+            .unwrap();
+        let r32 = Observer::<f32, 4, 1, 1>::new(&ss, &meas, &SMatrix::zeros());
+        let r64 = Observer::<f64, 4, 1, 1>::new(&ss, &meas, &SMatrix::zeros());
+        if h > 1.0 {
+            assert_eq!(r32.err(), Some(Error::InvalidTimeStep));
+        } else {
+            assert!(r32.is_ok());
+        }
+        assert!(r64.is_ok());
+    }
+}
+
+/// Bouc–Wen with a huge `β` (`3e94`, so `z_max = 6e-48`): the inner solve's tolerance was
+/// absolute (`4ε`), it stopped at `z = 3e-16`, 1e31 times `z_max`, and the next trial
+/// overflowed to a NaN force. The tolerance is now relative to `min(1, z_max)`.
+#[test]
+fn bouc_wen_tiny_z_max_is_resolved() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (beta, gamma) = (2.989215087890625e94, -0.5);
+    let law = BoucWen::<f64>::new(1e9, 1e7, 0.99, beta, gamma, 2.0).unwrap();
+    let uy = 1e-2;
+    let t1 = law.trial(&law.initial_history(), 2.9290771484375 * uy, -10.0);
+    // The trapezoidal update saturates at √2 z_max for n = 2 (z = c (g(0) + g(z)), c ≫ 1):
+    // z solves it to rounding, on z's own scale.
+    let (z, z_max) = (t1.history.z, (beta + gamma).powf(-0.5));
+    let c = 0.5 * 2.9290771484375;
+    let r = z - c * (2.0 - z * z * (beta + gamma));
+    let slope = 1.0 + 2.0 * c * z * (beta + gamma);
+    assert!(
+        z > 0.0 && z <= 1.4143 * z_max && (r / slope).abs() <= 1e-12 * z,
+        "{t1:?}, r = {r:e}"
+    );
+    let t2 = law.trial(&t1.history, 2.98736572265625 * uy, -10.0);
+    assert!(t2.force.is_finite() && t2.stiffness.is_finite(), "{t2:?}");
+}
+
+/// A start with a non-finite initial value is `NonFiniteInput` from every stepper: the
+/// full-order ones said `SingularMass` first when `M` was singular too (`Nonlinear`,
+/// `Modal`, `Varying` checked the input first).
+#[test]
+fn non_finite_start_is_non_finite_input_before_singular_mass() {
+    let (m, z, k) = (M2::zeros(), M2::zeros(), M2::identity());
+    let sys = Linear::<f64, 2>::new(&m, &z, &k, 0.01).unwrap();
+    let nan = vector![f64::NAN, 0.0];
+    let zero = vector![0.0, 0.0];
+    assert_eq!(
+        sys.start(&nan, &zero, &zero).err(),
+        Some(Error::NonFiniteInput)
+    );
+    assert_eq!(
+        sys.start(&zero, &zero, &zero).err(),
+        Some(Error::SingularMass)
+    );
+}
+
+/// The exact response-spectrum map over `dt` for a period of `2e-22` s at `dt = 1e-4`
+/// (`ω dt ≈ 3e18`): finite, but `uu = 6e134` where an oscillator's map is bounded by 1 —
+/// the matrix exponential's squarings amplified rounding by `ω dt`. Rejected now
+/// (`OperatorOverflow`); the AEM's closed form is bounded there.
+#[test]
+fn spectrum_exact_map_that_is_not_bounded_is_rejected() {
+    use aemstep::spectrum::{Bank, Scheme, Substeps};
+    let periods = [2.117582368135751e-22, 6.94091796875, 7.602937936467169];
+    assert_eq!(
+        Bank::<f64, 3>::new(periods, [0.0; 3], 1e-4).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert!(Bank::<f64, 3>::with(periods, [0.0; 3], 1e-4, Scheme::Aem, Substeps::AUTO).is_ok());
+    // Ordinary banks are untouched.
+    assert!(Bank::<f64, 3>::new([0.02, 1.0, 10.0], [0.05; 3], 0.02).is_ok());
+}
+
+/// A steady-state Kalman gain for a model with an unobservable marginal mode (two free
+/// masses, only the sum of their displacements measured, process noise on every state):
+/// the covariance grows without bound, yet the doubling algorithm stopped at a "solution"
+/// with diagonal entries of `−4e10` and returned it. Not a covariance: now
+/// `RiccatiNotConverged`, as documented for an undetectable model.
+#[test]
+fn riccati_solution_that_is_not_a_covariance_is_rejected() {
+    use aemstep::observer::{Outputs, StateSpace, SteadyState};
+    let m = matrix![1.7976931348623157e308, 0.0; 0.0, -2.1559570312499998e-48];
+    let ss = StateSpace::<2, 4, 1>::exact(
+        &m,
+        &M2::zeros(),
+        &M2::zeros(),
+        &matrix![1.0; 0.0],
+        1.4508452551555398e-1,
+    )
+    .unwrap();
+    let mut out = Outputs::<2, 1, 2>::zero();
+    out.u = [[-10.0, -10.0], [-10.0, -10.0]];
+    let meas = ss.outputs(&out).unwrap();
+    let q = SMatrix::<f64, 4, 4>::identity() * 1e-6;
+    let r = SMatrix::<f64, 2, 2>::identity() * 1e-6;
+    assert_eq!(
+        SteadyState::new(&ss, &meas, &q, &r).err(),
+        Some(Error::RiccatiNotConverged)
+    );
+}
+
+/// Friction with `v_r = 1.25e-308`: `1/v_r` fits `f64` but `f_s/v_r` does not, and the
+/// trial's damping `(f_s/v_r)(1 − tanh²)` was `∞ · 0 = NaN`. Now `OperatorOverflow`.
+#[test]
+fn friction_damping_coefficient_that_overflows_is_rejected() {
+    use aemstep::hysteresis::Friction;
+    assert_eq!(
+        Friction::<f64>::new(143777.64739990234, 1.2510781e-308).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert!(Friction::<f64>::new(1e5, 1e-3).is_ok());
 }

@@ -1,6 +1,6 @@
 //! Bilinear elastic–plastic law with linear kinematic hardening, by return mapping.
 
-use super::{Law, LawTrial, positive, unit_ratio};
+use super::{Law, LawTrial, fits, positive, unit_ratio};
 use crate::{Error, Real};
 
 /// Bilinear hysteresis with linear kinematic hardening: elastic stiffness `k`, yield force
@@ -47,19 +47,29 @@ impl<T: Real> Bilinear<T> {
     /// rounded once to `T`.
     ///
     /// Errors: [`Error::InvalidMaterial`] for any parameter out of its range or not
-    /// finite. Cost: O(1).
+    /// finite; [`Error::OperatorOverflow`] if a coefficient does not fit `T` (e.g.
+    /// `k > f32::MAX` in `f32`). Cost: O(1).
     pub fn new(k: f64, fy: f64, alpha: f64) -> Result<Self, Error> {
         if !(positive(k) && positive(fy) && unit_ratio(alpha)) {
             return Err(Error::InvalidMaterial);
         }
+        let c = [
+            k,
+            fy,
+            alpha * k / (1.0 - alpha),
+            1.0 - alpha,
+            (1.0 - alpha) / k,
+            alpha * k,
+        ];
+        fits::<T>(&c)?;
         let r = T::from_f64_rounded;
         Ok(Self {
-            k: r(k),
-            fy: r(fy),
-            hard: r(alpha * k / (1.0 - alpha)),
-            one_minus_alpha: r(1.0 - alpha),
-            compliance_p: r((1.0 - alpha) / k),
-            kt: r(alpha * k),
+            k: r(c[0]),
+            fy: r(c[1]),
+            hard: r(c[2]),
+            one_minus_alpha: r(c[3]),
+            compliance_p: r(c[4]),
+            kt: r(c[5]),
         })
     }
 

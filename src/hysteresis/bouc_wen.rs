@@ -1,11 +1,15 @@
 //! Bouc–Wen smooth hysteresis, its internal variable integrated by the trapezoidal rule in
 //! the deformation.
 
-use super::{Law, LawTrial, positive, unit_ratio};
+use nalgebra::ComplexField;
+
+use super::{Law, LawTrial, fits, positive, unit_ratio};
 use crate::{Error, Real};
 
-/// Scalar Newton iterations allowed for the internal variable of one trial.
-const MAX_ITERATIONS: u32 = 30;
+/// Iterations allowed for the internal variable of one trial: Newton, with bisection steps
+/// where it leaves its bracket or crawls (a bracket of width `|Δ|/u_y` halves to rounding
+/// within about 120 of them).
+const MAX_ITERATIONS: u32 = 200;
 
 /// Bouc–Wen hysteresis: `f = α k d + (1 − α) f_y z`, with the dimensionless hysteretic
 /// variable `z` governed (rate-independently, `A = 1`) by
@@ -26,8 +30,11 @@ const MAX_ITERATIONS: u32 = 30;
 /// ```
 ///
 /// second order in `Δ` and so in the time step, solved for `z` by a scalar Newton from the
-/// explicit Euler predictor (converged to `4ε` relative, at most 30 iterations). Its
-/// residual has slope `≥ 1` in `z` whenever `|γ| ≤ β` (required), so the root is unique.
+/// explicit Euler predictor (converged to `4ε` relative). Its residual has slope `≥ 1` in
+/// `z` whenever `|γ| ≤ β` (required), so the root is unique; it lies between `z₀` and the
+/// predictor (`g` is monotone in `z`), and an iterate that leaves that bracket, or a Newton
+/// step that does not halve, is replaced by bisection, so the solve converges for any
+/// exponent and step.
 /// The consistent tangent is the exact derivative of that update,
 ///
 /// ```text
@@ -35,8 +42,9 @@ const MAX_ITERATIONS: u32 = 30;
 /// ```
 ///
 /// **Cost per trial**: a few Newton iterations of ~15 flops (`n = 1` or `2`; otherwise two
-/// `powf` each); no panic. A trial whose inner Newton does not converge (not seen with
-/// `|Δ|` up to several `u_y`) returns a NaN force, which the stepper reports as
+/// `powf` each; at most 200 with bisection steps); no panic. A trial whose solve does not
+/// converge (not seen: the bracket of width `|Δ|/u_y` halves to rounding within the budget)
+/// or whose data is not finite returns a NaN force, which the stepper reports as
 /// [`Error::NonFiniteForce`] without taking the step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWen<T> {
@@ -49,6 +57,9 @@ pub struct BoucWen<T> {
     n: T,
     /// `1` or `2` for the exponents computed without `powf`, else `0`.
     n_kind: u8,
+    /// `min(1, z_max)`, `z_max = (β + γ)^{−1/n}`: the scale of `z` the inner solve's
+    /// tolerance is relative to.
+    z_scale: T,
 }
 
 /// The history of a [`BoucWen`] law: the committed deformation and hysteretic variable.
@@ -67,8 +78,8 @@ impl<T: Real> BoucWen<T> {
     /// (finite, `≥ 1`; `1` and `2` avoid `powf`). A common choice is `β = γ = 1/2`, `n = 1`
     /// (unloading is then linear with stiffness `k`).
     ///
-    /// Errors: [`Error::InvalidMaterial`] for any parameter out of its range or not finite.
-    /// Cost: O(1).
+    /// Errors: [`Error::InvalidMaterial`] for any parameter out of its range or not finite;
+    /// [`Error::OperatorOverflow`] if a coefficient does not fit `T`. Cost: O(1).
     pub fn new(k: f64, fy: f64, alpha: f64, beta: f64, gamma: f64, n: f64) -> Result<Self, Error> {
         if !(positive(k)
             && positive(fy)
@@ -81,15 +92,35 @@ impl<T: Real> BoucWen<T> {
         {
             return Err(Error::InvalidMaterial);
         }
+        let c = [
+            alpha * k,
+            (1.0 - alpha) * fy,
+            k / fy,
+            0.5 * k / fy,
+            beta,
+            gamma,
+            n,
+        ];
+        fits::<T>(&c)?;
+        // z lives on the scale of z_max (tiny for a huge β + γ: a tolerance of 4ε in
+        // absolute terms stopped at z = 3e-16 where z_max = 6e-48; found by fuzzing). Kept
+        // a normal number of `T` (above 1e-37 in f32, 1e-300 in f64).
+        let z_max = if beta + gamma > 0.0 {
+            <f64 as ComplexField>::powf(beta + gamma, -1.0 / n)
+        } else {
+            f64::INFINITY
+        };
+        let floor = if T::MAX < f64::MAX { 1e-37 } else { 1e-300 };
+        let z_scale = T::from_f64_rounded(z_max.min(1.0).max(floor));
         let r = T::from_f64_rounded;
         Ok(Self {
-            ak: r(alpha * k),
-            cz: r((1.0 - alpha) * fy),
-            inv_uy: r(k / fy),
-            half_inv_uy: r(0.5 * k / fy),
-            beta: r(beta),
-            gamma: r(gamma),
-            n: r(n),
+            ak: r(c[0]),
+            cz: r(c[1]),
+            inv_uy: r(c[2]),
+            half_inv_uy: r(c[3]),
+            beta: r(c[4]),
+            gamma: r(c[5]),
+            n: r(c[6]),
             n_kind: if n == 1.0 {
                 1
             } else if n == 2.0 {
@@ -97,6 +128,7 @@ impl<T: Real> BoucWen<T> {
             } else {
                 0
             },
+            z_scale,
         })
     }
 
@@ -128,6 +160,11 @@ impl<T: Real> BoucWen<T> {
         } else {
             T::zero()
         };
+        // |z|ⁿ · 0 is 0 even where |z|ⁿ overflows (γ = β makes the unloading shape 0; an
+        // ∞ · 0 there gave a NaN slope, found by fuzzing).
+        if shape == T::zero() {
+            return (T::one(), T::zero());
+        }
         (T::one() - an * shape, -self.n * an1 * sz * shape)
     }
 }
@@ -158,13 +195,42 @@ impl<T: Real> Law<T> for BoucWen<T> {
         } else {
             let c = delta * self.half_inv_uy;
             let tol = T::from_f64_rounded(4.0) * T::default_epsilon();
+            let half = T::from_f64_rounded(0.5);
             let mut z = z0 + (c + c) * g0;
+            // The root lies between z0 and the predictor (g is monotone in z, against the
+            // step's direction, so the residual changes sign between them): Newton safeguarded
+            // by bisection on that bracket. (Unsafeguarded, a large exponent n sent an iterate
+            // to |z|ⁿ = ∞ and the force to NaN at Δ = 3 u_y; found by fuzzing.)
+            // Bisection also where Newton crawls (steps not halving: with n ≈ 950 each
+            // Newton step from above shrinks z by only a factor 1 − 1/n), as `rtsafe`.
+            let (mut lo, mut hi) = if z < z0 { (z, z0) } else { (z0, z) };
+            let mut last = hi - lo;
             let mut converged = false;
             for _ in 0..MAX_ITERATIONS {
                 let (g, dg) = self.g(z, s);
-                let step = (z - z0 - c * (g0 + g)) / (one - c * dg);
-                z -= step;
-                if step.abs() <= tol * z.abs().max(one) {
+                let r = z - z0 - c * (g0 + g);
+                if r > T::zero() {
+                    hi = z;
+                } else {
+                    lo = z;
+                }
+                // (A slope that overflows is no Newton step: r/∞ = 0 looked converged; found
+                // by fuzzing with n = 984 in f32.)
+                let slope = one - c * dg;
+                let step = r / slope;
+                let next = z - step;
+                if slope.is_finite() && next >= lo && next <= hi && (step + step).abs() <= last {
+                    last = step.abs();
+                    z = next;
+                    if last <= tol * z.abs().max(self.z_scale) {
+                        converged = true;
+                        break;
+                    }
+                } else {
+                    last = half * (hi - lo);
+                    z = lo + last;
+                }
+                if hi - lo <= tol * lo.abs().max(hi.abs()).max(self.z_scale) {
                     converged = true;
                     break;
                 }

@@ -59,7 +59,8 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
     /// rounded once to `T`.
     ///
     /// Errors: [`Error::NonFiniteInput`] (a mass or damping entry not finite),
-    /// [`Error::MassNotSpd`] (a mass `≤ 0`). Cost: O(N²).
+    /// [`Error::MassNotSpd`] (a mass `≤ 0`), [`Error::OperatorOverflow`] (a mass or
+    /// damping entry does not fit `T`). Cost: O(N²).
     pub fn new(masses: [f64; N], laws: [L; N], damping: &Rows<N>) -> Result<Self, Error> {
         if !masses
             .iter()
@@ -70,6 +71,10 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
         }
         if masses.iter().any(|&m| m <= 0.0) {
             return Err(Error::MassNotSpd);
+        }
+        super::fits::<T>(&masses)?;
+        for row in damping {
+            super::fits::<T>(row)?;
         }
         Ok(Self {
             masses: SVector::from_fn(|i, _| T::from_f64_rounded(masses[i])),

@@ -1,6 +1,6 @@
 //! Coulomb friction regularized in the velocity.
 
-use super::{Law, LawTrial, positive};
+use super::{Law, LawTrial, fits, positive};
 use crate::{Error, Real};
 
 /// A friction device: Coulomb friction of slip force `f_s`, regularized in the velocity,
@@ -30,11 +30,15 @@ impl<T: Real> Friction<T> {
     /// Slip force `fs` (force, finite, `> 0`) and regularization velocity `vr`
     /// (deformation per second, finite, `> 0`).
     ///
-    /// Errors: [`Error::InvalidMaterial`]. Cost: O(1).
+    /// Errors: [`Error::InvalidMaterial`]; [`Error::OperatorOverflow`] if a coefficient
+    /// does not fit `T`. Cost: O(1).
     pub fn new(fs: f64, vr: f64) -> Result<Self, Error> {
         if !(positive(fs) && positive(vr)) {
             return Err(Error::InvalidMaterial);
         }
+        // `f_s / v_r` too: the trial's damping `(f_s / v_r)(1 − tanh²)` was `∞ · 0 = NaN`
+        // with `v_r = 1.25e-308` (found by fuzzing).
+        fits::<T>(&[fs, 1.0 / vr, vr, fs / vr])?;
         Ok(Self {
             fs: T::from_f64_rounded(fs),
             inv_vr: T::from_f64_rounded(1.0 / vr),

@@ -152,3 +152,16 @@ pub(crate) fn positive(x: f64) -> bool {
 pub(crate) fn unit_ratio(x: f64) -> bool {
     x.is_finite() && (0.0..1.0).contains(&x)
 }
+
+/// Every coefficient of a law or model, computed in `f64`, fits `T` (finite and at most
+/// `T::MAX` in size): else it would round to `∞` (found by fuzzing: `Bilinear::<f32>` with
+/// `k = 1.6e293` had an infinite stiffness).
+///
+/// Errors: [`Error::OperatorOverflow`](crate::Error::OperatorOverflow).
+pub(crate) fn fits<T: Real>(xs: &[f64]) -> Result<(), crate::Error> {
+    if xs.iter().all(|x| x.is_finite() && x.abs() <= T::MAX) {
+        Ok(())
+    } else {
+        Err(crate::Error::OperatorOverflow)
+    }
+}

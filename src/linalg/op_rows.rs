@@ -126,6 +126,15 @@ const fn layout<T: Copy, const N: usize, const K: usize>(
 }
 
 impl<T: Real, const N: usize, const K: usize> OpRows<T, N, K> {
+    /// Every value finite (in any layout). Cost: `K·N²` comparisons.
+    pub(crate) fn all_finite(&self) -> bool {
+        self.0
+            .as_flattened()
+            .as_flattened()
+            .iter()
+            .all(|x| x.is_finite())
+    }
+
     /// `out[i] = Σ rows[i] · x`, each row one chain in column order (module docs).
     /// `out` has `N` values (a shorter one gets only the rows it has room for). Cost:
     /// `K·N²` multiply-adds; no branch on the data, no panic.

@@ -23,7 +23,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kinematics::{AemKinematics, Kinematics};
+use crate::kinematics::{AemKinematics, Kinematics, check_time_step_as};
 use crate::linalg::cholesky::{cholesky, lower_solve, lower_transpose_solve};
 use crate::linalg::symmetric_eigen::{JACOBI_MAX_SWEEPS, jacobi_eigen};
 use crate::linalg::{
@@ -291,6 +291,16 @@ const fn scaled_pow2<const N: usize>(a: &Rows<N>, e: i32) -> Rows<N> {
     r
 }
 
+/// Every number of a damping description is finite.
+const fn damping_finite<const N: usize>(damping: &Damping<N>) -> bool {
+    match damping {
+        Damping::None => true,
+        Damping::Rayleigh { a0, a1 } => a0.is_finite() && a1.is_finite(),
+        Damping::Ratios(xi) => all_finite(&[*xi]),
+        Damping::Matrix(c) => all_finite(c),
+    }
+}
+
 /// `2ξ_r ω_r` of every mode for the given damping.
 const fn modal_damping<const N: usize>(
     damping: &Damping<N>,
@@ -406,11 +416,22 @@ pub(crate) const fn modal_operators<
         }
         i += 1;
     }
-    if !(all_finite(m) && all_finite(k) && all_finite(b) && all_finite(y)) {
+    // Every datum, the damping's included, is checked before any is used: a NaN is
+    // `NonFiniteInput` whatever else is wrong (the damping used to be checked after the
+    // eigenproblem, so a NaN there could come back as `MassNotSpd`; found by fuzzing).
+    if !(all_finite(m)
+        && all_finite(k)
+        && all_finite(b)
+        && all_finite(y)
+        && damping_finite(damping))
+    {
         return Err(Error::NonFiniteInput);
     }
-    let kin = match AemKinematics::new(h) {
-        Ok(kin) => kin,
+    let kin = match check_time_step_as(h, max) {
+        Ok(h) => match AemKinematics::new(h) {
+            Ok(kin) => kin,
+            Err(e) => return Err(e),
+        },
         Err(e) => return Err(e),
     };
     let (lam, phi) = match modes_of(m, k) {
@@ -766,7 +787,8 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> St
     }
 
     /// The state at `t = 0` from `u0, v0, a0`, each projected on the kept modes
-    /// (`η = Φ_Rᵀ M x`). Errors: [`Error::NonFiniteInput`]. Cost: `3R·N`.
+    /// (`η = Φ_Rᵀ M x`). Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if a
+    /// projection overflows (large `M` in `f32`). Cost: `3R·N`.
     fn start_with_acceleration(
         &self,
         u0: &SVector<T, N>,

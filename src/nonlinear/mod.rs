@@ -25,7 +25,7 @@ use core::marker::PhantomData;
 use nalgebra::{SMatrix, SVector};
 
 use crate::hysteresis::{HistoryModel, Trial};
-use crate::kinematics::{AemKinematics, Kinematics};
+use crate::kinematics::{AemKinematics, Kinematics, check_time_step_as};
 use crate::linalg::lu::{solve_in_place, solve_in_place_scaled};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
@@ -229,7 +229,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
     /// [`Error::InvalidNewtonSettings`] (zero iterations, or a tolerance that is negative
     /// or not finite). Cost: O(1).
     pub fn new(h: f64, settings: NewtonSettings<T>) -> Result<Self, Error> {
-        let kin = AemKinematics::new(h)?.round();
+        let kin = AemKinematics::new(check_time_step_as(h, T::MAX)?)?.round();
         let budget = match settings.iterations {
             Iterations::UpTo(k) | Iterations::Exactly(k) => k,
         };

@@ -18,7 +18,7 @@ use core::marker::PhantomData;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kinematics::{AemKinematics, Kinematics};
+use crate::kinematics::{AemKinematics, Kinematics, check_time_step_as};
 use crate::linalg::lu::solve_in_place_scaled;
 use crate::nonlinear::initial_from_equation;
 use crate::scalar::initial_inputs_finite;
@@ -100,7 +100,7 @@ impl<T: Real, const N: usize> Varying<T, N> {
     /// Errors: [`Error::InvalidTimeStep`] (`h` not finite or `≤ 0`). Cost: O(1).
     pub fn new(h: f64) -> Result<Self, Error> {
         Ok(Self {
-            kin: AemKinematics::new(h)?.round(),
+            kin: AemKinematics::new(check_time_step_as(h, T::MAX)?)?.round(),
             _n: PhantomData,
         })
     }

@@ -4,6 +4,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::state_space::{Measurement, StateSpace};
+use crate::kinematics::check_time_step_as;
 use crate::linalg::{self, all_finite, finite_as, round_rows, rows_f64};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
@@ -127,6 +128,11 @@ const fn check_parts<const N: usize, const S: usize, const I: usize, const O: us
     if !(all_finite(gain) && all_finite(&meas.h) && all_finite(&meas.d)) {
         return Err(Error::NonFiniteInput);
     }
+    // The time step too must fit `T` (an f32 observer of a model with h = 1e147 had an
+    // infinite time step; found by fuzzing).
+    if let Err(e) = check_time_step_as(model.dt, max) {
+        return Err(e);
+    }
     if !(finite_as(&model.phi, max)
         && finite_as(&model.gamma0, max)
         && finite_as(&model.gamma1, max)
@@ -145,6 +151,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
     /// loop). Rounded once to `T`.
     ///
     /// Errors: [`Error::NonFiniteInput`] (a non-finite gain or output matrix),
+    /// [`Error::InvalidTimeStep`] (the model's `dt` is not a valid time step in `T`),
     /// [`Error::OperatorOverflow`] (an operator does not fit `T`). Cost: `O(S²)`.
     pub fn new<const N: usize>(
         model: &StateSpace<N, S, I>,

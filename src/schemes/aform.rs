@@ -89,6 +89,11 @@ impl<T: Real, const N: usize> AForm<T, N> {
         Some(SMatrix::from_fn(|i, j| blk.get(i, c, j)))
     }
 
+    /// Every entry of every block is finite.
+    pub(crate) fn is_finite(&self) -> bool {
+        self.rows.iter().all(|r| r.all_finite())
+    }
+
     /// Block `b_r` (`r` in `0..3`), or `None` if out of range.
     pub fn b_block(&self, r: usize) -> Option<SMatrix<T, N, N>> {
         let blk = self.rows.get(r)?;

@@ -36,7 +36,7 @@
 use nalgebra::{ComplexField, SMatrix, SVector};
 
 use crate::kernel::{StartOps, checked_rows, start_operators};
-use crate::kinematics::check_time_step;
+use crate::kinematics::check_time_step_as;
 use crate::linalg::expm::{Blk, blk_expm, norm1};
 use crate::linalg::{Mat, add_scaled, finite_as, identity, round_rows, scaled};
 use crate::{Error, Real, State, Stepper};
@@ -102,7 +102,7 @@ impl<T: Real, const N: usize> Exact<T, N> {
         h: f64,
     ) -> Result<Self, Error> {
         let (m, c, k) = checked_rows(m, c, k)?;
-        let hf = check_time_step(h)?;
+        let hf = check_time_step_as(h, T::MAX)?;
         let (_, st) = start_operators(&m, &c, &k, T::MAX)?.ok_or(Error::SingularMass)?;
         let (mi, mic, mik) = (&st.minv, &st.minv_c, &st.minv_k);
         // Balancing D = diag(1, σ, τ1, τ2): block (i, j) scales by d_j / d_i.

@@ -25,7 +25,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use crate::kernel::{StartOps, start_operators, terms_scales};
-use crate::kinematics::{Kinematics, NewmarkKinematics};
+use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition};
 use crate::linalg::{Mat, add_scaled, all_finite, finite_as, round_rows, rows_f64, scaled};
 use crate::{Error, Real, State, Stepper};
@@ -126,7 +126,12 @@ pub(crate) const fn alpha_operators<const N: usize>(
     } = *p;
     let finite =
         alpha_m.is_finite() && alpha_f.is_finite() && beta.is_finite() && gamma.is_finite();
-    // The time step first (as the stepper always checked it), then the parameters.
+    // The time step first (as the stepper always checked it; in the scalar type: `h` and
+    // `h²/4` representable), then the parameters.
+    let h = match check_time_step_as(h, max) {
+        Ok(h) => h,
+        Err(e) => return Err(e),
+    };
     let kin = match NewmarkKinematics::new(h, beta, gamma) {
         Ok(kin) => kin,
         Err(e) => return Err(e),
@@ -156,7 +161,12 @@ pub(crate) const fn alpha_operators<const N: usize>(
         -f1 * (0.5 - beta) * hf * hf,
         &gk,
     );
-    if !(finite_as(&g, max) && finite_as(&gk, max) && finite_as(&av, max) && finite_as(&aa, max)) {
+    if !(finite_as(&g, max)
+        && finite_as(&gk, max)
+        && finite_as(&av, max)
+        && finite_as(&aa, max)
+        && kin.fits(max))
+    {
         return Err(Error::OperatorOverflow);
     }
     let start = match start_operators(m, c, k, max) {

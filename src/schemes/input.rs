@@ -248,10 +248,11 @@ impl<T: Real, const N: usize, const I: usize> Stepper<T, N> for LinearInput<T, N
         v0: &SVector<T, N>,
         w0: &SVector<T, I>,
     ) -> Result<State<T, N>, Error> {
-        let st = self.start.as_ref().ok_or(Error::SingularMass)?;
+        // A non-finite input first, as every start in the crate (found by fuzzing).
         if !initial_inputs_finite(u0, v0, w0) {
             return Err(Error::NonFiniteInput);
         }
+        let st = self.start.as_ref().ok_or(Error::SingularMass)?;
         let mv = |a: &[[T; N]; N], x: &SVector<T, N>| crate::kernel::mat_vec(a, x);
         let a0 = crate::kernel::mat_vec(&st.minv_b, w0)
             - mv(&st.ops.minv_c, v0)

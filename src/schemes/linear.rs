@@ -89,6 +89,10 @@ impl<T: Real, const N: usize> Linear<T, N> {
     /// The paper's literal form `U_n = A U_{n−1} + b p_n` of this stepper (`12N²`
     /// multiply-adds a step): the reference the fast form is tested against, and a way to
     /// inspect the amplification operator. Cost to build: about `6N³` flops in `T`.
+    ///
+    /// Its blocks are products in `T` of this stepper's operators and `h`, and can
+    /// overflow where those do not (e.g. `(h/2) G` with `G = 1e251`, `h = 1e147`, found by
+    /// fuzzing): [`Linear::try_a_form`] checks them.
     pub fn a_form(&self) -> AForm<T, N> {
         let ops = &self.kernel.ops;
         let block = |b: usize, sign: T| -> [[T; N]; N] {
@@ -97,6 +101,19 @@ impl<T: Real, const N: usize> Linear<T, N> {
         let one = T::one();
         let (g, gc, gk) = (block(0, one), block(1, -one), block(2, -one));
         AForm::from_operators(self.kernel.kin.h, &g, &gc, &gk, self.kernel.start)
+    }
+
+    /// [`Linear::a_form`], checked: every block of `A` and `b` finite.
+    ///
+    /// Errors: [`Error::OperatorOverflow`] (a block overflows `T`). Cost: that of
+    /// [`Linear::a_form`] and a scan of its `12N²` entries.
+    pub fn try_a_form(&self) -> Result<AForm<T, N>, Error> {
+        let af = self.a_form();
+        if af.is_finite() {
+            Ok(af)
+        } else {
+            Err(Error::OperatorOverflow)
+        }
     }
 }
 

@@ -95,14 +95,73 @@ pub(super) const fn substeps_for(rule: Substeps, dt: f64, t: f64) -> u16 {
     }
 }
 
+/// `x` finite and at most `max` in size (it fits the scalar type whose largest finite value
+/// is `max`).
+const fn fits(x: f64, max: f64) -> bool {
+    x.is_finite() && x.abs() <= max
+}
+
+/// The homogeneous part of a map is bounded as a damped oscillator's must be: the energy
+/// `(ω²u² + v²)/2` never grows, so `|uu|, |vv|, ω|uv|, |vu|/ω ≤ 1` (exactly for both
+/// schemes; here within `1e-6`). The exact scheme's matrix exponential loses that, and all
+/// accuracy, far beyond `ω dt ≈ 1e10` (its squarings amplify rounding by about `ω dt`):
+/// the fuzzer found a whole-interval `uu = 6e134` at `ω dt ≈ 3e18`.
+const fn contractive(m: &SdofOps, w: f64) -> bool {
+    let b = 1.0 + 1e-6;
+    m.uu.abs() <= b && m.vv.abs() <= b && (m.uv * w).abs() <= b && (m.vu / w).abs() <= b
+}
+
+/// Every operator of one oscillator, and `1/dt`, fits the scalar type (largest finite value
+/// `max`), the coefficients the bank derives from `ω` and `ζ` included, and both maps are
+/// [`contractive`].
+const fn oscillator_fits(op: &SdofOps, whole: &SdofOps, w: f64, z: f64, ka: f64, max: f64) -> bool {
+    if !(contractive(op, w) && contractive(whole, w)) {
+        return false;
+    }
+    let xs = [
+        op.uu,
+        op.uv,
+        op.ug,
+        op.ud,
+        op.vu,
+        op.vv,
+        op.vg,
+        op.vd,
+        whole.uu,
+        whole.uv,
+        whole.ug,
+        whole.ud,
+        whole.vu,
+        whole.vv,
+        whole.vg,
+        whole.vd,
+        w,
+        w * w,
+        2.0 * z * w,
+        ka,
+        1.0 / (w * w),
+        1.0 / w,
+        2.0 * z * w / (w * w * w),
+    ];
+    let mut i = 0;
+    while i < xs.len() {
+        if !fits(xs[i], max) {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
 /// Check the inputs and compute the `f64` operators (shared by the `f32` and `f64`
-/// constructors).
+/// constructors; `max`: the largest finite value of the scalar type they are rounded to).
 pub(super) const fn build_f64<const P: usize>(
     period: &[f64; P],
     damping: &[f64; P],
     dt: f64,
     scheme: Scheme,
     rule: Substeps,
+    max: f64,
 ) -> Result<OpsF64<P>, Error> {
     if !(dt.is_finite() && dt > 0.0) {
         return Err(Error::InvalidTimeStep);
@@ -133,6 +192,7 @@ pub(super) const fn build_f64<const P: usize>(
         c2: [0.0; P],
         n: [1; P],
     };
+    let mut fits_all = true;
     let mut p = 0;
     while p < P {
         let t = period[p];
@@ -169,7 +229,14 @@ pub(super) const fn build_f64<const P: usize>(
             it += 1;
         }
         out.ka[p] = 1.0 / (w * r);
+        // Operators that overflow (or come out NaN: the exact map over `ω dt ≈ 1e106` was
+        // NaN, found by fuzzing) are an error, not a bank that steps to NaN — reported
+        // after every period and damping ratio has been checked (bad data first).
+        fits_all &= oscillator_fits(&out.ops[p], &out.whole[p], w, z, out.ka[p], max);
         p += 1;
+    }
+    if !(fits_all && fits(1.0 / dt, max)) {
+        return Err(Error::OperatorOverflow);
     }
     Ok(out)
 }
@@ -177,7 +244,8 @@ pub(super) const fn build_f64<const P: usize>(
 macro_rules! bank_ctor {
     ($t:ident) => {
         impl<const P: usize> Bank<$t, P> {
-            /// A bank of oscillators with periods `period` (s, finite, `> 0`, in
+            /// A bank of oscillators with periods `period` (s, finite, at least `1e-150`
+            /// — shorter ones, whose `ω²` overflows, are `InvalidPeriod` too — in
             /// non-decreasing order), damping ratios `damping` (in `[0, 1)`), sample
             /// interval `dt` (s, finite, `> 0`), the exact scheme, and the sub-step rule
             /// [`Substeps::AUTO`].
@@ -186,7 +254,10 @@ macro_rules! bank_ctor {
             /// Cost: about 1 000 `f64` flops per oscillator, once.
             ///
             /// Errors: [`Error::InvalidPeriod`], [`Error::InvalidDamping`],
-            /// [`Error::InvalidTimeStep`].
+            /// [`Error::InvalidTimeStep`], [`Error::OperatorOverflow`] (an operator is not
+            /// finite in the scalar type, e.g. `ω²` beyond `f32`, or not bounded as an
+            /// oscillator's map must be: `T/dt` so small that the exact map over `dt`
+            /// cannot be formed, `ω dt` far beyond `1e10`).
             pub const fn new(period: [f64; P], damping: [f64; P], dt: f64) -> Result<Self, Error> {
                 Self::with(period, damping, dt, Scheme::Exact, Substeps::AUTO)
             }
@@ -203,7 +274,7 @@ macro_rules! bank_ctor {
                 scheme: Scheme,
                 substeps: Substeps,
             ) -> Result<Self, Error> {
-                let o = match build_f64(&period, &damping, dt, scheme, substeps) {
+                let o = match build_f64(&period, &damping, dt, scheme, substeps, $t::MAX as f64) {
                     Ok(o) => o,
                     Err(e) => return Err(e),
                 };

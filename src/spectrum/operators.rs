@@ -144,7 +144,9 @@ pub(crate) const fn exact(w: f64, c2: f64, h: f64) -> SdofOps {
     }
 }
 
-/// One AEM (average-acceleration) sub-step from `(u, v)` with load `g → g + δ`.
+/// One AEM (average-acceleration) sub-step from `(u, v)` with load `g → g + δ`: the
+/// reference [`aem`]'s closed form is tested against.
+#[cfg(test)]
 const fn aem_apply(w2: f64, c2: f64, h: f64, u: f64, v: f64, g: f64, d: f64) -> (f64, f64) {
     let q0 = -g - c2 * v - w2 * u;
     let meff = 1.0 + 0.5 * h * c2 + 0.25 * h * h * w2;
@@ -155,22 +157,30 @@ const fn aem_apply(w2: f64, c2: f64, h: f64, u: f64, v: f64, g: f64, d: f64) -> 
     )
 }
 
-/// AEM sub-step of length `h` for `ω² = w2`, `2ζω = c2` (the map's columns, from unit
-/// inputs).
+/// AEM sub-step of length `h` for `ω² = w2`, `2ζω = c2`: the map of [`aem_apply`] in
+/// closed form. With `D = 1 + (h/2) c2 + (h²/4) w2`,
+///
+/// ```text
+/// uu = (1 + (h/2) c2 − (h²/4) w2)/D   uv = h/D   ug = −(h²/2)/D   ud = −(h²/4)/D
+/// vu = −h w2/D   vv = (1 − (h/2) c2 − (h²/4) w2)/D   vg = −h/D   vd = −(h/2)/D
+/// ```
+///
+/// (Formed by applying the step to unit inputs, as before, `uu` came from
+/// `1 + h v − (h²/4)·w2·(…)` terms of size `(ωh)²/4` that cancel to about `−1`: at
+/// `ωh ≈ 5e14` it was off by `1e13`, and a bank stepped 10 m/s² to a displacement of
+/// `1e98`. Found by fuzzing.)
 pub(crate) const fn aem(w2: f64, c2: f64, h: f64) -> SdofOps {
-    let (uu, vu) = aem_apply(w2, c2, h, 1.0, 0.0, 0.0, 0.0);
-    let (uv, vv) = aem_apply(w2, c2, h, 0.0, 1.0, 0.0, 0.0);
-    let (ug, vg) = aem_apply(w2, c2, h, 0.0, 0.0, 1.0, 0.0);
-    let (ud, vd) = aem_apply(w2, c2, h, 0.0, 0.0, 0.0, 1.0);
+    let (a, b) = (0.5 * h * c2, 0.25 * h * h * w2);
+    let d = 1.0 + a + b;
     SdofOps {
-        uu,
-        uv,
-        ug,
-        ud,
-        vu,
-        vv,
-        vg,
-        vd,
+        uu: (1.0 + a - b) / d,
+        uv: h / d,
+        ug: -(0.5 * h * h) / d,
+        ud: -(0.25 * h * h) / d,
+        vu: -(h * w2) / d,
+        vv: (1.0 - a - b) / d,
+        vg: -h / d,
+        vd: -(0.5 * h) / d,
     }
 }
 
@@ -287,5 +297,46 @@ mod tests {
             );
             x += 0.013;
         }
+    }
+
+    /// The closed-form AEM map is the step applied to unit inputs (to rounding, where that
+    /// has no cancellation), and stays bounded at any `ωh` (the unit-input form did not).
+    #[test]
+    fn aem_closed_form_is_the_step() {
+        for (w2, c2, h) in [
+            (4.0, 0.1, 0.01),
+            (400.0, 2.0, 0.05),
+            (1.0, 0.0, 1.0),
+            (1e4, 10.0, 0.02),
+        ] {
+            let op = aem(w2, c2, h);
+            let cols = [
+                aem_apply(w2, c2, h, 1.0, 0.0, 0.0, 0.0),
+                aem_apply(w2, c2, h, 0.0, 1.0, 0.0, 0.0),
+                aem_apply(w2, c2, h, 0.0, 0.0, 1.0, 0.0),
+                aem_apply(w2, c2, h, 0.0, 0.0, 0.0, 1.0),
+            ];
+            let got = [
+                (op.uu, op.vu),
+                (op.uv, op.vv),
+                (op.ug, op.vg),
+                (op.ud, op.vd),
+            ];
+            for (a, b) in got.iter().zip(cols.iter()) {
+                for (x, y) in [(a.0, b.0), (a.1, b.1)] {
+                    assert!(
+                        (x - y).abs() <= 1e-13 * (1.0 + y.abs()),
+                        "{x} vs {y} at ω² = {w2}"
+                    );
+                }
+            }
+        }
+        let w = 2.0 * core::f64::consts::PI / 2.220446049250313e-16;
+        let op = aem(w * w, 2.0 * 0.18 * w, 1.643114108127686e-2);
+        assert!(
+            (op.uu + 1.0).abs() < 1e-6 && op.vv.abs() <= 1.0,
+            "{}",
+            op.uu
+        );
     }
 }

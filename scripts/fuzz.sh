@@ -1,0 +1,160 @@
+#!/usr/bin/env bash
+# Fuzzing (issue 10): builds the fuzz targets of fuzz/ (libFuzzer through the crates.io
+# crate libfuzzer-sys) and runs each for a bounded time, starting from its kept corpus
+# fuzz/corpus/<target>/; fails on any crash (a panic, i.e. a broken property: the checks
+# in fuzz/src/checks.rs panic, and libfuzzer-sys aborts on a panic). Prints per-target
+# executions, time, crashes and the checks' counters, and writes them to
+# fuzz/target/fuzz-stats.txt.
+#
+# How it is built, and why without cargo-fuzz: cargo-fuzz is only a driver — it runs
+# `cargo build` with the sanitizer-coverage flags below and runs the binaries. Doing that
+# here needs nothing but the stable toolchain and a C++ compiler (libfuzzer-sys compiles
+# libFuzzer's sources), so there is no tool to install from source on every fresh machine
+# (and no nightly: without AddressSanitizer, which this crate does not need —
+# `#![forbid(unsafe_code)]` — no flag here is unstable). The flags are cargo-fuzz's: the
+# SanitizerCoverage module pass with inline 8-bit counters, the PC table and comparison
+# tracing, and `--cfg fuzzing`; the fuzz crate's release profile keeps debug assertions and
+# overflow checks on. `--target` keeps the flags off build scripts and proc macros.
+#
+# Usage: bash scripts/fuzz.sh [options] [TARGET...]   (default: every target)
+#   FUZZ_SECONDS=N   seconds per target (default 30)
+#   --merge          afterwards, minimize the kept corpus plus this run's new inputs into
+#                    fuzz/corpus/<target>/ (libFuzzer -merge=1; capped at 200 files)
+#   --record         copy the stats to fuzz/stats.txt (committed; docs/robustness.md
+#                    tabulates it, crashes included: bash scripts/robustness.sh)
+#   --self-test      show that a crash fails the run: with AEMSTEP_FUZZ_INJECT_PANIC=1 the
+#                    fuzz binaries panic on inputs whose first byte is 0x2a; the fuzzer
+#                    must find one within 30 s and the run must fail (exit 0 if it did)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+TARGETS_ALL=(linear_family modal nonlinear hysteresis observer spectrum)
+SECS=${FUZZ_SECONDS:-30}
+merge=0
+record=0
+selftest=0
+targets=()
+for a in "$@"; do
+    case "$a" in
+    --merge) merge=1 ;;
+    --record) record=1 ;;
+    --self-test) selftest=1 ;;
+    -*) echo "unknown option $a" >&2; exit 2 ;;
+    *) targets+=("$a") ;;
+    esac
+done
+[ ${#targets[@]} -gt 0 ] || targets=("${TARGETS_ALL[@]}")
+
+fail() { printf '\nFAILED: %s\n' "$*" >&2; exit 1; }
+
+# What the build needs: a C++ compiler for libFuzzer (installed if missing; fails loudly).
+if ! command -v c++ >/dev/null 2>&1; then
+    echo "==> installing a C++ compiler (libFuzzer is C++)"
+    { apt-get update -qq && apt-get install -y -qq g++; } || fail "no C++ compiler and could not install g++"
+fi
+host=$(rustc -vV | sed -n 's/^host: //p')
+[ -n "$host" ] || fail "rustc -vV gave no host triple"
+
+export CARGO_TARGET_DIR="$PWD/fuzz/target"
+flags="-Cpasses=sancov-module -Cllvm-args=-sanitizer-coverage-level=4"
+flags+=" -Cllvm-args=-sanitizer-coverage-inline-8bit-counters"
+flags+=" -Cllvm-args=-sanitizer-coverage-pc-table"
+flags+=" -Cllvm-args=-sanitizer-coverage-trace-compares --cfg fuzzing"
+
+build() { # the instrumented binaries
+    RUSTFLAGS="$flags" cargo build --release --manifest-path fuzz/Cargo.toml \
+        --target "$host" --bins || fail "building the fuzz targets"
+}
+
+bin="$CARGO_TARGET_DIR/$host/release"
+out="$CARGO_TARGET_DIR/fuzz-run"
+
+# run TARGET SECONDS: one bounded run from the kept corpus; new inputs go to a scratch
+# directory (the committed corpus is only read). Returns libFuzzer's exit status.
+run() {
+    local t=$1 secs=$2
+    mkdir -p "$out/$t/new" "fuzz/corpus/$t"
+    rm -f "$out/$t/counts" "$out/$t/crash-"*
+    AEMSTEP_FUZZ_COUNTS="$out/$t/counts" "$bin/$t" "$out/$t/new" "fuzz/corpus/$t" \
+        -max_total_time="$secs" -max_len=1024 -timeout=20 -rss_limit_mb=2048 \
+        -artifact_prefix="$out/$t/" -print_final_stats=1 >"$out/$t/log" 2>&1
+}
+
+if [ "$selftest" = 1 ]; then
+    # The fuzz binaries panic on every input whose first byte is 0x2a when
+    # AEMSTEP_FUZZ_INJECT_PANIC=1: the fuzzer must find one, report the crash, write the
+    # input, and this script's run must fail. (The same binaries as the real runs.)
+    echo "==> self-test: an injected panic must fail the fuzz run"
+    build
+    t=linear_family
+    if AEMSTEP_FUZZ_INJECT_PANIC=1 run "$t" 30; then
+        fail "self-test: the run with an injected panic passed"
+    fi
+    grep -q "injected panic" "$out/$t/log" || fail "self-test: no injected panic in the log"
+    [ -n "$(find "$out/$t" -maxdepth 1 -name 'crash-*')" ] || fail "self-test: no crash artifact written"
+    echo "self-test: the injected panic failed the run (crash artifact written)"
+    exit 0
+fi
+
+echo "==> building the fuzz targets ($host, libFuzzer via libfuzzer-sys, stable toolchain)"
+start=$(date +%s)
+build
+echo "built in $(( $(date +%s) - start )) s"
+
+stats="$CARGO_TARGET_DIR/fuzz-stats.txt"
+{
+    echo "# scripts/fuzz.sh: $SECS s per target; $(rustc --version)"
+} >"$stats"
+crashed=()
+for t in "${targets[@]}"; do
+    [ -x "$bin/$t" ] || fail "no fuzz target $t"
+    echo "==> fuzzing $t for $SECS s (from fuzz/corpus/$t: $(find "fuzz/corpus/$t" -type f 2>/dev/null | wc -l) inputs)"
+    status=0
+    run "$t" "$SECS" || status=$?
+    execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$out/$t/log" | tail -1)
+    time_s=$(sed -n 's/^Done [0-9]* runs in \([0-9]*\) second.*/\1/p' "$out/$t/log" | tail -1)
+    crashes=$(find "$out/$t" -maxdepth 1 -name 'crash-*' | wc -l)
+    if [ "$status" != 0 ] || [ "$crashes" != 0 ]; then
+        crashed+=("$t")
+        grep -E "property broken|panicked|ERROR: libFuzzer|data:" "$out/$t/log" | head -20 >&2 || true
+        find "$out/$t" -maxdepth 1 -name 'crash-*' >&2
+        [ "$crashes" != 0 ] || crashes=1
+    fi
+    {
+        echo "TARGET $t executions ${execs:-0} seconds ${time_s:-$SECS} crashes $crashes"
+        [ -f "$out/$t/counts" ] && cat "$out/$t/counts"
+    } >>"$stats"
+    echo "$t: ${execs:-0} executions in ${time_s:-$SECS} s, $crashes crash(es)"
+    if [ "$merge" = 1 ] && [ "$crashes" = 0 ]; then
+        # Minimize the kept corpus and this run's new inputs into a fresh set covering all
+        # of their coverage; keep it if it is small enough to commit.
+        m="$out/$t/merged"
+        rm -rf "$m" && mkdir -p "$m"
+        "$bin/$t" -merge=1 -max_len=1024 "$m" "fuzz/corpus/$t" "$out/$t/new" >"$out/$t/merge.log" 2>&1 ||
+            fail "merging the corpus of $t"
+                n=$(find "$m" -type f | wc -l)
+        if [ "$n" -gt 200 ]; then
+            # Over the cap: 200 of them, by name (libFuzzer names an input by its hash, so
+            # this is an unbiased, reproducible sample); the rest of the coverage is the
+            # fuzzer's to find again in each run.
+            find "$m" -type f | sort | tail -n +201 | xargs rm -f
+            echo "$t: merged corpus had $n inputs; kept 200 (fuzz/corpus/$t)"
+        else
+            echo "$t: corpus minimized to $n inputs (fuzz/corpus/$t)"
+        fi
+        rm -rf "fuzz/corpus/$t" && mv "$m" "fuzz/corpus/$t"
+    fi
+done
+
+echo
+echo "per-target results (also in $stats):"
+grep '^TARGET' "$stats" | awk '{ printf "  %-14s %10s executions %5s s %s crash(es)\n", $2, $4, $6, $8 }'
+if [ "$record" = 1 ]; then
+    [ ${#targets[@]} = ${#TARGETS_ALL[@]} ] || fail "--record needs a run of every target"
+    cp "$stats" fuzz/stats.txt
+    echo "recorded in fuzz/stats.txt (bash scripts/robustness.sh tabulates it)"
+fi
+if [ ${#crashed[@]} -gt 0 ]; then
+    fail "fuzzing found a crash in: ${crashed[*]} (inputs in $out/<target>/crash-*; replay one with AEMSTEP_FUZZ_REPLAY=<dir>/<target>/<file> cargo test --test fuzz_corpus -- --nocapture, the file in a directory named after its target)"
+fi
+echo "fuzzing: no crash"
