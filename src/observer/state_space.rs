@@ -397,17 +397,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         put(&mut ss.gamma0, &bl.v0, N, 0);
         put(&mut ss.gamma1, &bl.u1, 0, 0);
         put(&mut ss.gamma1, &bl.v1, N, 0);
-        let id: Mat<N, N> = identity();
-        put(&mut ss.dof_u, &id, 0, 0);
-        put(&mut ss.dof_v, &id, 0, N);
-        put(&mut ss.dof_a, &bl.au, 0, 0);
-        put(&mut ss.dof_a, &bl.av, 0, N);
-        ss.dof_a_input = bl.aw;
-        if ss.all_finite() {
-            Ok(ss)
-        } else {
-            Err(Error::OperatorOverflow)
-        }
+        ss.full_outputs(&bl.au, &bl.av, bl.aw)
     }
 
     /// [`StateSpace::newmark_from_rows`] from `nalgebra` matrices (run time; same numbers).
@@ -511,17 +501,9 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         put(&mut ss.gamma1, &scaled(bh2, &a1), 0, 0);
         put(&mut ss.gamma1, &scaled(gh, &a1), N, 0);
         put(&mut ss.gamma1, &a1, 2 * N, 0);
-        put(&mut ss.dof_u, &id, 0, 0);
-        put(&mut ss.dof_v, &id, 0, N);
         // The physical acceleration M⁻¹ (B w − C v − K u).
-        put(&mut ss.dof_a, &scaled(-1.0, &st.minv_k), 0, 0);
-        put(&mut ss.dof_a, &scaled(-1.0, &st.minv_c), 0, N);
-        ss.dof_a_input = lu_m.solve(&b);
-        if ss.all_finite() {
-            Ok(ss)
-        } else {
-            Err(Error::OperatorOverflow)
-        }
+        let (au, av) = (scaled(-1.0, &st.minv_k), scaled(-1.0, &st.minv_c));
+        ss.full_outputs(&au, &av, lu_m.solve(&b))
     }
 
     /// [`StateSpace::generalized_alpha_from_rows`] from `nalgebra` matrices (run time; same
@@ -655,17 +637,8 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         put(&mut ss.gamma0, &mul(&ex.av[2], &bb), N, 0);
         put(&mut ss.gamma1, &mul(&ex.au[3], &bb), 0, 0);
         put(&mut ss.gamma1, &mul(&ex.av[3], &bb), N, 0);
-        let id: Mat<N, N> = identity();
-        put(&mut ss.dof_u, &id, 0, 0);
-        put(&mut ss.dof_v, &id, 0, N);
-        put(&mut ss.dof_a, &scaled(-1.0, &st.minv_k), 0, 0);
-        put(&mut ss.dof_a, &scaled(-1.0, &st.minv_c), 0, N);
-        ss.dof_a_input = lu_m.solve(&bb);
-        if ss.all_finite() {
-            Ok(ss)
-        } else {
-            Err(Error::OperatorOverflow)
-        }
+        let (au, av) = (scaled(-1.0, &st.minv_k), scaled(-1.0, &st.minv_c));
+        ss.full_outputs(&au, &av, lu_m.solve(&bb))
     }
 
     /// The form of [`Modal`](crate::Modal) keeping the modes `modes` (indices in ascending
@@ -781,6 +754,28 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
             }
             e
         })
+    }
+
+    /// The output maps of a full-state model (`u`, `v` the first `2N` states;
+    /// `a = A_u u + A_v v + A_w w`), then the check that every matrix is finite
+    /// ([`Error::OperatorOverflow`] if not).
+    const fn full_outputs(
+        mut self,
+        au: &Mat<N, N>,
+        av: &Mat<N, N>,
+        aw: [[f64; I]; N],
+    ) -> Result<Self, Error> {
+        let id: Mat<N, N> = identity();
+        put(&mut self.dof_u, &id, 0, 0);
+        put(&mut self.dof_v, &id, 0, N);
+        put(&mut self.dof_a, au, 0, 0);
+        put(&mut self.dof_a, av, 0, N);
+        self.dof_a_input = aw;
+        if self.all_finite() {
+            Ok(self)
+        } else {
+            Err(Error::OperatorOverflow)
+        }
     }
 
     /// Every entry of every matrix is finite.
