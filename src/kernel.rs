@@ -60,11 +60,47 @@ impl<const N: usize> KernelOps<N> {
     }
 }
 
+impl<T: Real, const N: usize> Kernel<T, N, AemKinematics<T>> {
+    /// The AEM kernel of `M, C, K, h` (run time; bit-identical to `aem_from_rows`): the
+    /// one build behind `Linear::new` and `CompensatedLinear::new`.
+    pub(crate) fn aem(
+        m: &nalgebra::SMatrix<f64, N, N>,
+        c: &nalgebra::SMatrix<f64, N, N>,
+        k: &nalgebra::SMatrix<f64, N, N>,
+        h: f64,
+    ) -> Result<Self, Error> {
+        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+        Ok(newmark_operators(&m, &c, &k, h, 0.25, 0.5, T::MAX)?.round_aem())
+    }
+}
+
+impl<T: Real, const N: usize, K> Kernel<T, N, K> {
+    /// `G = M_eff⁻¹`, `N×N`. Cost: `N²` reads.
+    pub(crate) fn effective_inverse(&self) -> nalgebra::SMatrix<T, N, N> {
+        nalgebra::SMatrix::from_fn(|i, j| self.ops.get(i, 0, j))
+    }
+}
+
 /// `Kernel::<f32, N, AemKinematics<f32>>::from_ops` (and `f64`): the `const` twin of
 /// [`KernelOps::round_aem`], for the `const fn` constructors (bit-identical to it).
 macro_rules! const_kernel {
     ($t:ident) => {
         impl<const N: usize> Kernel<$t, N, AemKinematics<$t>> {
+            /// The AEM kernel of `M, C, K, h` (`const`): the checks and operators of
+            /// [`newmark_operators`] with β = 1/4, γ = 1/2, rounded once (the one build
+            /// behind `Linear::from_rows` and `CompensatedLinear::from_rows`).
+            pub(crate) const fn aem_from_rows(
+                m: &Mat<N, N>,
+                c: &Mat<N, N>,
+                k: &Mat<N, N>,
+                h: f64,
+            ) -> Result<Self, Error> {
+                match newmark_operators(m, c, k, h, 0.25, 0.5, $t::MAX as f64) {
+                    Ok(op) => Ok(Self::from_ops(&op)),
+                    Err(e) => Err(e),
+                }
+            }
+
             pub(crate) const fn from_ops(op: &KernelOps<N>) -> Self {
                 let (g, gc, gk) = (
                     crate::linalg::const_round!($t, rows op.g),

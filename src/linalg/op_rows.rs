@@ -34,7 +34,7 @@
 use crate::Real;
 
 /// Whether this target stores operators column-blocked (x86-64) or by rows.
-pub(crate) const COLUMN_BLOCKED: bool = cfg!(target_arch = "x86_64");
+const COLUMN_BLOCKED: bool = cfg!(target_arch = "x86_64");
 
 /// Rows of a column block for a scalar of `bytes` bytes: 8 packed chains of 16 bytes
 /// (16 `f64`, 32 `f32`); 0 on row-layout targets.
@@ -235,7 +235,7 @@ fn column_block<T: Real, const R: usize>(cols: &[[T; R]], x: &[T]) -> [T; R] {
 /// `((rows[r][0][0]·x[0][0] + rows[r][0][1]·x[0][1]) + …) + rows[r][K−1][N−1]·x[K−1][N−1]`,
 /// the same chain as every other layout computes.
 #[inline(always)]
-pub(crate) fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
+fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
     rows: &[[[T; N]; K]; R],
     x: &[[T; N]; K],
 ) -> [T; R] {

@@ -9,9 +9,9 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{Kernel, Lows, initial_state, newmark_operators, newmark_step_compensated};
+use crate::kernel::{Kernel, Lows, initial_state, newmark_step_compensated};
 use crate::kinematics::{AemKinematics, Kinematics};
-use crate::linalg::{Rows, rows_f64};
+use crate::linalg::Rows;
 use crate::{Error, Real, State, StepState, Stepper};
 
 /// The state of a [`CompensatedLinear`]: the working-precision [`State`] and the rounding
@@ -109,10 +109,8 @@ impl<T: Real, const N: usize> CompensatedLinear<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
-        let op = newmark_operators(&m, &c, &k, h, 0.25, 0.5, T::MAX)?;
         Ok(Self {
-            kernel: op.round_aem(),
+            kernel: Kernel::aem(m, c, k, h)?,
         })
     }
 
@@ -125,7 +123,7 @@ impl<T: Real, const N: usize> CompensatedLinear<T, N> {
     /// `G = (M + (h/2) C + (h²/4) K)⁻¹` (bit-identical to
     /// [`Linear::effective_inverse`](crate::Linear::effective_inverse)).
     pub fn effective_inverse(&self) -> SMatrix<T, N, N> {
-        SMatrix::from_fn(|i, j| self.kernel.ops.get(i, 0, j))
+        self.kernel.effective_inverse()
     }
 }
 
@@ -143,13 +141,10 @@ macro_rules! const_ctor {
                 k: Rows<N>,
                 h: f64,
             ) -> Result<Self, Error> {
-                let op = match newmark_operators(&m, &c, &k, h, 0.25, 0.5, $t::MAX as f64) {
-                    Ok(op) => op,
-                    Err(e) => return Err(e),
-                };
-                Ok(Self {
-                    kernel: Kernel::<$t, N, AemKinematics<$t>>::from_ops(&op),
-                })
+                match Kernel::<$t, N, AemKinematics<$t>>::aem_from_rows(&m, &c, &k, h) {
+                    Ok(kernel) => Ok(Self { kernel }),
+                    Err(e) => Err(e),
+                }
             }
         }
     };

@@ -16,9 +16,9 @@
 
 use nalgebra::SMatrix;
 
-use crate::kernel::{Kernel, kernel_stepper, newmark_operators};
+use crate::kernel::{Kernel, kernel_stepper};
 use crate::kinematics::AemKinematics;
-use crate::linalg::{Rows, rows_f64};
+use crate::linalg::Rows;
 use crate::{AForm, Error, Real};
 
 /// The linear constant-coefficient AEM stepper (paper Algorithm 1, eliminated form).
@@ -74,16 +74,14 @@ impl<T: Real, const N: usize> Linear<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
-        let op = newmark_operators(&m, &c, &k, h, 0.25, 0.5, T::MAX)?;
         Ok(Self {
-            kernel: op.round_aem(),
+            kernel: Kernel::aem(m, c, k, h)?,
         })
     }
 
     /// `G = (M + (h/2) C + (h²/4) K)⁻¹`.
     pub fn effective_inverse(&self) -> SMatrix<T, N, N> {
-        SMatrix::from_fn(|i, j| self.kernel.ops.get(i, 0, j))
+        self.kernel.effective_inverse()
     }
 
     /// The paper's literal form `U_n = A U_{n−1} + b p_n` of this stepper (`12N²`
@@ -154,13 +152,10 @@ macro_rules! const_ctor {
                 k: Rows<N>,
                 h: f64,
             ) -> Result<Self, Error> {
-                let op = match newmark_operators(&m, &c, &k, h, 0.25, 0.5, $t::MAX as f64) {
-                    Ok(op) => op,
-                    Err(e) => return Err(e),
-                };
-                Ok(Self {
-                    kernel: Kernel::<$t, N, AemKinematics<$t>>::from_ops(&op),
-                })
+                match Kernel::<$t, N, AemKinematics<$t>>::aem_from_rows(&m, &c, &k, h) {
+                    Ok(kernel) => Ok(Self { kernel }),
+                    Err(e) => Err(e),
+                }
             }
 
             /// The time step `h` (s), in `const` contexts.
