@@ -8,6 +8,11 @@
 
 pub use crate::linalg::Rows;
 
+/// The hysteretic shear building (storeys from any [`hysteresis`](crate::hysteresis) law
+/// plus linear damping, for the nonlinear stepper at any `N`), here beside the linear
+/// builders; defined in [`hysteresis`](crate::hysteresis).
+pub use crate::hysteresis::ShearBuilding;
+
 /// Lumped masses and storey stiffnesses of a shear building with `N` storeys, ground
 /// storey first: returns `(M, K)`, `M = diag(m)`, `K` tridiagonal with
 /// `K_ii = k_i + k_{i+1}` (`k_{N+1} = 0`), `K_{i,i+1} = K_{i+1,i} = −k_{i+1}`.
