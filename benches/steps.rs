@@ -183,19 +183,60 @@ fn bench_references<T: Real, const N: usize>(
     let bytes = 3 * N * N * core::mem::size_of::<T>();
     let words = vec![1u64; bytes.div_ceil(8)];
     g.throughput(Throughput::Bytes(bytes as u64));
+    let avx2 = has_avx2();
     g.bench_with_input(BenchmarkId::new("floor-read", N), &N, |b, _| {
         b.iter(|| {
-            black_box(&words)
-                .iter()
-                .fold(0u64, |s, &w| s.wrapping_add(w))
+            if avx2 {
+                // SAFETY: `has_avx2()`: the CPU and OS run AVX2 instructions.
+                unsafe { read_all_avx(black_box(&words)) }
+            } else {
+                read_all(black_box(&words))
+            }
         })
     });
 }
 
+/// Whether the CPU (and OS) run AVX: then the step's column-blocked product runs on AVX
+/// registers (`src/linalg/avx.rs`), and so do the floors it is compared with.
+fn has_avx() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::is_x86_feature_detected!("avx");
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}
+
+/// Whether the CPU (and OS) run AVX2 (256-bit integer adds, for the read floor's sum).
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}
+
+/// One pass over `words` (a wrapping integer sum, which the compiler vectorizes freely).
+#[inline(always)]
+fn read_all(words: &[u64]) -> u64 {
+    words.iter().fold(0u64, |s, &w| s.wrapping_add(w))
+}
+
+/// [`read_all`] compiled for AVX (two 32-byte loads a cycle where SSE2 has 16-byte ones).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn read_all_avx(words: &[u64]) -> u64 {
+    read_all(words)
+}
+
+/// No AVX off x86-64.
+#[cfg(not(target_arch = "x86_64"))]
+unsafe fn read_all_avx(words: &[u64]) -> u64 {
+    read_all(words)
+}
+
 /// The compute floor: 12 independent chains of packed multiply-then-add (no fusing, as
-/// the steppers), `MACS` multiply-adds a call; the rate the cores' multiply and add pipes
-/// sustain in this build.
-fn floor_compute<T: Real, const LANES: usize>(c: &mut Criterion, ty: &str) {
+/// the steppers), `LANES·256` multiply-adds a call; the rate the cores' multiply and add
+/// pipes sustain. On a CPU with AVX it runs on 256-bit registers (`LANES` twice as many:
+/// 12 packed chains either way), as the column-blocked step does (`src/linalg/avx.rs`).
+fn floor_compute<T: Real, const LANES: usize>(c: &mut Criterion, ty: &str, avx: bool) {
     const ROUNDS: usize = 256;
     let mut g = c.benchmark_group("floor");
     g.warm_up_time(Duration::from_millis(200))
@@ -205,16 +246,41 @@ fn floor_compute<T: Real, const LANES: usize>(c: &mut Criterion, ty: &str) {
     let (m, k) = (T::from_f64_rounded(0.999), T::from_f64_rounded(1e-3));
     g.bench_function(format!("compute-{ty}"), |b| {
         b.iter(|| {
-            let mut acc = [T::one(); LANES];
-            for _ in 0..ROUNDS {
-                for a in acc.iter_mut() {
-                    *a = *a * m + k;
-                }
+            if avx {
+                // SAFETY: `avx` is true only where `is_x86_feature_detected!("avx")` is
+                // (see `main`): the CPU and OS run AVX instructions.
+                unsafe { chains_avx::<T, LANES, ROUNDS>(m, k) }
+            } else {
+                chains::<T, LANES, ROUNDS>(m, k)
             }
-            black_box(acc)
         })
     });
     g.finish();
+}
+
+/// `LANES` chains of `ROUNDS` multiply-then-adds.
+#[inline(always)]
+fn chains<T: Real, const LANES: usize, const ROUNDS: usize>(m: T, k: T) -> [T; LANES] {
+    let mut acc = [T::one(); LANES];
+    for _ in 0..ROUNDS {
+        for a in acc.iter_mut() {
+            *a = *a * m + k;
+        }
+    }
+    black_box(acc)
+}
+
+/// [`chains`] compiled for AVX.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx")]
+fn chains_avx<T: Real, const LANES: usize, const ROUNDS: usize>(m: T, k: T) -> [T; LANES] {
+    chains::<T, LANES, ROUNDS>(m, k)
+}
+
+/// No AVX off x86-64.
+#[cfg(not(target_arch = "x86_64"))]
+unsafe fn chains_avx<T: Real, const LANES: usize, const ROUNDS: usize>(m: T, k: T) -> [T; LANES] {
+    chains::<T, LANES, ROUNDS>(m, k)
 }
 
 fn per_step_all(c: &mut Criterion, full: bool) {
@@ -295,9 +361,14 @@ fn main() {
             // N = 100 operators take minutes to build in a debug build.
             let full = std::env::args().any(|a| a == "--bench");
             let mut c = Criterion::default().configure_from_args();
-            // 12 packed registers of chains either way (more would spill: 16 on SSE2).
-            floor_compute::<f64, 24>(&mut c, "f64");
-            floor_compute::<f32, 48>(&mut c, "f32");
+            // 12 packed registers of chains either way (more would spill: 16 registers).
+            if has_avx() {
+                floor_compute::<f64, 48>(&mut c, "f64", true);
+                floor_compute::<f32, 96>(&mut c, "f32", true);
+            } else {
+                floor_compute::<f64, 24>(&mut c, "f64", false);
+                floor_compute::<f32, 48>(&mut c, "f32", false);
+            }
             per_step_all(&mut c, full);
             if full {
                 example10(&mut c);

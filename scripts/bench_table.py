@@ -19,12 +19,14 @@ import sys
 root = sys.argv[1] if len(sys.argv) > 1 else "target/criterion"
 res = {}
 fast = {}  # fastest sample, ns per iteration
+elements = {}  # criterion's throughput: elements (multiply-adds) per iteration
 for dirpath, _, files in os.walk(root):
     if os.path.basename(dirpath) == "new" and "estimates.json" in files:
         b = json.load(open(os.path.join(dirpath, "benchmark.json")))
         e = json.load(open(os.path.join(dirpath, "estimates.json")))
         key = (b["group_id"], b["function_id"], b["value_str"])
         res[key] = e["median"]["point_estimate"]
+        elements[key] = (b.get("throughput") or {}).get("Elements")
         if "sample.json" in files:
             smp = json.load(open(os.path.join(dirpath, "sample.json")))
             fast[key] = min(t / i for t, i in zip(smp["times"], smp["iters"]))
@@ -86,10 +88,10 @@ for n in [25, 50, 100]:
 SIZE = {"f64": 8, "f32": 4}
 for ty in ["f64", "f32"]:
     peak = fast.get(("floor", f"compute-{ty}", None)) or fast.get(("floor", f"compute-{ty}", ""))
-    lanes = {"f64": 24, "f32": 48}[ty]  # benches/steps.rs: floor_compute::<T, LANES>
-    peak = lanes * 256 / peak if peak else None  # multiply-adds per ns
-    print(f"\n`Linear<{ty}, N>` against the floor (fastest sample; compute peak of this build "
-          f"{peak:.1f} multiply-adds per ns; operators {3 * SIZE[ty]}N² bytes):\n" if peak else "")
+    macs = elements.get(("floor", f"compute-{ty}", None))  # LANES·256 (benches/steps.rs)
+    peak = macs / peak if peak and macs else None  # multiply-adds per ns
+    print(f"\n`Linear<{ty}, N>` against the floor (fastest sample; compute peak of this run "
+          f"(AVX where the CPU has it) {peak:.1f} multiply-adds per ns; operators {3 * SIZE[ty]}N² bytes):\n" if peak else "")
     print("| N | `Linear` | multiply-adds / ns | floor: read operators | floor: compute | share of floor | "
           "nalgebra `DMatrix` loop | `Linear` speed-up | `AForm` | `AForm` multiply-adds / ns |")
     print("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")

@@ -43,6 +43,14 @@ for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi thumbv8m.ma
 done
 cargo check --lib --target thumbv7em-none-eabihf --features defmt || fail "defmt feature"
 
+msrv=$(sed -n 's/^rust-version = "\(.*\)"/\1/p' Cargo.toml)
+step "MSRV: Rust ${msrv} (Cargo.toml rust-version) checks every target and builds the firmware library"
+rustup toolchain install "$msrv" --profile minimal --target thumbv7em-none-eabihf ||
+    fail "installing Rust ${msrv}"
+cargo +"$msrv" check --all-targets --features std || fail "Rust ${msrv} (MSRV): host targets"
+cargo +"$msrv" build --lib --release --target thumbv7em-none-eabihf ||
+    fail "Rust ${msrv} (MSRV): thumbv7em library"
+
 step "firmware on QEMU (Cortex-M4F; cost table across M0, M3, M4F, M7, M33): run every example, broken variants must fail, cost tables"
 bash scripts/qemu.sh || fail "firmware (scripts/qemu.sh)"
 

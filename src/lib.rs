@@ -42,11 +42,13 @@
 //! Scalars are `f32` or `f64` ([`Real`]); sizes are const generics; nothing allocates.
 #![no_std]
 #![deny(missing_docs)]
-#![forbid(unsafe_code)]
+// Denied everywhere; allowed only in `linalg::avx` (run-time AVX dispatch, argued there).
+#![deny(unsafe_code)]
+#![deny(clippy::undocumented_unsafe_blocks)]
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-#[cfg(feature = "std")]
+#[cfg(any(test, feature = "std"))]
 extern crate std;
 
 /// The `nalgebra` this crate's API is written in (version 0.35): use `aemstep::nalgebra`

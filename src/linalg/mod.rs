@@ -15,6 +15,8 @@
 //! Cost: `O(N³)` flops and a few `N×N` `f64` temporaries on the stack (`8N²` bytes each)
 //! per build — call them once, not per step (the in-place solve excepted).
 
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod avx;
 pub(crate) mod cholesky;
 pub(crate) mod expm;
 pub(crate) mod lu;

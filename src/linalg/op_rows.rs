@@ -141,11 +141,25 @@ impl<T: Real, const N: usize, const K: usize> OpRows<T, N, K> {
     #[inline(always)]
     pub(crate) fn mat_vec(&self, x: &[[T; N]; K], out: &mut [T]) {
         match Self::WIDE {
-            32 => column_blocks::<T, N, K, 32>(&self.0, x, out),
-            16 => column_blocks::<T, N, K, 16>(&self.0, x, out),
+            32 => wide_blocks::<T, N, K, 32>(&self.0, x, out),
+            16 => wide_blocks::<T, N, K, 16>(&self.0, x, out),
             _ => row_pairs(&self.0, x, out),
         }
     }
+}
+
+/// The column-blocked product: on x86-64 through the run-time AVX choice
+/// ([`super::avx`]), elsewhere (never reached: no other target is column-blocked) plain.
+#[inline(always)]
+fn wide_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
+    ops: &[[[T; N]; K]; N],
+    x: &[[T; N]; K],
+    out: &mut [T],
+) {
+    #[cfg(target_arch = "x86_64")]
+    super::avx::column_blocks::<T, N, K, W>(ops, x, out);
+    #[cfg(not(target_arch = "x86_64"))]
+    column_blocks::<T, N, K, W>(ops, x, out);
 }
 
 /// Rows in the row layout times `x`: a single row first if their number is odd, then
@@ -169,7 +183,7 @@ fn row_pairs<T: Real, const N: usize, const K: usize>(
 /// Storage in the column-blocked layout with blocks of `W` rows, times `x`: the first
 /// block ([`first_block`] rows, dispatched to its size), then the blocks of `W`.
 #[inline(always)]
-fn column_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
+pub(super) fn column_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
     ops: &[[[T; N]; K]; N],
     x: &[[T; N]; K],
     out: &mut [T],

@@ -1,0 +1,171 @@
+//! x86-64 only: the column-blocked product on 256-bit AVX registers when the CPU has them,
+//! chosen at run time.
+//!
+//! The default x86-64 target may assume SSE2 only (2 `f64` lanes a packed operation). The
+//! same column-blocked loop compiled with AVX enabled runs 4 lanes a packed operation
+//! and reaches the operators' read floor at N = 100 (`docs/performance.md`: 4.1 → 2.7 µs a
+//! step of `Linear<f64, 100>` on the benchmark machine). AVX adds no instruction that
+//! changes a result: packed `vmulpd`/`vaddpd` round each lane as `mulpd`/`addpd` do, and
+//! Rust never fuses a multiply and an add (no FMA contraction), so both paths compute every
+//! row's chain in the same order and give the same bits (`cargo test --lib avx`).
+//!
+//! # Why `unsafe`, and why it is sound
+//!
+//! Calling a `#[target_feature(enable = "avx")]` function from code not compiled with AVX
+//! is `unsafe`: on a CPU (or an OS) without AVX its instructions fault. The call is made
+//! only when [`available`] is true, which requires CPUID to report AVX **and** OSXSAVE
+//! and the OS to have enabled the SSE and AVX register state in `XCR0` — the conditions
+//! under which the Intel and AMD manuals define AVX instructions to execute. `XGETBV`
+//! itself is read only once CPUID reports OSXSAVE (its own precondition), and CPUID (an
+//! `unsafe` intrinsic on the MSRV) exists on every x86-64 CPU. These three blocks are the
+//! crate's only `unsafe`. A build that already targets AVX
+//! (`-C target-cpu=native`, `-C target-feature=+avx`) compiles the plain loop with AVX
+//! and never takes this path.
+//!
+//! Cost: one relaxed atomic load and a branch a step (the CPUID query runs once per
+//! process); the dispatch is used only for operators of at least [`MIN_BYTES`] bytes,
+//! below which the call does not pay for itself.
+
+#![allow(unsafe_code)]
+
+use core::sync::atomic::{AtomicU8, Ordering};
+
+use crate::Real;
+
+/// Operators of fewer bytes (`K·N²` values) stay on the inlined SSE2 loop: there a step is
+/// a few tens of nanoseconds and the call's overhead is a fair share of it. Measured with
+/// the threshold at 0 (`cargo bench --bench steps -- 'step/f(32|64)/aem/'`, N = 1…12): AVX
+/// is slower up to `Linear<f64, 7>` (1176 bytes) and `Linear<f32, 11>` (1452), faster from
+/// `f64` N = 8 (1536) and `f32` N = 12 (1728).
+pub(crate) const MIN_BYTES: usize = 1536;
+
+/// Whether the build already targets AVX (then the plain loop is AVX code already).
+const BUILT_WITH_AVX: bool = cfg!(target_feature = "avx");
+
+/// Cached answer of [`detect`]: 0 not yet asked, 1 no AVX, 2 AVX.
+static AVX: AtomicU8 = AtomicU8::new(0);
+
+/// Whether AVX instructions may run here (CPU and OS). Cost: a relaxed load after the
+/// first call.
+#[inline(always)]
+pub(crate) fn available() -> bool {
+    match AVX.load(Ordering::Relaxed) {
+        2 => true,
+        1 => false,
+        _ => detect(),
+    }
+}
+
+/// Query CPUID (and XCR0) once and cache the answer. Racing first calls compute the same
+/// answer and store the same value.
+#[cold]
+#[inline(never)]
+fn detect() -> bool {
+    const OSXSAVE: u32 = 1 << 27;
+    const AVX_BIT: u32 = 1 << 28;
+    const XMM_YMM_STATE: u64 = 0b110;
+    let yes = __cpuid(0).eax >= 1 && {
+        let ecx = __cpuid(1).ecx;
+        ecx & OSXSAVE != 0
+            && ecx & AVX_BIT != 0
+            // SAFETY: CPUID.1:ECX.OSXSAVE is set (checked just above): the OS has enabled
+            // XGETBV, so it executes (the `xsave` precondition of `_xgetbv`).
+            && unsafe { core::arch::x86_64::_xgetbv(0) } & XMM_YMM_STATE == XMM_YMM_STATE
+    };
+    AVX.store(if yes { 2 } else { 1 }, Ordering::Relaxed);
+    yes
+}
+
+/// The CPUID leaf `leaf` (sub-leaf 0).
+fn __cpuid(leaf: u32) -> core::arch::x86_64::CpuidResult {
+    // The intrinsic became a safe function after Rust 1.89 (the MSRV), where it is still
+    // `unsafe`: the block is needed there and unused on newer compilers.
+    #[allow(unused_unsafe)]
+    // SAFETY: every x86-64 CPU has the CPUID instruction; it has no other precondition.
+    unsafe {
+        core::arch::x86_64::__cpuid(leaf)
+    }
+}
+
+/// `out = ops · x` by the column-blocked loop (`op_rows::column_blocks`), on AVX
+/// registers when [`available`], else on SSE2. Same bits either way.
+#[inline(always)]
+pub(crate) fn column_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
+    ops: &[[[T; N]; K]; N],
+    x: &[[T; N]; K],
+    out: &mut [T],
+) {
+    if BUILT_WITH_AVX || K * N * N * core::mem::size_of::<T>() < MIN_BYTES || !available() {
+        super::op_rows::column_blocks::<T, N, K, W>(ops, x, out);
+    } else {
+        // SAFETY: `available()` is true: the CPU reports AVX and the OS saves its
+        // registers (module docs), the precondition of `column_blocks_avx`.
+        unsafe { column_blocks_avx::<T, N, K, W>(ops, x, out) }
+    }
+}
+
+/// The column-blocked loop compiled with AVX enabled (its body is the same inlined loop).
+#[target_feature(enable = "avx")]
+#[inline(never)]
+fn column_blocks_avx<T: Real, const N: usize, const K: usize, const W: usize>(
+    ops: &[[[T; N]; K]; N],
+    x: &[[T; N]; K],
+    out: &mut [T],
+) {
+    super::op_rows::column_blocks::<T, N, K, W>(ops, x, out);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AVX and SSE2 paths give the same bits, for operator sizes above the dispatch
+    /// threshold, both block widths and first blocks of every kind.
+    fn same_bits<T: Real, const N: usize, const K: usize, const W: usize>() {
+        let mut ops = [[[T::zero(); N]; K]; N];
+        let mut x = [[T::zero(); N]; K];
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64 ^ (N * 131 + K) as u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            // Values of mixed sign and magnitude, so every rounding matters.
+            let m = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            T::from_f64_rounded(m * 2f64.powi((seed % 40) as i32 - 20))
+        };
+        for v in ops.iter_mut().flatten().flatten() {
+            *v = next();
+        }
+        for v in x.iter_mut().flatten() {
+            *v = next();
+        }
+        let (mut plain, mut wide) = ([T::zero(); N], [T::zero(); N]);
+        super::super::op_rows::column_blocks::<T, N, K, W>(&ops, &x, &mut plain);
+        column_blocks::<T, N, K, W>(&ops, &x, &mut wide);
+        for (p, w) in plain.iter().zip(&wide) {
+            assert_eq!(
+                p.as_f64().to_bits(),
+                w.as_f64().to_bits(),
+                "N = {N}, K = {K}"
+            );
+        }
+    }
+
+    /// The CPUID/XCR0 query agrees with the standard library's detection.
+    #[test]
+    fn detection_agrees_with_std() {
+        assert_eq!(available(), std::is_x86_feature_detected!("avx"));
+    }
+
+    #[test]
+    fn avx_path_is_bit_identical() {
+        // Where the CPU has no AVX both calls run the SSE2 loop (and still must agree).
+        same_bits::<f64, 16, 3, 16>();
+        same_bits::<f64, 37, 3, 16>();
+        same_bits::<f64, 100, 3, 16>();
+        same_bits::<f64, 100, 4, 16>();
+        same_bits::<f32, 50, 3, 32>();
+        same_bits::<f32, 100, 3, 32>();
+        same_bits::<f32, 100, 2, 32>();
+    }
+}
