@@ -10,7 +10,7 @@ use nalgebra::SVector;
 use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition, row_scales};
 use crate::linalg::op_rows::OpRows;
-use crate::linalg::{Mat, add_scaled, all_finite, fits, round_rows, rows_f64};
+use crate::linalg::{Mat, add_scaled, all_finite, first_error, fits, round_rows, rows_f64};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
@@ -347,21 +347,6 @@ impl<const N: usize> StartOps<f64, N> {
             minv_k: round_rows(&self.minv_k),
         }
     }
-}
-
-/// The verdict of several [`fits`] checks: an overflow if any, else an underflow if any.
-const fn first_error(fit: [Result<(), Error>; 3]) -> Option<Error> {
-    let mut under = None;
-    let mut i = 0;
-    while i < 3 {
-        match fit[i] {
-            Err(Error::OperatorUnderflow) => under = Some(Error::OperatorUnderflow),
-            Err(e) => return Some(e),
-            Ok(()) => {}
-        }
-        i += 1;
-    }
-    under
 }
 
 /// The factorization of `M` and the `StartOps` of `(M, C, K)`; `None` when `M` is singular to working

@@ -384,12 +384,14 @@ fn hysteresis_coefficients_that_overflow_f32_are_rejected() {
 }
 
 /// A reduced stepper's start from known values can overflow in `f32`: the projection
-/// `Φᵀ M u` of `u = (10, 10)` with `M = 1e76 I` is about `1.4e39`. That is
-/// `NonFiniteState` (documented now), and a start from rest still works.
+/// `Φᵀ M u` of `u = (100, 100)` with `M = K = 1e74 I` is about `1.4e39`. That is
+/// `NonFiniteState` (documented now), and a start from rest still works. (The data first
+/// found, `M = 1e76 I`, `K = I`, has `ω² = 1e-76`, which flushes to zero in `f32`: that
+/// build is `OperatorUnderflow` now, as `Linear<f32>`'s.)
 #[test]
 fn modal_f32_projection_overflow_is_non_finite_state() {
-    let m = SMatrix::<f64, 2, 2>::identity() * 1e76;
-    let k = SMatrix::<f64, 2, 2>::identity();
+    let m = SMatrix::<f64, 2, 2>::identity() * 1e74;
+    let k = m;
     let sys = Modal::<f32, 2, 2, 1, 1>::new(
         &m,
         &k,
@@ -399,12 +401,19 @@ fn modal_f32_projection_overflow_is_non_finite_state() {
         0.01,
     )
     .unwrap();
-    let (ten, z) = (vector![10.0f32, 10.0], vector![0.0f32, 0.0]);
+    let (hundred, z) = (vector![100.0f32, 100.0], vector![0.0f32, 0.0]);
     assert_eq!(
-        sys.start_with_acceleration(&ten, &z, &z).err(),
+        sys.start_with_acceleration(&hundred, &z, &z).err(),
         Some(Error::NonFiniteState)
     );
     assert!(sys.start_with_acceleration(&z, &z, &z).is_ok());
+    let m = SMatrix::<f64, 2, 2>::identity() * 1e76;
+    let k = SMatrix::<f64, 2, 2>::identity();
+    let (b, y) = (SMatrix::repeat(1.0), SMatrix::repeat(1.0));
+    assert_eq!(
+        Modal::<f32, 2, 2, 1, 1>::new(&m, &k, &Damping::None, &b, &y, 0.01).err(),
+        Some(Error::OperatorUnderflow)
+    );
 }
 
 /// Bouc–Wen with a large exponent (`n = 951`, β = 1, γ = 0.5) at a step of 3 `u_y` from
@@ -658,4 +667,43 @@ fn friction_damping_coefficient_that_overflows_is_rejected() {
         Some(Error::OperatorOverflow)
     );
     assert!(Friction::<f64>::new(1e5, 1e-3).is_ok());
+}
+
+/// One range check for every build (`linalg::fits`, issue 10's review): generalized-α, the
+/// exact scheme and modal reduction checked only for overflow, so an operator flushed to
+/// zero or subnormal in `T` was accepted where the Newmark family says `OperatorUnderflow`.
+/// Each case is derived by hand: the operator's size against `MIN_POSITIVE` of the type.
+#[test]
+fn every_build_rejects_operators_that_underflow() {
+    let want = Some(Error::OperatorUnderflow);
+    // f64: G K = K / ((1 − α_m) M + …) ≈ 1e-112 / 1e212 = 1e-324, below f64's subnormals.
+    let (m, c, k, h) = (matrix![1e212], matrix![0.0], matrix![1e-112], 1e99);
+    assert_eq!(
+        GeneralizedAlpha::<f64, 1>::new(&m, &c, &k, h, 0.8).err(),
+        want
+    );
+    assert_eq!(
+        GeneralizedAlpha::<f64, 1>::hht(&m, &c, &k, h, -0.1).err(),
+        want
+    );
+    // Exact, f32: M = 1e30, h = 1e-10: the load reaches v through Γ₂/h ≈ h/(2M) = 5e-41,
+    // subnormal in f32 (1.18e-38); in f64 it is normal and the build succeeds.
+    let (m, z, k) = (matrix![1e30], matrix![0.0], matrix![1.0]);
+    assert_eq!(Exact::<f32, 1>::new(&m, &z, &k, 1e-10).err(), want);
+    assert!(Exact::<f64, 1>::new(&m, &z, &k, 1e-10).is_ok());
+    // Modal, f32: M = 1, K = 1e-40: ω² = 1e-40 is subnormal in f32 (as `Linear<f32>`'s
+    // G K); in f64 it is normal.
+    let (one, k) = (matrix![1.0], matrix![1e-40]);
+    let modal32 = Modal::<f32, 1, 1, 1, 1>::new(&one, &k, &Damping::None, &one, &one, 0.01);
+    assert_eq!(modal32.err(), want);
+    assert_eq!(
+        Linear::<f32, 1>::new(&one, &matrix![0.0], &k, 0.01).err(),
+        want
+    );
+    assert!(Modal::<f64, 1, 1, 1, 1>::new(&one, &k, &Damping::None, &one, &one, 0.01).is_ok());
+    // Ordinary data still build in every scheme.
+    let k = matrix![4.0];
+    assert!(GeneralizedAlpha::<f32, 1>::new(&one, &z, &k, 0.01, 0.8).is_ok());
+    assert!(Exact::<f32, 1>::new(&one, &z, &k, 0.01).is_ok());
+    assert!(Modal::<f32, 1, 1, 1, 1>::new(&one, &k, &Damping::None, &one, &one, 0.01).is_ok());
 }

@@ -310,6 +310,34 @@ pub(crate) const fn fits<const R: usize, const C: usize, const R2: usize, const 
     Ok(())
 }
 
+/// [`fits`] judged on `a` alone, for operators with no one source matrix to tell an
+/// operator flushed to zero from one that is zero (the exact scheme's exponential blocks,
+/// the modal operators): overflow, or a largest entry that is subnormal in the type.
+pub(crate) const fn fits_alone<const R: usize, const C: usize>(
+    a: &Mat<R, C>,
+    max: f64,
+) -> Result<(), crate::Error> {
+    fits(a, a, max)
+}
+
+/// The verdict of several [`fits`] checks: an overflow if any, else an underflow if any
+/// (the same verdict whatever the order of the checks).
+pub(crate) const fn first_error<const L: usize>(
+    fit: [Result<(), crate::Error>; L],
+) -> Option<crate::Error> {
+    let mut under = None;
+    let mut i = 0;
+    while i < L {
+        match fit[i] {
+            Err(crate::Error::OperatorUnderflow) => under = Some(crate::Error::OperatorUnderflow),
+            Err(e) => return Some(e),
+            Ok(()) => {}
+        }
+        i += 1;
+    }
+    under
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

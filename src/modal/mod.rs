@@ -27,7 +27,8 @@ use crate::kinematics::{AemKinematics, Kinematics, check_time_step_as};
 use crate::linalg::cholesky::{cholesky, lower_solve, lower_transpose_solve};
 use crate::linalg::symmetric_eigen::{JACOBI_MAX_SWEEPS, jacobi_eigen};
 use crate::linalg::{
-    self, Rows, all_finite, finite_as, is_symmetric, max_abs, mul, rows_f64, sqrt, transpose,
+    self, Rows, all_finite, first_error, fits_alone, is_symmetric, max_abs, mul, rows_f64, sqrt,
+    transpose,
 };
 use crate::{Error, Real, State, StepState, Stepper};
 
@@ -505,17 +506,20 @@ pub(crate) const fn modal_operators<
         r += 1;
     }
     // Every operator must fit the scalar type it will be rounded to (`max`: its largest
-    // finite value), else it would round to ∞.
-    let fits = finite_as(&op.g_gamma, max)
-        && finite_as(&[op.g_c, op.g_k, op.c, op.k], max)
-        && finite_as(&op.gamma, max)
-        && finite_as(&op.out, max)
-        && finite_as(&op.phi, max)
-        && finite_as(&op.proj, max);
-    if !fits {
-        return Err(Error::OperatorOverflow);
+    // finite value), else it would round to ∞ — or, its largest entry subnormal there, lose
+    // its precision (the range check of every build, `linalg::fits`).
+    let fit = [
+        fits_alone(&op.g_gamma, max),
+        fits_alone(&[op.g_c, op.g_k, op.c, op.k], max),
+        fits_alone(&op.gamma, max),
+        fits_alone(&op.out, max),
+        fits_alone(&op.phi, max),
+        fits_alone(&op.proj, max),
+    ];
+    match first_error(fit) {
+        Some(e) => Err(e),
+        None => Ok(op),
     }
-    Ok(op)
 }
 
 impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Modal<T, N, R, I, O> {
@@ -536,7 +540,9 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
     /// [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`], [`Error::MassNotSpd`],
     /// [`Error::StiffnessNotSymmetric`], [`Error::NonClassicalDamping`],
     /// [`Error::EigenNotConverged`], [`Error::SingularEffectiveMatrix`] (a mode with
-    /// `1 + (h/2)·2ξω + (h²/4)·ω² ≤ 0`, possible only for negative `ω²` or `ξ`).
+    /// `1 + (h/2)·2ξω + (h²/4)·ω² ≤ 0`, possible only for negative `ω²` or `ξ`),
+    /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`] (an operator beyond the
+    /// range of `T`, or its largest entry subnormal there).
     ///
     /// Cost: `O(N³)` `f64` flops (Jacobi: `≈ 4N³` a sweep, a few sweeps) and a few `N×N`
     /// `f64` temporaries on the stack; once.

@@ -38,7 +38,9 @@ use nalgebra::{ComplexField, SMatrix, SVector};
 use crate::kernel::{StartOps, checked_rows, start_operators};
 use crate::kinematics::check_time_step_as;
 use crate::linalg::expm::{Blk, blk_expm, norm1};
-use crate::linalg::{Mat, add_scaled, finite_as, identity, round_rows, scaled};
+use crate::linalg::{
+    Mat, add_scaled, finite_as, first_error, fits, fits_alone, identity, round_rows, scaled,
+};
 use crate::{Error, Real, State, Stepper};
 
 /// `y += A x` for a row-major `A`.
@@ -90,7 +92,9 @@ impl<T: Real, const N: usize> Exact<T, N> {
     /// once to `T`.
     ///
     /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
-    /// [`Error::SingularMass`] (`M` singular: the first-order form needs `M⁻¹`).
+    /// [`Error::SingularMass`] (`M` singular: the first-order form needs `M⁻¹`),
+    /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`] (an operator beyond the
+    /// range of `T`, or its largest entry subnormal there).
     ///
     /// Cost: about `(4N)³ (19 + s)` flops, `s = ⌈log₂(2‖hF‖)⌉` squarings (balanced norm,
     /// e.g. `s ≈ 14` for `ω_max h = 10⁴`), and three `16N²` `f64` temporaries on the
@@ -130,6 +134,7 @@ impl<T: Real, const N: usize> Exact<T, N> {
         blk_expm(&mut x, &mut work, &mut e);
         // Undo the balancing: E_ij = (d_i / d_j) E'_ij, for block rows u, v.
         let blk = |i: usize, j: usize| add_scaled(&z, d[i] / d[j], &e[i][j]);
+        let mut under = None;
         let mut au = [[[T::zero(); N]; N]; 4];
         let mut av = [[[T::zero(); N]; N]; 4];
         for (r, out) in [(0usize, &mut au), (1usize, &mut av)] {
@@ -137,11 +142,18 @@ impl<T: Real, const N: usize> Exact<T, N> {
             // P0 = Γ₁ − Γ₂/h multiplies p_{n−1} = M a + C v + K u; P1 = Γ₂/h multiplies p_n.
             let p0 = add_scaled(&g1, -1.0 / hf, &g2);
             let p1 = scaled(1.0 / hf, &g2);
-            if ![&phi_u, &phi_v, &p0, &p1]
-                .iter()
-                .all(|x| finite_as(x, T::MAX))
-            {
-                return Err(Error::OperatorOverflow);
+            // Representable in `T` (overflow now, underflow after every block is seen):
+            // `P1 = Γ₂/h` is never zero for a regular `M`; the others are judged alone.
+            let fit = [
+                fits_alone(&phi_u, T::MAX),
+                fits_alone(&phi_v, T::MAX),
+                fits_alone(&p0, T::MAX),
+                fits(&p1, &m, T::MAX),
+            ];
+            match first_error(fit) {
+                Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
+                Some(e) => under = Some(e),
+                None => {}
             }
             *out = [
                 round_rows(&phi_u),
@@ -152,6 +164,9 @@ impl<T: Real, const N: usize> Exact<T, N> {
         }
         if ![&m, &c, &k].iter().all(|x| finite_as(x, T::MAX)) {
             return Err(Error::OperatorOverflow);
+        }
+        if let Some(e) = under {
+            return Err(e);
         }
         Ok(Self {
             h: T::from_f64_rounded(hf),

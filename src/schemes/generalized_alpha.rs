@@ -27,7 +27,9 @@ use nalgebra::{SMatrix, SVector};
 use crate::kernel::{StartOps, start_operators, terms_scales};
 use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition};
-use crate::linalg::{Mat, add_scaled, all_finite, finite_as, round_rows, rows_f64, scaled};
+use crate::linalg::{
+    Mat, add_scaled, all_finite, finite_as, first_error, fits, round_rows, rows_f64, scaled,
+};
 use crate::{Error, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
@@ -106,7 +108,8 @@ pub(crate) struct AlphaOps<const N: usize> {
 ///
 /// Errors, in this order: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
 /// [`Error::InvalidParameter`], [`Error::OperatorOverflow`] (`M_eff` not finite),
-/// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`].
+/// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`],
+/// [`Error::OperatorUnderflow`] (as the Newmark family's builds).
 pub(crate) const fn alpha_operators<const N: usize>(
     m: &Mat<N, N>,
     c: &Mat<N, N>,
@@ -161,13 +164,16 @@ pub(crate) const fn alpha_operators<const N: usize>(
         -f1 * (0.5 - beta) * hf * hf,
         &gk,
     );
-    if !(finite_as(&g, max)
-        && finite_as(&gk, max)
-        && finite_as(&av, max)
-        && finite_as(&aa, max)
-        && kin.fits(max))
-    {
-        return Err(Error::OperatorOverflow);
+    // The same range check as the Newmark family's (`G`, `GC`, `GK` representable and not
+    // flushed to zero), then the combined blocks and the kinematics; overflow anywhere
+    // before underflow anywhere.
+    let fit = [fits(&g, &meff, max), fits(&gc, c, max), fits(&gk, k, max)];
+    let combined = finite_as(&av, max) && finite_as(&aa, max) && kin.fits(max);
+    match first_error(fit) {
+        Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
+        _ if !combined => return Err(Error::OperatorOverflow),
+        Some(e) => return Err(e),
+        None => {}
     }
     let start = match start_operators(m, c, k, max) {
         Ok(s) => s,
@@ -252,7 +258,7 @@ impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
     /// [`Error::InvalidParameter`] (a parameter not finite, `α_m ≥ 1`, `α_f ≥ 1`, `β < 0`
     /// or `γ < 0`), [`Error::SingularEffectiveMatrix`] (`(1 − α_m) M + (1 − α_f)(γh C +
     /// βh² K)` singular to working precision against its terms),
-    /// [`Error::OperatorOverflow`].
+    /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`].
     ///
     /// Cost: about `9N³` flops in `f64`, six `N×N` `f64` temporaries on the stack.
     pub fn with_parameters(
