@@ -226,7 +226,9 @@ s += """
   instead of about 1e-226, with `Ok`. Now every Newmark-family build returns
   `OperatorUnderflow` when an operator from nonzero data is zero or has its largest entry
   subnormal in the scalar type (`tests/bad_input.rs`,
-  `operators_that_underflow_are_rejected`). An operator whose largest entry is normal keeps
+  `operators_that_underflow_are_rejected`); since the review of this issue generalized-α,
+  the exact scheme and modal reduction make the same range check (they checked overflow
+  only: `every_build_rejects_operators_that_underflow`). An operator whose largest entry is normal keeps
   its precision normwise; the independent check above still skips those whose entries fall
   below `MIN_POSITIVE / ε`, where its own products would underflow.
 - Rows of very different size (the accuracy contract, not a defect). The precomputed
