@@ -199,16 +199,22 @@ fn bench_references<T: Real, const N: usize>(
 /// Whether the CPU (and OS) run AVX: then the step's column-blocked product runs on AVX
 /// registers (`src/linalg/avx.rs`), and so do the floors it is compared with.
 fn has_avx() -> bool {
-    #[cfg(target_arch = "x86_64")]
+    // The SSE2-only control build (`--cfg aemstep_control="sse2-only"`) keeps its floors
+    // on SSE2 too.
+    #[cfg(all(target_arch = "x86_64", not(aemstep_control = "sse2-only")))]
     return std::is_x86_feature_detected!("avx");
+    #[cfg(aemstep_control = "sse2-only")]
+    return false;
     #[cfg(not(target_arch = "x86_64"))]
     false
 }
 
 /// Whether the CPU (and OS) run AVX2 (256-bit integer adds, for the read floor's sum).
 fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
+    #[cfg(all(target_arch = "x86_64", not(aemstep_control = "sse2-only")))]
     return std::is_x86_feature_detected!("avx2");
+    #[cfg(aemstep_control = "sse2-only")]
+    return false;
     #[cfg(not(target_arch = "x86_64"))]
     false
 }

@@ -39,8 +39,10 @@ use crate::Real;
 /// `f64` N = 8 (1536) and `f32` N = 12 (1728).
 pub(crate) const MIN_BYTES: usize = 1536;
 
-/// Whether the build already targets AVX (then the plain loop is AVX code already).
-const BUILT_WITH_AVX: bool = cfg!(target_feature = "avx");
+/// Whether the build already targets AVX (then the plain loop is AVX code already), or is
+/// the benchmark's SSE2-only control build (`--cfg aemstep_control="sse2-only"`): either
+/// way the plain loop runs.
+const PLAIN_ONLY: bool = cfg!(target_feature = "avx") || cfg!(aemstep_control = "sse2-only");
 
 /// Cached answer of [`detect`]: 0 not yet asked, 1 no AVX, 2 AVX.
 static AVX: AtomicU8 = AtomicU8::new(0);
@@ -95,7 +97,7 @@ pub(crate) fn column_blocks<T: Real, const N: usize, const K: usize, const W: us
     x: &[[T; N]; K],
     out: &mut [T],
 ) {
-    if BUILT_WITH_AVX || K * N * N * core::mem::size_of::<T>() < MIN_BYTES || !available() {
+    if PLAIN_ONLY || K * N * N * core::mem::size_of::<T>() < MIN_BYTES || !available() {
         super::op_rows::column_blocks::<T, N, K, W>(ops, x, out);
     } else {
         // SAFETY: `available()` is true: the CPU reports AVX and the OS saves its
