@@ -748,6 +748,84 @@ fn bouc_wen_negative_gamma_stays_bounded_under_cyclic_steps() {
     }
 }
 
+/// A steady-state Kalman gain whose closed loop has modes at `0.99988` (the fuzz input
+/// `riccati-residual-3e-3`: an `exact` model of an indefinite `M`, `R = 1e-6`, `Q` of
+/// rank ~1). The doubling stopped at iteration 2 — `X` had not moved by `4ε` yet, while
+/// its slow part had still to accumulate — with `P` off by 6e-14 relative, and the gain of
+/// that `P` (the innovation covariance has `κ = 3.5e13`, so the gain magnifies such
+/// errors) made an observer with spectral radius 1.0000085: unstable. (The fuzz check's
+/// residual of 3e-3 was its own rounding, in the textbook form.) The doubling now also
+/// waits for `‖A_k‖∞ ≤ 2^-26`, and the solution is verified: its closed loop is certified
+/// stable and its Joseph-form residual is within `RICCATI_RESIDUAL_UNITS` units of rounding.
+#[test]
+fn riccati_gain_of_a_slow_closed_loop_is_converged_and_verified() {
+    use aemstep::observer::{Outputs, RICCATI_RESIDUAL_UNITS, StateSpace, SteadyState};
+    let m = matrix![0.17854163271146717, 0.0; 0.0, -8.50982666015625];
+    let c = M2::identity() * -8.50982666015625;
+    let b = matrix![-8.50982666015625; -8.50982666015625];
+    let ss = StateSpace::<2, 4, 1>::exact(&m, &c, &c, &b, 1.9862534655951106e-4).unwrap();
+    let mut out = Outputs::<2, 1, 2>::zero();
+    out.a = [
+        [-8.50982666015625, 8.57208251953125],
+        [-8.50982666015625, 0.001],
+    ];
+    out.w = [[-10.0], [9.99969482421875]];
+    let meas = ss.outputs(&out).unwrap();
+    // The fuzz input's Q: v vᵀ (rank one), v = (0.15625, 9.9871826171875, 10, 10).
+    let q = SMatrix::<f64, 4, 4>::from_column_slice(&[
+        0.0244140625,
+        1.5604972839355469,
+        1.5625,
+        1.5625,
+        1.5604972839355469,
+        99.74381662905216,
+        99.871826171875,
+        99.871826171875,
+        1.5625,
+        99.871826171875,
+        100.0,
+        100.0,
+        1.5625,
+        99.871826171875,
+        100.0,
+        100.0,
+    ]);
+    let r = M2::identity() * 1e-6;
+    let kf = SteadyState::new(&ss, &meas, &q, &r).unwrap();
+    assert!(kf.iterations > 2, "{}", kf.iterations);
+    let (phi, h, p, l) = (
+        ss.phi_matrix(),
+        meas.h_matrix(),
+        kf.covariance_matrix(),
+        kf.gain_matrix(),
+    );
+    let a = phi - phi * l * h;
+    let rho = aemstep::nalgebra::DMatrix::from_fn(4, 4, |i, j| a[(i, j)])
+        .complex_eigenvalues()
+        .iter()
+        .fold(0.0f64, |m, z| m.max(z.norm()));
+    assert!(rho < 1.0, "closed-loop spectral radius {rho}");
+    // The residual the library bounds, evaluated here in the same Joseph form (its own
+    // rounding: about one more unit).
+    let k = phi * l;
+    let res = a * p * a.transpose() + k * r * k.transpose() + q - p;
+    let bnd = a.abs() * p.abs() * a.abs().transpose()
+        + k.abs() * r.abs() * k.abs().transpose()
+        + q.abs()
+        + p.abs();
+    let unit = 13.0 * f64::EPSILON;
+    for i in 0..4 {
+        for j in 0..4 {
+            let scale = (bnd[(i, i)] * bnd[(j, j)]).sqrt().max(bnd[(i, j)]);
+            assert!(
+                res[(i, j)].abs() <= (RICCATI_RESIDUAL_UNITS + 1.0) * unit * scale,
+                "residual ({i}, {j}) {:e} of {scale:e}",
+                res[(i, j)]
+            );
+        }
+    }
+}
+
 /// A shear building with a floor mass of `6.2e-322` kg: positive, so accepted, but `0` in
 /// `f32` (and subnormal in `f64`): the `f32` building's start failed with `SingularMass`.
 /// A mass below the smallest normal number of the scalar type is `OperatorUnderflow` now.
