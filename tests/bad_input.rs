@@ -873,3 +873,39 @@ fn bouc_wen_huge_exponent_tangent_at_saturation_is_finite() {
         h = t.history;
     }
 }
+
+/// Bouc–Wen with `n = 2.9e17` and `u_y = 8e-265` (`k = 1.3e266`, `f_y = 100`): at a step
+/// of `−10 u_y` the root is resolved to within `4ε` of saturation, where `wⁿ ≈ 1e250`, so
+/// `g₀ + g ≈ −1e250` and the denominator `1 − c ∂g/∂z` is as large: their ratio is small,
+/// but `(g₀ + g)/(2u_y)` was formed first and overflowed — a tangent of `−∞`. The ratio is
+/// formed first where that product overflows.
+#[test]
+fn bouc_wen_tangent_ratio_is_formed_before_its_overflowing_scale() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (k, fy) = (1.2897815701554327e266, 1e2);
+    let law = BoucWen::<f64>::new(
+        k,
+        fy,
+        1.4693801879882812e-1,
+        5.324081420898438e-1,
+        4.921722412109375e-1,
+        2.8823037615171174e17,
+    )
+    .unwrap();
+    let uy = fy / k;
+    let mut h = law.initial_history();
+    // (A further trial at the same deformation has the law's own slope `g₀/u_y ≈ −1e514`
+    // at that state, beyond `f64`: not judged, as in the fuzz check.)
+    for x in [5.883593420661338e-185, -10.0] {
+        let t = law.trial(&h, x * uy, -10.0);
+        // Finite, and no stiffer than elastic (|dz/dd| ≤ 1/u_y here: g₀ + g ≤ 2 over a
+        // denominator ≥ 1), up to rounding.
+        assert!(
+            t.force.is_finite()
+                && t.stiffness.is_finite()
+                && t.stiffness.abs() <= k * (1.0 + 1e-12),
+            "{t:?}"
+        );
+        h = t.history;
+    }
+}

@@ -330,17 +330,23 @@ impl<T: Real> BoucWen<T> {
                 }
             }
         }
-        let dz_dd = if big {
-            // (g₀ + g)/(2u_y (1 − c ∂g/∂z)) with numerator and denominator divided by |c|;
-            // at c = ±∞ the root has g = −g₀ and the increment does not move z.
-            let num = (g0 + g) * a;
-            if num == zero {
-                zero
-            } else {
-                num * self.half_inv_uy / (a - b * dg)
-            }
+        // (g₀ + g)/(2u_y (1 − c ∂g/∂z)), for |c| > 1 with numerator and denominator
+        // divided by |c| (at c = ±∞ the root has g = −g₀ and the increment does not move
+        // z). Divided before the multiplication by 1/(2u_y) where the product overflows:
+        // with n = 2.9e17, z within its tolerance of saturation has g ≈ −1e250, the
+        // denominator is as large, and (g₀ + g)/(2u_y) was −∞ at u_y = 8e-265 (found by
+        // fuzzing).
+        let (num, den) = if big {
+            ((g0 + g) * a, a - b * dg)
         } else {
-            (g0 + g) * self.half_inv_uy / (one - c * dg)
+            (g0 + g, one - c * dg)
+        };
+        let dz_dd = if num == zero {
+            zero
+        } else if (num * self.half_inv_uy).is_finite() {
+            num * self.half_inv_uy / den
+        } else {
+            num / den * self.half_inv_uy
         };
         (z, dz_dd)
     }
