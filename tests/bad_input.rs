@@ -909,3 +909,29 @@ fn bouc_wen_tangent_ratio_is_formed_before_its_overflowing_scale() {
         h = t.history;
     }
 }
+
+/// Bouc–Wen with `n = 7.3e17` (`β = 1`, `γ = −1/2`): `g` changes by `e^(n δ)` over a
+/// relative `δ` of `z`, so a `z` within the solve's `4ε` of the root had `g = −3e209`
+/// where the root has `g ≈ −1`. Committed, that `g₀` drove the next loading step (further
+/// negative) to `z = +1`, and the one after to a force of `−∞`. The solve now keeps, of the
+/// numbers within its tolerance, the one with the smallest residual: `z` keeps its sign
+/// along a monotonic path and stays within `2^(1/n) z_max` to rounding.
+#[test]
+fn bouc_wen_huge_exponent_root_is_the_smallest_residual() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let law = BoucWen::<f64>::new(1e9, 1e7, 0.0, 1.0, -0.5, 7.259738159179689e17).unwrap();
+    let uy = 0.01;
+    let mut h = law.initial_history();
+    for x in [-5.75347900390625, -9.9835205078125, -20.0, -1e6] {
+        let t = law.trial(&h, x * uy, -1.0);
+        let z = t.history.z;
+        // z_max = 0.5^(−1/n) = 1 + 1e-18: 1 to rounding; 4ε is the solve's tolerance.
+        assert!(
+            t.force.is_finite()
+                && t.stiffness.is_finite()
+                && (-(1.0 + 4.0 * f64::EPSILON)..0.0).contains(&z),
+            "x = {x}: {t:?}"
+        );
+        h = t.history;
+    }
+}

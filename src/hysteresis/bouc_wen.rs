@@ -17,6 +17,10 @@ const MAX_ITERATIONS: u32 = 200;
 /// crawling or cycling inside its bracket.
 const FREE_NEWTON: u32 = 8;
 
+/// Steps from number to neighbouring number after the solve, for a huge exponent only
+/// (`n ε > 1e-3`): the tolerance `4ε` is a few numbers wide.
+const WALK: u32 = 16;
+
 /// Bouc–Wen hysteresis: `f = α k d + (1 − α) f_y z`, with the dimensionless hysteretic
 /// variable `z` governed (rate-independently, `A = 1`) by
 ///
@@ -315,13 +319,36 @@ impl<T: Real> BoucWen<T> {
             return (nan, nan);
         }
         let (mut g, mut dg) = self.g(z, s);
+        let near = tol * z.abs().max(self.z_scale);
+        // With a huge exponent (a change of one ulp in z changes wⁿ by more than 0.1 %:
+        // n ε > 1e-3), g changes by a factor e^(n δ) over a relative δ of z, and a z within
+        // the solve's 4ε of the root could have g = −3e209 where the root has g ≈ −1;
+        // committed, that g₀ sent the next step's z to the other side (n = 7e17, found by
+        // fuzzing). There the solve goes on from number to neighbouring number while the
+        // residual decreases: z is the number nearest the root by its residual.
+        if self.n * T::default_epsilon() > T::from_f64_rounded(1e-3) && z.is_finite() {
+            let mut r_z = residual(z, g).abs();
+            for _ in 0..WALK {
+                let k = key(z);
+                let (down, up) = (from_key::<T>(k - 1), from_key::<T>(k + 1));
+                let (gd, dgd) = self.g(down, s);
+                let (gu, dgu) = self.g(up, s);
+                let (rd, ru) = (residual(down, gd).abs(), residual(up, gu).abs());
+                if rd < r_z && (rd <= ru || ru.as_f64().is_nan()) {
+                    (z, g, dg, r_z) = (down, gd, dgd, rd);
+                } else if ru < r_z {
+                    (z, g, dg, r_z) = (up, gu, dgu, ru);
+                } else {
+                    break;
+                }
+            }
+        }
         if !(g.is_finite() && dg.is_finite()) && z.is_finite() {
             // With a huge exponent g jumps from 0 to −∞ within one ulp of z_max (n = 8e83:
             // wⁿ overflows at w = 1 + 2ε), and a z converged there had a NaN tangent (found
             // by fuzzing): take the nearest number within the tolerance where g is finite
             // (the root is as well resolved there, and the next step's g₀ is finite).
             let k = key(z);
-            let near = tol * z.abs().max(self.z_scale);
             for e in [from_key::<T>(k - 1), from_key::<T>(k + 1), lo, hi] {
                 let (ge, dge) = self.g(e, s);
                 if ge.is_finite() && dge.is_finite() && (e - z).abs() <= near + near {
