@@ -17,10 +17,6 @@ const MAX_ITERATIONS: u32 = 200;
 /// crawling or cycling inside its bracket.
 const FREE_NEWTON: u32 = 8;
 
-/// Steps from number to neighbouring number after the solve, for a huge exponent only
-/// (`n ε > 1e-3`): the tolerance `4ε` is a few numbers wide.
-const WALK: u32 = 16;
-
 /// Bouc–Wen hysteresis: `f = α k d + (1 − α) f_y z`, with the dimensionless hysteretic
 /// variable `z` governed (rate-independently, `A = 1`) by
 ///
@@ -43,8 +39,16 @@ const WALK: u32 = 16;
 /// explicit Euler predictor (converged to `4ε` relative). Its residual has slope `≥ 1` in
 /// `z` whenever `|γ| ≤ β` (required), so the root is unique; it lies between `z₀` and the
 /// predictor (`g` is monotone in `z`), and an iterate that leaves that bracket, or a Newton
-/// step that does not halve, is replaced by bisection, so the solve converges for any
-/// exponent and step.
+/// step that does not halve, is replaced by bisection (in the ordering of the numbers, so
+/// at any scale within 64 halvings), so the solve converges for any exponent and step.
+/// `g` is evaluated in `w = (β + |γ|)^{1/n} |z|`, about 1 at saturation whatever `β`, `γ`
+/// and `n`. For `γ < 0` (unloading steeper than elastic) a step that carries `z` from the
+/// unloading branch through 0 is split there, the rule applied on each smooth piece; then
+/// `|z|` never exceeds `max(|z₀|, 2^{1/n} z_max)` for `β + γ > 0`, under any path
+/// (unsplit, cyclic steps of about `u_y` grew `z` without bound). For `γ = −β`, `z` does
+/// not saturate (`g = 1` on loading), and the unloading slope `1 + 2β |z|ⁿ` can leave
+/// `T`: then the force or tangent is not finite and the stepper reports
+/// [`Error::NonFiniteForce`].
 /// The consistent tangent is the exact derivative of that update,
 ///
 /// ```text
@@ -52,10 +56,10 @@ const WALK: u32 = 16;
 /// ```
 ///
 /// **Cost per trial**: a few Newton iterations of ~15 flops (`n = 1` or `2`; otherwise two
-/// `powf` each; at most 200 with bisection steps); no panic. A trial whose solve does not
-/// converge (not seen: the bracket of width `|Δ|/u_y` halves to rounding within the budget)
-/// or whose data is not finite returns a NaN force, which the stepper reports as
-/// [`Error::NonFiniteForce`] without taking the step.
+/// `powf` each; at most 136 with bisection steps; for a huge exponent, `n ε > 1e-3`, the
+/// bracket is bisected to two neighbouring numbers); no panic. A trial whose
+/// data is not finite, or whose `z` is beyond `T`, returns a non-finite force, which the
+/// stepper reports as [`Error::NonFiniteForce`] without taking the step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWen<T> {
     ak: T,
@@ -269,6 +273,14 @@ impl<T: Real> BoucWen<T> {
         let mut z = if zp.is_finite() { zp } else { midpoint(lo, hi) };
         let mut last = hi - lo;
         let mut converged = false;
+        // With a huge exponent (one ulp of z changes wⁿ by more than 0.1 %: n ε > 1e-3), g
+        // changes by a factor e^(n δ) over a relative δ of z, and a z within 4ε of the
+        // root could have g = −3e209 where the root has g ≈ −1; committed, that g₀ sent the
+        // next step's z to the other side (n = 7e17, found by fuzzing), and Newton's step
+        // there, r/r′ ≈ z/n, looks converged 34 numbers away from the root (n = 6.8e15).
+        // There the bracket is bisected down to two neighbouring numbers, and z is the one
+        // with the smaller residual.
+        let exact = self.n * T::default_epsilon() > T::from_f64_rounded(1e-3);
         for i in 0..MAX_ITERATIONS {
             let (g, dg) = self.g(z, s);
             let r = residual(z, g);
@@ -294,7 +306,7 @@ impl<T: Real> BoucWen<T> {
             {
                 last = step.abs();
                 z = next;
-                if last <= tol * z.abs().max(self.z_scale) {
+                if !exact && last <= tol * z.abs().max(self.z_scale) {
                     converged = true;
                     break;
                 }
@@ -304,7 +316,7 @@ impl<T: Real> BoucWen<T> {
                 z = m;
             }
             let finite = lo.is_finite() && hi.is_finite();
-            if (finite && hi - lo <= tol * lo.abs().max(hi.abs()).max(self.z_scale))
+            if (!exact && finite && hi - lo <= tol * lo.abs().max(hi.abs()).max(self.z_scale))
                 || key(hi).wrapping_sub(key(lo)) as u64 <= 1
             {
                 converged = true;
@@ -320,28 +332,15 @@ impl<T: Real> BoucWen<T> {
         }
         let (mut g, mut dg) = self.g(z, s);
         let near = tol * z.abs().max(self.z_scale);
-        // With a huge exponent (a change of one ulp in z changes wⁿ by more than 0.1 %:
-        // n ε > 1e-3), g changes by a factor e^(n δ) over a relative δ of z, and a z within
-        // the solve's 4ε of the root could have g = −3e209 where the root has g ≈ −1;
-        // committed, that g₀ sent the next step's z to the other side (n = 7e17, found by
-        // fuzzing). There the solve goes on from number to neighbouring number while the
-        // residual decreases: z is the number nearest the root by its residual.
-        if self.n * T::default_epsilon() > T::from_f64_rounded(1e-3) && z.is_finite() {
-            let mut r_z = residual(z, g).abs();
-            for _ in 0..WALK {
-                let k = key(z);
-                let (down, up) = (from_key::<T>(k - 1), from_key::<T>(k + 1));
-                let (gd, dgd) = self.g(down, s);
-                let (gu, dgu) = self.g(up, s);
-                let (rd, ru) = (residual(down, gd).abs(), residual(up, gu).abs());
-                if rd < r_z && (rd <= ru || ru.as_f64().is_nan()) {
-                    (z, g, dg, r_z) = (down, gd, dgd, rd);
-                } else if ru < r_z {
-                    (z, g, dg, r_z) = (up, gu, dgu, ru);
-                } else {
-                    break;
-                }
-            }
+        if exact && lo.is_finite() && hi.is_finite() {
+            // The bracket is two neighbouring numbers: the one with the smaller residual.
+            let (gl, dgl) = self.g(lo, s);
+            let (gh, dgh) = self.g(hi, s);
+            (z, g, dg) = if residual(lo, gl).abs() <= residual(hi, gh).abs() {
+                (lo, gl, dgl)
+            } else {
+                (hi, gh, dgh)
+            };
         }
         if !(g.is_finite() && dg.is_finite()) && z.is_finite() {
             // With a huge exponent g jumps from 0 to −∞ within one ulp of z_max (n = 8e83:
