@@ -129,7 +129,12 @@ Library fixes (each `Ok` with garbage, or a wrong error, before):
   tangent); a root converged where `g` is not finite (`n = 8e83`: `g` jumps from 0 to
   `−∞` within an ulp of `z_max`) moves to the nearest number within the tolerance where
   it is finite; the tangent's ratio is formed before its scale `1/2u_y` where that product
-  overflows (`n = 2.9e17`, `u_y = 8e-265`: a tangent of `−∞`).
+  overflows (`n = 2.9e17`, `u_y = 8e-265`: a tangent of `−∞`). With a huge exponent
+  (`n ε > 1e-3`: `n = 7e17`, `6.8e15`) a `z` within `4ε` of the root had `g = −3e209`
+  where the root has `g ≈ −1`, and Newton's step `≈ z/n` looked converged 34 numbers from
+  the root; committed, the next step sent `z` to the other side and the force to `−∞`.
+  There the bracket is bisected to two neighbouring numbers, and `z` is the one with the
+  smaller residual.
 - Bouc–Wen with `γ < 0` (found testing the neighbourhood of those inputs): the
   trapezoidal rule's explicit half took the unloading slope `1 + ρ wⁿ`,
   `ρ = (β − γ)/(β + γ) > 1`, over a whole step that carried `z` through 0, and under

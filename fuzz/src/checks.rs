@@ -2203,7 +2203,8 @@ pub fn observer(data: &[u8]) {
             let m =
                 Modal::<f64, 2, 2, 1, 1>::new(&s.m, &s.k, &damp, &bm, &SMatrix::repeat(1.0), s.h);
             // The same modal data checks; the state-space form has more products (`Φ ω²`
-            // …) and may overflow where the stepper does not.
+            // …) and may overflow, or underflow (`OperatorUnderflow`: `K ≈ 1.5e-228`,
+            // `B ≈ 1e-74`, `h = 6e115`, found by fuzzing), where the stepper does not.
             let (ea, em) = (a.as_ref().err().copied(), m.as_ref().err().copied());
             // (And it judges a mode's effective mass by an LU with row scales where Modal
             // asks for `1 + … > ε`: `SingularEffectiveMatrix` from it where Modal builds is
@@ -2213,7 +2214,11 @@ pub fn observer(data: &[u8]) {
                     || (em.is_none()
                         && matches!(
                             ea,
-                            Some(Error::OperatorOverflow | Error::SingularEffectiveMatrix)
+                            Some(
+                                Error::OperatorOverflow
+                                    | Error::OperatorUnderflow
+                                    | Error::SingularEffectiveMatrix
+                            )
                         )),
                 "{OB}: StateSpace::modal {ea:?} vs Modal {em:?}"
             );
