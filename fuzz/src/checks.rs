@@ -2421,13 +2421,17 @@ fn riccati_holds<const S: usize, const O: usize>(
         worst <= 2.0 * RICCATI_RESIDUAL_UNITS,
         "{OB}: Riccati residual {worst:e} units of (2S + 5) ε (P = {p:?})"
     );
-    // L = P Hᵀ S⁻¹, S = H P Hᵀ + R, judged backward (`L S − P Hᵀ`, row by row against
-    // `|L||S| + |P Hᵀ|`): an ill-conditioned S makes L itself uncertain, not its equation.
+    // L = P Hᵀ S⁻¹, S = H P Hᵀ + R, judged backward, row by row: `L S − P Hᵀ` against
+    // `‖S‖∞ ‖L_i‖∞ + ‖(P Hᵀ)_i‖∞`, the normwise backward error of the solve for that row
+    // (an ill-conditioned S makes L itself uncertain, not its equation; entry by entry,
+    // `|L||S|`, was too strict for S with entries 1e-6 and 1e6 apart).
     let si = h * p * h.transpose() + r;
     let e = l * si - p * h.transpose();
-    let f = l.abs() * si.abs() + (p * h.transpose()).abs();
+    let phr = p * h.transpose();
+    let s_norm = si.abs().row_sum().max();
     for i in 0..S {
-        let (ei, fi) = (e.row(i).amax(), f.row(i).amax());
+        let ei = e.row(i).amax();
+        let fi = s_norm * l.row(i).amax() + phr.row(i).amax();
         check!(
             ei <= 1e-8 * fi || !fi.is_finite(),
             "{OB}: gain {l:?} does not solve L (H P Hᵀ + R) = P Hᵀ (row {i}: {ei:e} of {fi:e})"
