@@ -2422,7 +2422,7 @@ fn riccati_holds<const S: usize, const O: usize>(
         "{OB}: Riccati residual {worst:e} units of (2S + 5) ε (P = {p:?})"
     );
     // L = P Hᵀ S⁻¹, S = H P Hᵀ + R, judged backward, row by row: `L S − P Hᵀ` against
-    // `‖S‖∞ ‖L_i‖∞ + ‖(P Hᵀ)_i‖∞`, the normwise backward error of the solve for that row
+    // `‖S‖∞ (‖L_i‖∞ + MIN_POSITIVE) + ‖(P Hᵀ)_i‖∞`, the normwise backward error of the solve for that row
     // (an ill-conditioned S makes L itself uncertain, not its equation; entry by entry,
     // `|L||S|`, was too strict for S with entries 1e-6 and 1e6 apart).
     let si = h * p * h.transpose() + r;
@@ -2431,7 +2431,9 @@ fn riccati_holds<const S: usize, const O: usize>(
     let s_norm = si.abs().row_sum().max();
     for i in 0..S {
         let ei = e.row(i).amax();
-        let fi = s_norm * l.row(i).amax() + phr.row(i).amax();
+        // (`+ MIN_POSITIVE`: an `L` below the normal range has lost its precision, and one
+        // below the subnormals is 0 — `P Hᵀ ≈ 2e-267` over `R = 4.6e305`.)
+        let fi = s_norm * (l.row(i).amax() + f64::MIN_POSITIVE) + phr.row(i).amax();
         check!(
             ei <= 1e-8 * fi || !fi.is_finite(),
             "{OB}: gain {l:?} does not solve L (H P Hᵀ + R) = P Hᵀ (row {i}: {ei:e} of {fi:e})"
