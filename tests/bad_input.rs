@@ -431,9 +431,18 @@ fn bouc_wen_large_exponent_converges() {
         assert!(t.force.is_finite() && t.stiffness.is_finite(), "{t:?}");
         // z solves z = (Δ/2u_y)(g(0) + g(z)), g(z) = 1 − |z|ⁿ (β + γ) loading.
         let z = t.history.z;
+        // Judged as the solve stops: the Newton correction `r/r'` within `4ε |z|` (its
+        // tolerance), plus the rounding of `r` itself (`z ≈ 1`, `|c| ≤ 2.5`, `|g| ≤ 2`: a
+        // few ε) over the slope `r' ≥ 1` — 8ε |z| in all. (The slope is ~3500 here, so
+        // `r` itself is ~1e-12 at the root's neighbouring numbers.)
+        let c = 0.5 * (d / uy);
         let g = |z: f64| 1.0 - z.abs().powf(n) * 1.5;
-        let r = z - 0.5 * (d / uy) * (1.0 + g(z));
-        assert!(r.abs() <= 1e-12, "d = {d:e}: z = {z}, residual {r:e}");
+        let r = z - c * (1.0 + g(z));
+        let slope = 1.0 + c * n * z.abs().powf(n - 1.0) * z.signum() * 1.5;
+        assert!(
+            (r / slope).abs() <= 8.0 * f64::EPSILON * z.abs(),
+            "d = {d:e}: z = {z}, residual {r:e}, slope {slope:e}"
+        );
     }
 }
 
@@ -706,4 +715,271 @@ fn every_build_rejects_operators_that_underflow() {
     assert!(GeneralizedAlpha::<f32, 1>::new(&one, &z, &k, 0.01, 0.8).is_ok());
     assert!(Exact::<f32, 1>::new(&one, &z, &k, 0.01).is_ok());
     assert!(Modal::<f32, 1, 1, 1, 1>::new(&one, &k, &Damping::None, &one, &one, 0.01).is_ok());
+}
+
+/// Bouc–Wen with `β = 8.5e199`, `γ = 1/2`, `n = 2` (`z_max = 1.1e-100`) at a step of
+/// `−3.18 u_y` from rest: the root `z ≈ −√2 z_max` lies 1e100 below the predictor `−3.18`,
+/// and bisection in value needed about 380 halvings to reach it to `4ε` — beyond the
+/// budget of 200: the force was NaN. Bisection in the ordering of the numbers reaches any
+/// scale within 64 halvings: `z` solves its update to the solve's tolerance.
+#[test]
+fn bouc_wen_root_100_orders_below_its_bracket_is_resolved() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (k, fy, alpha, beta, gamma) = (8.050498138213321, 1e7, 0.99, 8.48062133789063e199, 0.5);
+    let law = BoucWen::<f64>::new(k, fy, alpha, beta, gamma, 2.0).unwrap();
+    let uy = fy / k;
+    let x = -3.17657470703125;
+    let t = law.trial(&law.initial_history(), x * uy, -10.0);
+    assert!(t.force.is_finite() && t.stiffness.is_finite(), "{t:?}");
+    // z = c (g(0) + g(z)), g(z) = 1 − z² (β + γ) on the loading branch (z < 0, step < 0);
+    // judged as the solve stops: the Newton correction r/r′ within 4ε |z| (its tolerance)
+    // plus the rounding of r (a few ε |z| over the slope r′ ≥ 1): 8ε |z|.
+    let (z, c, bg) = (t.history.z, 0.5 * x, beta + gamma);
+    let r = z - c * (2.0 - z * z * bg);
+    let slope = 1.0 + 2.0 * c * z * bg;
+    let z_max = bg.powf(-0.5);
+    assert!(
+        z < 0.0 && z.abs() <= 2f64.sqrt() * z_max * (1.0 + 4.0 * f64::EPSILON),
+        "z = {z:e}, z_max = {z_max:e}"
+    );
+    assert!((r / slope).abs() <= 8.0 * f64::EPSILON * z.abs(), "{r:e}");
+    // The path goes on (the fuzzer's next deformations, −10 u_y): finite.
+    let t2 = law.trial(&t.history, -10.0 * uy, -10.0);
+    assert!(t2.force.is_finite() && t2.stiffness.is_finite(), "{t2:?}");
+}
+
+/// Bouc–Wen with `β = γ = 3e-310`, `n = 950`: `z_max = (β + γ)^{−1/n} = 2.11`, where
+/// `|z|ⁿ = 1.6e309` overflows though `|z|ⁿ (β + γ) ≈ 1`: the slope `∂g/∂z` was `−∞` and the
+/// tangent `∞/∞ = NaN` at every step that reached saturation. `g` is now evaluated in
+/// `w = (β + |γ|)^{1/n} |z|`, about 1 at saturation at any scale.
+#[test]
+fn bouc_wen_saturation_where_z_to_the_n_overflows_has_a_finite_tangent() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (k, fy) = (1e8, 1e5);
+    let law = BoucWen::<f64>::new(k, fy, 0.05, 3e-310, 3e-310, 950.0).unwrap();
+    let uy = fy / k;
+    let mut h = law.initial_history();
+    for x in [4.0, -2.8, 1e3, -7e2, 10.0] {
+        let t = law.trial(&h, x * uy, x);
+        assert!(t.force.is_finite() && t.stiffness.is_finite(), "{t:?}");
+        // Saturation bound of the trapezoidal update, 2^{1/n} z_max.
+        let z_max = (6e-310f64).powf(-1.0 / 950.0);
+        assert!(t.history.z.abs() <= 2f64.powf(1.0 / 950.0) * z_max * (1.0 + 8.0 * f64::EPSILON));
+        h = t.history;
+    }
+}
+
+/// Bouc–Wen with `γ < 0` (`β = 1/2`, `γ = −0.4`, `n = 2`): unloading is steeper than
+/// elastic (`g = 1 + 0.9 z²`), and the trapezoidal rule's explicit half took that slope over
+/// a whole step that carried `z` through 0, overshooting `z_max` on the other side by up to
+/// `ρ = (β − γ)/(β + γ) = 9`: under cyclic steps of `1.7 u_y`, `z` reached 5e8 in 26 steps and
+/// the force overflowed later. Such a step is split at `z = 0` now, and `z` stays within
+/// the trapezoidal update's saturation bound `2^{1/n} z_max` (`z_max = (β + γ)^{−1/n}`).
+#[test]
+fn bouc_wen_negative_gamma_stays_bounded_under_cyclic_steps() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (k, fy, beta, gamma) = (1e8, 1e5, 0.5, -0.4);
+    let law = BoucWen::<f64>::new(k, fy, 0.05, beta, gamma, 2.0).unwrap();
+    let uy = fy / k;
+    let bound = 2f64.sqrt() * (beta + gamma).powf(-0.5) * (1.0 + 8.0 * f64::EPSILON);
+    for amp in [1.0, 4.0, 1e3, 1e10] {
+        let mut h = law.initial_history();
+        for i in 0..2000 {
+            let x = if i % 2 == 0 { amp } else { -0.7 * amp };
+            let t = law.trial(&h, x * uy, x);
+            assert!(
+                t.force.is_finite() && t.stiffness.is_finite() && t.history.z.abs() <= bound,
+                "amplitude {amp} u_y, step {i}: {t:?}"
+            );
+            h = t.history;
+        }
+    }
+}
+
+/// A steady-state Kalman gain whose closed loop has modes at `0.99988` (the fuzz input
+/// `riccati-residual-3e-3`: an `exact` model of an indefinite `M`, `R = 1e-6`, `Q` of
+/// rank ~1). The doubling stopped at iteration 2 — `X` had not moved by `4ε` yet, while
+/// its slow part had still to accumulate — with `P` off by 6e-14 relative, and the gain of
+/// that `P` (the innovation covariance has `κ = 3.5e13`, so the gain magnifies such
+/// errors) made an observer with spectral radius 1.0000085: unstable. (The fuzz check's
+/// residual of 3e-3 was its own rounding, in the textbook form.) The doubling now also
+/// waits for `‖A_k‖∞ ≤ 2^-26`, and the solution is verified: its closed loop is certified
+/// stable and its Joseph-form residual is within `RICCATI_RESIDUAL_UNITS` units of rounding.
+#[test]
+fn riccati_gain_of_a_slow_closed_loop_is_converged_and_verified() {
+    use aemstep::observer::{Outputs, RICCATI_RESIDUAL_UNITS, StateSpace, SteadyState};
+    let m = matrix![0.17854163271146717, 0.0; 0.0, -8.50982666015625];
+    let c = M2::identity() * -8.50982666015625;
+    let b = matrix![-8.50982666015625; -8.50982666015625];
+    let ss = StateSpace::<2, 4, 1>::exact(&m, &c, &c, &b, 1.9862534655951106e-4).unwrap();
+    let mut out = Outputs::<2, 1, 2>::zero();
+    out.a = [
+        [-8.50982666015625, 8.57208251953125],
+        [-8.50982666015625, 0.001],
+    ];
+    out.w = [[-10.0], [9.99969482421875]];
+    let meas = ss.outputs(&out).unwrap();
+    // The fuzz input's Q: v vᵀ (rank one), v = (0.15625, 9.9871826171875, 10, 10).
+    let q = SMatrix::<f64, 4, 4>::from_column_slice(&[
+        0.0244140625,
+        1.5604972839355469,
+        1.5625,
+        1.5625,
+        1.5604972839355469,
+        99.74381662905216,
+        99.871826171875,
+        99.871826171875,
+        1.5625,
+        99.871826171875,
+        100.0,
+        100.0,
+        1.5625,
+        99.871826171875,
+        100.0,
+        100.0,
+    ]);
+    let r = M2::identity() * 1e-6;
+    let kf = SteadyState::new(&ss, &meas, &q, &r).unwrap();
+    assert!(kf.iterations > 2, "{}", kf.iterations);
+    let (phi, h, p, l) = (
+        ss.phi_matrix(),
+        meas.h_matrix(),
+        kf.covariance_matrix(),
+        kf.gain_matrix(),
+    );
+    let a = phi - phi * l * h;
+    let rho = aemstep::nalgebra::DMatrix::from_fn(4, 4, |i, j| a[(i, j)])
+        .complex_eigenvalues()
+        .iter()
+        .fold(0.0f64, |m, z| m.max(z.norm()));
+    assert!(rho < 1.0, "closed-loop spectral radius {rho}");
+    // The residual the library bounds, evaluated here in the same Joseph form (its own
+    // rounding: about one more unit).
+    let k = phi * l;
+    let res = a * p * a.transpose() + k * r * k.transpose() + q - p;
+    let bnd = a.abs() * p.abs() * a.abs().transpose()
+        + k.abs() * r.abs() * k.abs().transpose()
+        + q.abs()
+        + p.abs();
+    let unit = 13.0 * f64::EPSILON;
+    for i in 0..4 {
+        for j in 0..4 {
+            let scale = (bnd[(i, i)] * bnd[(j, j)]).sqrt().max(bnd[(i, j)]);
+            assert!(
+                res[(i, j)].abs() <= (RICCATI_RESIDUAL_UNITS + 1.0) * unit * scale,
+                "residual ({i}, {j}) {:e} of {scale:e}",
+                res[(i, j)]
+            );
+        }
+    }
+}
+
+/// A shear building with a floor mass of `6.2e-322` kg: positive, so accepted, but `0` in
+/// `f32` (and subnormal in `f64`): the `f32` building's start failed with `SingularMass`.
+/// A mass below the smallest normal number of the scalar type is `OperatorUnderflow` now.
+#[test]
+fn building_mass_below_the_smallest_normal_is_operator_underflow() {
+    use aemstep::hysteresis::{Bilinear, ShearBuilding};
+    let c = [[-10.0, -10.0], [-10.0, -10.0]];
+    let l32 = Bilinear::<f32>::new(1e3, 1e7, 0.99).unwrap();
+    assert_eq!(
+        ShearBuilding::<f32, _, 2>::new([1000.0, 6.2e-322], [l32, l32], &c).err(),
+        Some(Error::OperatorUnderflow)
+    );
+    assert_eq!(
+        ShearBuilding::<f32, _, 2>::new([1000.0, 1e-39], [l32, l32], &c).err(),
+        Some(Error::OperatorUnderflow)
+    );
+    let l64 = Bilinear::<f64>::new(1e3, 1e7, 0.99).unwrap();
+    assert_eq!(
+        ShearBuilding::<f64, _, 2>::new([1000.0, 6.2e-322], [l64, l64], &c).err(),
+        Some(Error::OperatorUnderflow)
+    );
+    assert!(ShearBuilding::<f64, _, 2>::new([1000.0, 1e-39], [l64, l64], &c).is_ok());
+    assert!(ShearBuilding::<f32, _, 2>::new([1000.0, 1e-37], [l32, l32], &c).is_ok());
+}
+
+/// Bouc–Wen with an exponent of `8.4e83` (the fuzzer's; here with `β = γ = 1/2`, so that
+/// `z_max = 1` as in its input): `g = 1 − zⁿ` jumps from `0` to `−∞` within one ulp of `z = 1`, the solve
+/// converged to `z = 1 + 2ε` where `zⁿ = ∞`, and the tangent was `∞/∞ = NaN`. A root
+/// converged where `g` is not finite is moved to the nearest number within the tolerance
+/// where it is (`z = 1`, the root to rounding).
+#[test]
+fn bouc_wen_huge_exponent_tangent_at_saturation_is_finite() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (k, fy) = (8.050498138213321, 1e7);
+    let law = BoucWen::<f64>::new(k, fy, 0.99, 0.5, 0.5, 8.430468750000003e83).unwrap();
+    let uy = fy / k;
+    let mut h = law.initial_history();
+    for x in [0.5, 1.5, 3.0, 3.1, -2.0, 4.0, 4.0] {
+        let t = law.trial(&h, x * uy, 1.0);
+        assert!(
+            t.force.is_finite() && t.stiffness.is_finite(),
+            "x = {x}: {t:?}"
+        );
+        assert!(t.history.z.abs() <= 1.0, "{t:?}");
+        h = t.history;
+    }
+}
+
+/// Bouc–Wen with `n = 2.9e17` and `u_y = 8e-265` (`k = 1.3e266`, `f_y = 100`): at a step
+/// of `−10 u_y` the root is resolved to within `4ε` of saturation, where `wⁿ ≈ 1e250`, so
+/// `g₀ + g ≈ −1e250` and the denominator `1 − c ∂g/∂z` is as large: their ratio is small,
+/// but `(g₀ + g)/(2u_y)` was formed first and overflowed — a tangent of `−∞`. The ratio is
+/// formed first where that product overflows.
+#[test]
+fn bouc_wen_tangent_ratio_is_formed_before_its_overflowing_scale() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (k, fy) = (1.2897815701554327e266, 1e2);
+    let law = BoucWen::<f64>::new(
+        k,
+        fy,
+        1.4693801879882812e-1,
+        5.324081420898438e-1,
+        4.921722412109375e-1,
+        2.8823037615171174e17,
+    )
+    .unwrap();
+    let uy = fy / k;
+    let mut h = law.initial_history();
+    // (A further trial at the same deformation has the law's own slope `g₀/u_y ≈ −1e514`
+    // at that state, beyond `f64`: not judged, as in the fuzz check.)
+    for x in [5.883593420661338e-185, -10.0] {
+        let t = law.trial(&h, x * uy, -10.0);
+        // Finite, and no stiffer than elastic (|dz/dd| ≤ 1/u_y here: g₀ + g ≤ 2 over a
+        // denominator ≥ 1), up to rounding.
+        assert!(
+            t.force.is_finite()
+                && t.stiffness.is_finite()
+                && t.stiffness.abs() <= k * (1.0 + 1e-12),
+            "{t:?}"
+        );
+        h = t.history;
+    }
+}
+
+/// Bouc–Wen with `n = 7.3e17` (`β = 1`, `γ = −1/2`): `g` changes by `e^(n δ)` over a
+/// relative `δ` of `z`, so a `z` within the solve's `4ε` of the root had `g = −3e209`
+/// where the root has `g ≈ −1`. Committed, that `g₀` drove the next loading step (further
+/// negative) to `z = +1`, and the one after to a force of `−∞`. The solve now keeps, of the
+/// numbers within its tolerance, the one with the smallest residual: `z` keeps its sign
+/// along a monotonic path and stays within `2^(1/n) z_max` to rounding.
+#[test]
+fn bouc_wen_huge_exponent_root_is_the_smallest_residual() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let law = BoucWen::<f64>::new(1e9, 1e7, 0.0, 1.0, -0.5, 7.259738159179689e17).unwrap();
+    let uy = 0.01;
+    let mut h = law.initial_history();
+    for x in [-5.75347900390625, -9.9835205078125, -20.0, -1e6] {
+        let t = law.trial(&h, x * uy, -1.0);
+        let z = t.history.z;
+        // z_max = 0.5^(−1/n) = 1 + 1e-18: 1 to rounding; 4ε is the solve's tolerance.
+        assert!(
+            t.force.is_finite()
+                && t.stiffness.is_finite()
+                && (-(1.0 + 4.0 * f64::EPSILON)..0.0).contains(&z),
+            "x = {x}: {t:?}"
+        );
+        h = t.history;
+    }
 }

@@ -7,9 +7,15 @@ use super::{Law, LawTrial, fits, positive, unit_ratio};
 use crate::{Error, Real};
 
 /// Iterations allowed for the internal variable of one trial: Newton, with bisection steps
-/// where it leaves its bracket or crawls (a bracket of width `|Δ|/u_y` halves to rounding
-/// within about 120 of them).
+/// where it leaves its bracket or crawls, and every other iteration from [`FREE_NEWTON`]
+/// on. A bisection halves the count of floating-point numbers in the bracket, so the solve
+/// ends within `FREE_NEWTON + 2·64 = 136` iterations for any bracket (in `f64`).
 const MAX_ITERATIONS: u32 = 200;
+
+/// Iterations of unforced Newton (safeguarded) before every other iteration bisects: a
+/// Newton solve from the predictor converges within a few; one that has not by then is
+/// crawling or cycling inside its bracket.
+const FREE_NEWTON: u32 = 8;
 
 /// Bouc–Wen hysteresis: `f = α k d + (1 − α) f_y z`, with the dimensionless hysteretic
 /// variable `z` governed (rate-independently, `A = 1`) by
@@ -33,8 +39,16 @@ const MAX_ITERATIONS: u32 = 200;
 /// explicit Euler predictor (converged to `4ε` relative). Its residual has slope `≥ 1` in
 /// `z` whenever `|γ| ≤ β` (required), so the root is unique; it lies between `z₀` and the
 /// predictor (`g` is monotone in `z`), and an iterate that leaves that bracket, or a Newton
-/// step that does not halve, is replaced by bisection, so the solve converges for any
-/// exponent and step.
+/// step that does not halve, is replaced by bisection (in the ordering of the numbers, so
+/// at any scale within 64 halvings), so the solve converges for any exponent and step.
+/// `g` is evaluated in `w = (β + |γ|)^{1/n} |z|`, about 1 at saturation whatever `β`, `γ`
+/// and `n`. For `γ < 0` (unloading steeper than elastic) a step that carries `z` from the
+/// unloading branch through 0 is split there, the rule applied on each smooth piece; then
+/// `|z|` never exceeds `max(|z₀|, 2^{1/n} z_max)` for `β + γ > 0`, under any path
+/// (unsplit, cyclic steps of about `u_y` grew `z` without bound). For `γ = −β`, `z` does
+/// not saturate (`g = 1` on loading), and the unloading slope `1 + 2β |z|ⁿ` can leave
+/// `T`: then the force or tangent is not finite and the stepper reports
+/// [`Error::NonFiniteForce`].
 /// The consistent tangent is the exact derivative of that update,
 ///
 /// ```text
@@ -42,18 +56,26 @@ const MAX_ITERATIONS: u32 = 200;
 /// ```
 ///
 /// **Cost per trial**: a few Newton iterations of ~15 flops (`n = 1` or `2`; otherwise two
-/// `powf` each; at most 200 with bisection steps); no panic. A trial whose solve does not
-/// converge (not seen: the bracket of width `|Δ|/u_y` halves to rounding within the budget)
-/// or whose data is not finite returns a NaN force, which the stepper reports as
-/// [`Error::NonFiniteForce`] without taking the step.
+/// `powf` each; at most 136 with bisection steps; for a huge exponent, `n ε > 1e-3`, the
+/// bracket is bisected to two neighbouring numbers); no panic. A trial whose
+/// data is not finite, or whose `z` is beyond `T`, returns a non-finite force, which the
+/// stepper reports as [`Error::NonFiniteForce`] without taking the step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWen<T> {
     ak: T,
     cz: T,
     inv_uy: T,
     half_inv_uy: T,
-    beta: T,
-    gamma: T,
+    /// `κ = (β + |γ|)^{1/n}`: `g` is evaluated in `w = κ |z|`, so that `|z|ⁿ (β ± γ) =
+    /// wⁿ σ±` with `|σ±| ≤ 1`; `wⁿ` is about 1 where `z` saturates, however large or
+    /// small `β` and `n` are (`|z|ⁿ` alone overflowed at `n = 950`, `z = 2.1`).
+    kappa: T,
+    /// `σ₊ = (β + γ)/(β + |γ|)` (loading, `s z > 0`), in `[0, 1]`.
+    sigma_load: T,
+    /// `σ₋ = (γ − β)/(β + |γ|)` (unloading), in `[−1, 0]`.
+    sigma_unload: T,
+    /// `γ < 0`: steps from the unloading branch are split where `z` crosses 0.
+    split_at_zero: bool,
     n: T,
     /// `1` or `2` for the exponents computed without `powf`, else `0`.
     n_kind: u8,
@@ -92,25 +114,46 @@ impl<T: Real> BoucWen<T> {
         {
             return Err(Error::InvalidMaterial);
         }
+        // β + |γ| ≤ 2β may overflow f64: then halved (the ratios are the same, κ gains
+        // the factor 2^{1/n}).
+        let (m, kappa) = if (beta + gamma.abs()).is_finite() {
+            let m = beta + gamma.abs();
+            (m, <f64 as ComplexField>::powf(m, 1.0 / n))
+        } else {
+            let m = 0.5 * beta + 0.5 * gamma.abs();
+            let two = <f64 as ComplexField>::powf(2.0, 1.0 / n);
+            (m, <f64 as ComplexField>::powf(m, 1.0 / n) * two)
+        };
+        let half = if (beta + gamma.abs()).is_finite() {
+            1.0
+        } else {
+            0.5
+        };
         let c = [
             alpha * k,
             (1.0 - alpha) * fy,
             k / fy,
             0.5 * k / fy,
-            beta,
-            gamma,
+            kappa,
+            (half * beta + half * gamma) / m,
+            (half * gamma - half * beta) / m,
             n,
         ];
         fits::<T>(&c)?;
         // z lives on the scale of z_max (tiny for a huge β + γ: a tolerance of 4ε in
         // absolute terms stopped at z = 3e-16 where z_max = 6e-48; found by fuzzing). Kept
-        // a normal number of `T` (above 1e-37 in f32, 1e-300 in f64).
+        // a normal number of `T` (at least its `MIN_POSITIVE`), so `4ε z_scale` is not zero;
+        // the bisection in the ordering of the numbers reaches any scale within its budget.
         let z_max = if beta + gamma > 0.0 {
             <f64 as ComplexField>::powf(beta + gamma, -1.0 / n)
         } else {
             f64::INFINITY
         };
-        let floor = if T::MAX < f64::MAX { 1e-37 } else { 1e-300 };
+        let floor = if T::MAX < f64::MAX {
+            f64::from(f32::MIN_POSITIVE)
+        } else {
+            f64::MIN_POSITIVE
+        };
         let z_scale = T::from_f64_rounded(z_max.min(1.0).max(floor));
         let r = T::from_f64_rounded;
         Ok(Self {
@@ -118,9 +161,11 @@ impl<T: Real> BoucWen<T> {
             cz: r(c[1]),
             inv_uy: r(c[2]),
             half_inv_uy: r(c[3]),
-            beta: r(c[4]),
-            gamma: r(c[5]),
-            n: r(c[6]),
+            kappa: r(c[4]),
+            sigma_load: r(c[5]),
+            sigma_unload: r(c[6]),
+            n: r(c[7]),
+            split_at_zero: gamma < 0.0,
             n_kind: if n == 1.0 {
                 1
             } else if n == 2.0 {
@@ -132,10 +177,21 @@ impl<T: Real> BoucWen<T> {
         })
     }
 
-    /// `(g(z, s), ∂g/∂z)`.
+    /// `(g(z, s), ∂g/∂z)`, evaluated in `w = κ |z|`: `g = 1 − wⁿ σ±`,
+    /// `∂g/∂z = −n wⁿ⁻¹ sgn(z) σ± κ`.
     #[inline]
     fn g(&self, z: T, s: T) -> (T, T) {
-        let a = z.abs();
+        let sigma = if s * z > T::zero() {
+            self.sigma_load
+        } else {
+            self.sigma_unload
+        };
+        // wⁿ · 0 is 0 even where wⁿ overflows (γ = β makes the unloading shape 0; an
+        // ∞ · 0 there gave a NaN slope, found by fuzzing).
+        if sigma == T::zero() {
+            return (T::one(), T::zero());
+        }
+        let a = z.abs() * self.kappa;
         let (an1, an) = match self.n_kind {
             1 => (T::one(), a),
             2 => (a, a * a),
@@ -148,11 +204,6 @@ impl<T: Real> BoucWen<T> {
                 (an1, an1 * a)
             }
         };
-        let shape = if s * z > T::zero() {
-            self.beta + self.gamma
-        } else {
-            self.gamma - self.beta
-        };
         let sz = if z > T::zero() {
             T::one()
         } else if z < T::zero() {
@@ -160,13 +211,209 @@ impl<T: Real> BoucWen<T> {
         } else {
             T::zero()
         };
-        // |z|ⁿ · 0 is 0 even where |z|ⁿ overflows (γ = β makes the unloading shape 0; an
-        // ∞ · 0 there gave a NaN slope, found by fuzzing).
-        if shape == T::zero() {
-            return (T::one(), T::zero());
-        }
-        (T::one() - an * shape, -self.n * an1 * sz * shape)
+        (
+            T::one() - an * sigma,
+            -self.n * an1 * sz * sigma * self.kappa,
+        )
     }
+
+    /// The trapezoidal update's `z` and `dz/dd` for a step with `c = Δ/(2u_y) ≠ 0` from
+    /// `z₀` (`g₀ = g(z₀, s)`): the root of `r(z) = z − z₀ − c (g₀ + g(z))`, which has slope
+    /// `1 − c ∂g/∂z ≥ 1` and lies between `z₀` and the predictor `z₀ + 2c g₀`.
+    ///
+    /// Newton, safeguarded by bisection on that bracket (`rtsafe`): a Newton iterate that
+    /// leaves the bracket, or a step that does not halve, is replaced by a bisection step,
+    /// and from iteration [`FREE_NEWTON`] on every other iteration bisects. The bisection
+    /// halves the bracket in the *ordering* of the floating-point numbers (the midpoint of
+    /// their bit patterns read as integers), not in value: within one binade that is the
+    /// arithmetic midpoint, across binades it halves the exponent range, so any bracket —
+    /// `[0, 3]` around a root of `1e-100`, or one end at `±∞` — is down to two adjacent
+    /// numbers within 64 bisections in `f64` (32 in `f32`), and the solve ends within
+    /// `FREE_NEWTON + 2·64` iterations. (A value bisection needed about 380 halvings to go
+    /// from `3` to a root of `1e-100` to `4ε`, beyond the budget of 200, and the force was
+    /// NaN; found by fuzzing with `β = 8.5e199`.)
+    ///
+    /// For `|c| > 1` the residual is divided by `|c|` — `(z − z₀)/|c| − sgn c (g₀ + g(z))`,
+    /// the same sign — so that a step of `c = ±∞` (a deformation increment or `Δ/u_y` beyond
+    /// `T`) solves its limit `g(z) = −g₀` instead of `∞ − ∞`. A root beyond the largest
+    /// finite number is `±∞` (the force is then not finite and the stepper reports
+    /// [`Error::NonFiniteForce`]); a NaN `c` or residual gives NaN.
+    #[inline]
+    fn solve(&self, z0: T, g0: T, c: T, s: T) -> (T, T) {
+        let zero = T::zero();
+        let one = T::one();
+        let nan = T::from_f64_rounded(f64::NAN);
+        if g0 == zero {
+            // r(z₀) = 0: z₀ is the root (saturated exactly).
+            return (z0, zero);
+        }
+        if c.as_f64().is_nan() || g0.as_f64().is_nan() || z0.as_f64().is_nan() {
+            return (nan, nan);
+        }
+        let big = c.abs() > one;
+        // r/|c| = a z − a z₀ − b (g₀ + g) for |c| > 1.
+        let (a, b) = if big {
+            (one / c.abs(), if c > zero { one } else { -one })
+        } else {
+            (one, c)
+        };
+        let residual = |z: T, g: T| {
+            if big {
+                a * z - a * z0 - b * (g0 + g)
+            } else {
+                z - z0 - c * (g0 + g)
+            }
+        };
+        let tol = T::from_f64_rounded(4.0) * T::default_epsilon();
+        let zp = z0 + (c + c) * g0;
+        if zp.as_f64().is_nan() {
+            return (nan, nan);
+        }
+        let (mut lo, mut hi) = if zp < z0 { (zp, z0) } else { (z0, zp) };
+        let mut z = if zp.is_finite() { zp } else { midpoint(lo, hi) };
+        let mut last = hi - lo;
+        let mut converged = false;
+        // With a huge exponent (one ulp of z changes wⁿ by more than 0.1 %: n ε > 1e-3), g
+        // changes by a factor e^(n δ) over a relative δ of z, and a z within 4ε of the
+        // root could have g = −3e209 where the root has g ≈ −1; committed, that g₀ sent the
+        // next step's z to the other side (n = 7e17, found by fuzzing), and Newton's step
+        // there, r/r′ ≈ z/n, looks converged 34 numbers away from the root (n = 6.8e15).
+        // There the bracket is bisected down to two neighbouring numbers, and z is the one
+        // with the smaller residual.
+        let exact = self.n * T::default_epsilon() > T::from_f64_rounded(1e-3);
+        for i in 0..MAX_ITERATIONS {
+            let (g, dg) = self.g(z, s);
+            let r = residual(z, g);
+            if r > zero {
+                hi = z;
+            } else if r <= zero {
+                lo = z;
+            } else {
+                break; // NaN
+            }
+            // (A slope that overflows is no Newton step: r/∞ = 0 looked converged; found
+            // by fuzzing with n = 984 in f32.)
+            let slope = if big { a - b * dg } else { one - c * dg };
+            let step = r / slope;
+            let next = z - step;
+            let bisect = i >= FREE_NEWTON && (i - FREE_NEWTON) % 2 == 1;
+            if !bisect
+                && slope.is_finite()
+                && slope > zero
+                && next >= lo
+                && next <= hi
+                && (step + step).abs() <= last
+            {
+                last = step.abs();
+                z = next;
+                if !exact && last <= tol * z.abs().max(self.z_scale) {
+                    converged = true;
+                    break;
+                }
+            } else {
+                let m = midpoint(lo, hi);
+                last = (m - z).abs();
+                z = m;
+            }
+            let finite = lo.is_finite() && hi.is_finite();
+            if (!exact && finite && hi - lo <= tol * lo.abs().max(hi.abs()).max(self.z_scale))
+                || key(hi).wrapping_sub(key(lo)) as u64 <= 1
+            {
+                converged = true;
+                // A bracket [MAX, ∞]: the root is beyond the finite numbers.
+                if !finite {
+                    z = if lo.is_finite() { hi } else { lo };
+                }
+                break;
+            }
+        }
+        if !converged {
+            return (nan, nan);
+        }
+        let (mut g, mut dg) = self.g(z, s);
+        let near = tol * z.abs().max(self.z_scale);
+        if exact && lo.is_finite() && hi.is_finite() {
+            // The bracket is two neighbouring numbers: the one with the smaller residual.
+            let (gl, dgl) = self.g(lo, s);
+            let (gh, dgh) = self.g(hi, s);
+            (z, g, dg) = if residual(lo, gl).abs() <= residual(hi, gh).abs() {
+                (lo, gl, dgl)
+            } else {
+                (hi, gh, dgh)
+            };
+        }
+        if !(g.is_finite() && dg.is_finite()) && z.is_finite() {
+            // With a huge exponent g jumps from 0 to −∞ within one ulp of z_max (n = 8e83:
+            // wⁿ overflows at w = 1 + 2ε), and a z converged there had a NaN tangent (found
+            // by fuzzing): take the nearest number within the tolerance where g is finite
+            // (the root is as well resolved there, and the next step's g₀ is finite).
+            let k = key(z);
+            for e in [from_key::<T>(k - 1), from_key::<T>(k + 1), lo, hi] {
+                let (ge, dge) = self.g(e, s);
+                if ge.is_finite() && dge.is_finite() && (e - z).abs() <= near + near {
+                    (z, g, dg) = (e, ge, dge);
+                    break;
+                }
+            }
+        }
+        // (g₀ + g)/(2u_y (1 − c ∂g/∂z)), for |c| > 1 with numerator and denominator
+        // divided by |c| (at c = ±∞ the root has g = −g₀ and the increment does not move
+        // z). Divided before the multiplication by 1/(2u_y) where the product overflows:
+        // with n = 2.9e17, z within its tolerance of saturation has g ≈ −1e250, the
+        // denominator is as large, and (g₀ + g)/(2u_y) was −∞ at u_y = 8e-265 (found by
+        // fuzzing).
+        let (num, den) = if big {
+            ((g0 + g) * a, a - b * dg)
+        } else {
+            (g0 + g, one - c * dg)
+        };
+        let dz_dd = if num == zero {
+            zero
+        } else if (num * self.half_inv_uy).is_finite() {
+            num * self.half_inv_uy / den
+        } else {
+            num / den * self.half_inv_uy
+        };
+        (z, dz_dd)
+    }
+}
+
+/// `x`'s place in the ordering of the numbers of `T`: an integer, increasing with `x`,
+/// consecutive for adjacent numbers (`±0` are both `0`; `±∞` are one past `±MAX`). The
+/// sign-magnitude bit pattern made two's complement. (Not called with NaN.)
+#[inline]
+fn key<T: Real>(x: T) -> i64 {
+    if T::MAX < f64::MAX {
+        let b = (x.as_f64() as f32).to_bits();
+        let m = i64::from(b & 0x7fff_ffff);
+        if b >> 31 == 1 { -m } else { m }
+    } else {
+        let b = x.as_f64().to_bits();
+        let m = (b & 0x7fff_ffff_ffff_ffff) as i64;
+        if b >> 63 == 1 { -m } else { m }
+    }
+}
+
+/// The number of `T` whose [`key`] is `k` (the inverse of `key`, `+0` for `0`).
+#[inline]
+fn from_key<T: Real>(k: i64) -> T {
+    let m = k.unsigned_abs();
+    let x = if T::MAX < f64::MAX {
+        let b = (m as u32) | if k < 0 { 1 << 31 } else { 0 };
+        f64::from(f32::from_bits(b))
+    } else {
+        f64::from_bits(m | if k < 0 { 1 << 63 } else { 0 })
+    };
+    T::from_f64_rounded(x)
+}
+
+/// The midpoint of `[lo, hi]` in the ordering of the numbers (`lo ≤ hi`, not NaN): the
+/// number halfway by [`key`] (rounded down), so a bisection halves the count of numbers
+/// in the bracket.
+#[inline]
+fn midpoint<T: Real>(lo: T, hi: T) -> T {
+    let (a, b) = (key(lo), key(hi));
+    from_key((a >> 1) + (b >> 1) + (a & b & 1))
 }
 
 impl<T: Real> Law<T> for BoucWen<T> {
@@ -194,52 +441,19 @@ impl<T: Real> Law<T> for BoucWen<T> {
             (z0, g0 * self.inv_uy)
         } else {
             let c = delta * self.half_inv_uy;
-            let tol = T::from_f64_rounded(4.0) * T::default_epsilon();
-            let half = T::from_f64_rounded(0.5);
-            let mut z = z0 + (c + c) * g0;
-            // The root lies between z0 and the predictor (g is monotone in z, against the
-            // step's direction, so the residual changes sign between them): Newton safeguarded
-            // by bisection on that bracket. (Unsafeguarded, a large exponent n sent an iterate
-            // to |z|ⁿ = ∞ and the force to NaN at Δ = 3 u_y; found by fuzzing.)
-            // Bisection also where Newton crawls (steps not halving: with n ≈ 950 each
-            // Newton step from above shrinks z by only a factor 1 − 1/n), as `rtsafe`.
-            let (mut lo, mut hi) = if z < z0 { (z, z0) } else { (z0, z) };
-            let mut last = hi - lo;
-            let mut converged = false;
-            for _ in 0..MAX_ITERATIONS {
-                let (g, dg) = self.g(z, s);
-                let r = z - z0 - c * (g0 + g);
-                if r > T::zero() {
-                    hi = z;
-                } else {
-                    lo = z;
-                }
-                // (A slope that overflows is no Newton step: r/∞ = 0 looked converged; found
-                // by fuzzing with n = 984 in f32.)
-                let slope = one - c * dg;
-                let step = r / slope;
-                let next = z - step;
-                if slope.is_finite() && next >= lo && next <= hi && (step + step).abs() <= last {
-                    last = step.abs();
-                    z = next;
-                    if last <= tol * z.abs().max(self.z_scale) {
-                        converged = true;
-                        break;
-                    }
-                } else {
-                    last = half * (hi - lo);
-                    z = lo + last;
-                }
-                if hi - lo <= tol * lo.abs().max(hi.abs()).max(self.z_scale) {
-                    converged = true;
-                    break;
-                }
+            // γ < 0: a step from the unloading branch that carries z through 0 is split
+            // there (the trapezoidal rule on each smooth piece). Unsplit, its explicit half
+            // took the unloading slope g₀ = 1 + ρ wⁿ (ρ = (β − γ)/(β + γ) > 1) over the
+            // whole step, overshot past z_max on the other side by up to ρ, and under cyclic
+            // steps of a few u_y z grew without bound to a force of ∞ (found by testing the
+            // fuzz finding's neighbourhood). Split, z stays within max(|z₀|, 2^{1/n} z_max).
+            // (c* = −z₀/(g₀ + 1): the increment that brings z₀ to 0, where g = 1.)
+            let c_zero = -z0 / (g0 + one);
+            if self.split_at_zero && s * z0 < T::zero() && c.abs() > c_zero.abs() {
+                self.solve(T::zero(), one, c - c_zero, s)
+            } else {
+                self.solve(z0, g0, c, s)
             }
-            if !converged {
-                z = T::from_f64_rounded(f64::NAN);
-            }
-            let (g, dg) = self.g(z, s);
-            (z, (g0 + g) * self.half_inv_uy / (one - c * dg))
         };
         LawTrial {
             force: self.ak * d + self.cz * z,

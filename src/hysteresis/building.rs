@@ -60,7 +60,9 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
     ///
     /// Errors: [`Error::NonFiniteInput`] (a mass or damping entry not finite),
     /// [`Error::MassNotSpd`] (a mass `≤ 0`), [`Error::OperatorOverflow`] (a mass or
-    /// damping entry does not fit `T`). Cost: O(N²).
+    /// damping entry does not fit `T`), [`Error::OperatorUnderflow`] (a mass below the
+    /// smallest normal number of `T`: subnormal or rounded to zero, e.g. `6e-322` kg in
+    /// `f32`, whose start then failed with a singular mass). Cost: O(N²).
     pub fn new(masses: [f64; N], laws: [L; N], damping: &Rows<N>) -> Result<Self, Error> {
         if !masses
             .iter()
@@ -73,6 +75,14 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
             return Err(Error::MassNotSpd);
         }
         super::fits::<T>(&masses)?;
+        let smallest = if T::MAX < f64::MAX {
+            f64::from(f32::MIN_POSITIVE)
+        } else {
+            f64::MIN_POSITIVE
+        };
+        if masses.iter().any(|&m| m < smallest) {
+            return Err(Error::OperatorUnderflow);
+        }
         for row in damping {
             super::fits::<T>(row)?;
         }

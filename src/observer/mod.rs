@@ -36,5 +36,5 @@ mod state_space;
 
 pub use fixed::{Estimate, Observer, Readout};
 pub use kalman::{Kalman, KalmanState};
-pub use riccati::{RICCATI_MAX_ITERATIONS, SteadyState};
+pub use riccati::{RICCATI_MAX_ITERATIONS, RICCATI_RESIDUAL_UNITS, SteadyState};
 pub use state_space::{Measurement, Outputs, StateSpace};
