@@ -2289,10 +2289,12 @@ pub fn observer(data: &[u8]) {
         // A covariance: symmetric, no eigenvalue clearly negative.
         let p = g.covariance_matrix();
         let sc = p.amax();
-        let lo = nalgebra::DMatrix::from_fn(4, 4, |i, j| p[(i, j)] / sc.max(f64::MIN_POSITIVE))
-            .symmetric_eigen()
-            .eigenvalues
-            .min();
+        let lo = nalgebra::linalg::SymmetricEigen::try_new(
+            nalgebra::DMatrix::from_fn(4, 4, |i, j| p[(i, j)] / sc.max(f64::MIN_POSITIVE)),
+            f64::EPSILON,
+            100_000,
+        )
+        .map_or(0.0, |e| e.eigenvalues.min());
         check!(
             lo > -1e-6,
             "{OB}: SteadyState covariance is not positive semidefinite: {p:?}"
@@ -2468,7 +2470,14 @@ fn riccati_holds<const S: usize, const O: usize>(
             break;
         }
     }
-    let rho = d
+    // (nalgebra's `complex_eigenvalues` iterates without a limit, and on some badly scaled
+    // closed loops it did not return; found by fuzzing once the checks covered them. With
+    // a limit; unconverged, the library's own certificate is all there is.)
+    let Some(schur) = nalgebra::linalg::Schur::try_new(d, f64::EPSILON, 100_000) else {
+        count(OB, "riccati: closed-loop eigenvalues not converged");
+        return;
+    };
+    let rho = schur
         .complex_eigenvalues()
         .iter()
         .map(|z| z.norm())
