@@ -172,7 +172,8 @@ judged in Joseph form, `A P Aᵀ + K R Kᵀ + Q − P`, against the size of the 
 terms (the textbook form carries the error of `(H P Hᵀ + R)⁻¹`: with `κ = 3.5e13` it read
 3e-3 for a `P` whose residual is 2e-16 in exact arithmetic), and the gain by the
 normwise backward error of its solve, `L (H P Hᵀ + R) − P Hᵀ` row by row, allowing
-for the underflow of `L`; the check's eigenvalues have an iteration limit (nalgebra's
+for the underflow of `L` and for the rounding of forming `H P Hᵀ` (with `P = 3e9` along a
+direction `H` does not see it cancels to 1e-3, as large as its rounding); the check's eigenvalues have an iteration limit (nalgebra's
 Schur form did not return on a free-mass model's closed loop), and where they say
 unstable the closed loop's powers decide (their error is about `ε ‖A‖`: a nilpotent
 closed loop with an entry of 4e96 at `h = 1e113` read a spectral radius of 5e80); a law's force and tangent are judged where they are

@@ -2429,13 +2429,18 @@ fn riccati_holds<const S: usize, const O: usize>(
     // `|L||S|`, was too strict for S with entries 1e-6 and 1e6 apart).
     let si = h * p * h.transpose() + r;
     let e = l * si - p * h.transpose();
-    let phr = p * h.transpose();
-    let s_norm = si.abs().row_sum().max();
+    // S itself is known only to the rounding of forming it, ε |H||P||H|ᵀ, and P H to
+    // ε |P||H|ᵀ: with P = 3e9 along a direction H does not see, H P Hᵀ cancels to 1e-3
+    // and its rounding is as large (found by fuzzing: the check's S was not even
+    // symmetric), so those sizes join the scale.
+    let hph = h.abs() * p.abs() * h.abs().transpose();
+    let s_norm = si.abs().row_sum().max() + hph.row_sum().max();
+    let phr_size = p.abs() * h.abs().transpose();
     for i in 0..S {
         let ei = e.row(i).amax();
         // (`+ MIN_POSITIVE`: an `L` below the normal range has lost its precision, and one
         // below the subnormals is 0 — `P Hᵀ ≈ 2e-267` over `R = 4.6e305`.)
-        let fi = s_norm * (l.row(i).amax() + f64::MIN_POSITIVE) + phr.row(i).amax();
+        let fi = s_norm * (l.row(i).amax() + f64::MIN_POSITIVE) + phr_size.row(i).amax();
         check!(
             ei <= 1e-8 * fi || !fi.is_finite(),
             "{OB}: gain {l:?} does not solve L (H P Hᵀ + R) = P Hᵀ (row {i}: {ei:e} of {fi:e})"
