@@ -171,7 +171,14 @@ an `f32` Newton tolerance of `−1e-50` is `−0`, a valid tolerance; the Riccat
 judged in Joseph form, `A P Aᵀ + K R Kᵀ + Q − P`, against the size of the equation's
 terms (the textbook form carries the error of `(H P Hᵀ + R)⁻¹`: with `κ = 3.5e13` it read
 3e-3 for a `P` whose residual is 2e-16 in exact arithmetic), and the gain by the
-normwise backward error of its solve, `L (H P Hᵀ + R) − P Hᵀ` row by row; a law's force and tangent are judged where they are
+normwise backward error of its solve, `L (H P Hᵀ + R) − P Hᵀ` row by row, allowing
+for the underflow of `L` and for the rounding of forming `H P Hᵀ` (with `P = 3e9` along a
+direction `H` does not see it cancels to 1e-3, as large as its rounding); the check's eigenvalues have an iteration limit (nalgebra's
+Schur form did not return on a free-mass model's closed loop), and where they say
+unstable the closed loop's powers decide (their error is about `ε ‖A‖`: a nilpotent
+closed loop with an entry of 4e96 at `h = 1e113` read a spectral radius of 5e80); a `Readout`'s read of a state of ones is judged where its
+rows' sums fit the scalar type (each entry of `H` may fit `f32` while a row's sum does
+not); a law's force and tangent are judged where they are
 representable (a stiffness of 1.8e308 has a tangent beyond `f64`; with `γ = −β`
 Bouc–Wen's `z` does not saturate and its unloading slope `k (1 + 2β |z|ⁿ)` leaves `f64`
 at `|z| = 10`, `n = 1000`).
