@@ -23,7 +23,7 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use aemstep::{Exact, GeneralizedAlpha, Linear, Newmark, Real, State, Stepper};
+use aemstep::{CompensatedLinear, Exact, GeneralizedAlpha, Linear, Newmark, Real, Stepper};
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, BenchmarkId, Criterion, Throughput};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
@@ -61,11 +61,7 @@ fn system<const N: usize>() -> Box<(SMatrix<f64, N, N>, SMatrix<f64, N, N>, SMat
     Box::new((m, c, k))
 }
 
-fn bench_stepper<
-    T: Real,
-    S: Stepper<T, N, Input = SVector<T, N>, State = State<T, N>>,
-    const N: usize,
->(
+fn bench_stepper<T: Real, S: Stepper<T, N, Input = SVector<T, N>>, const N: usize>(
     g: &mut BenchmarkGroup<'_, WallTime>,
     name: &str,
     sys: &S,
@@ -303,6 +299,32 @@ fn per_step_all(c: &mut Criterion, full: bool) {
     }
 }
 
+/// `CompensatedLinear` beside `Linear` (same operators; the compensated update adds the
+/// predictor's rounding errors through `GC`, `GK`: `5N² + 34N` against `3N² + 7N`).
+fn compensated<T: Real, const N: usize>(c: &mut Criterion, ty: &str) {
+    let sys = system::<N>();
+    let (m, cc, k) = (&sys.0, &sys.1, &sys.2);
+    let mut g = c.benchmark_group(format!("compensated/{ty}"));
+    g.warm_up_time(Duration::from_millis(200))
+        .measurement_time(Duration::from_millis(700))
+        .sample_size(20);
+    let lin = Box::new(Linear::<T, N>::new(m, cc, k, 0.01).expect("linear"));
+    bench_stepper(&mut g, "aem", &*lin, 3 * N * N + 7 * N);
+    let cl = Box::new(CompensatedLinear::<T, N>::new(m, cc, k, 0.01).expect("compensated"));
+    bench_stepper(&mut g, "aem-compensated", &*cl, 5 * N * N + 34 * N);
+    g.finish();
+}
+
+fn compensated_all(c: &mut Criterion, full: bool) {
+    compensated::<f32, 1>(c, "f32");
+    compensated::<f32, 5>(c, "f32");
+    if full {
+        compensated::<f32, 12>(c, "f32");
+        compensated::<f32, 50>(c, "f32");
+        compensated::<f32, 100>(c, "f32");
+    }
+}
+
 /// Paper Example 10 (spec §8): whole runs of t_tot / h steps, h = 0.01, f64.
 fn example10_n<const N: usize>(c: &mut Criterion) {
     let sys = system::<N>();
@@ -376,6 +398,7 @@ fn main() {
                 floor_compute::<f32, 48>(&mut c, "f32", false);
             }
             per_step_all(&mut c, full);
+            compensated_all(&mut c, full);
             if full {
                 example10(&mut c);
             }

@@ -247,29 +247,24 @@ pub(crate) fn newmark_step_compensated<T: Real, const N: usize, K: Kinematics<T>
     p: &SVector<T, N>,
 ) {
     let mut x = [[T::zero(); N]; 3];
-    // The predictor's rounding errors (e_v̂, e_û).
-    let mut e = [[T::zero(); N]; 2];
+    // The predictor's rounding errors (e_v̂, e_û) in blocks 1 and 2 (block 0 is not read).
+    let mut e = [[T::zero(); N]; 3];
     for j in 0..N {
         x[0][j] = p[j];
         let a = s.a[j];
-        (x[1][j], e[0][j]) = two_sum(s.v[j], kin.c_v() * a + lo.dv[j]);
-        let du = (kin.h() * x[1][j] - kin.c_u() * a) + (kin.h() * e[0][j] + lo.du[j]);
-        (x[2][j], e[1][j]) = two_sum(s.u[j], du);
+        (x[1][j], e[1][j]) = two_sum(s.v[j], kin.c_v() * a + lo.dv[j]);
+        let du = (kin.h() * x[1][j] - kin.c_u() * a) + (kin.h() * e[1][j] + lo.du[j]);
+        (x[2][j], e[2][j]) = two_sum(s.u[j], du);
     }
     let mut q = [T::zero(); N];
     ops.mat_vec(&x, &mut q);
-    for i in 0..N {
-        // −GC e_v̂ − GK e_û (the stored blocks are already negated).
-        let mut q_lo = T::zero();
-        for j in 0..N {
-            q_lo += ops.get(i, 1, j) * e[0][j] + ops.get(i, 2, j) * e[1][j];
-        }
-        q[i] += q_lo;
-    }
+    // −GC e_v̂ − GK e_û (the stored blocks are already negated), by the same product.
+    let mut q_lo = [T::zero(); N];
+    ops.mat_vec_from(1, &e, &mut q_lo);
     for j in 0..N {
-        let qj = q[j];
-        (s.v[j], lo.dv[j]) = two_sum(x[1][j], kin.gamma_h() * qj + e[0][j]);
-        (s.u[j], lo.du[j]) = two_sum(x[2][j], kin.beta_h2() * qj + e[1][j]);
+        let qj = q[j] + q_lo[j];
+        (s.v[j], lo.dv[j]) = two_sum(x[1][j], kin.gamma_h() * qj + e[1][j]);
+        (s.u[j], lo.du[j]) = two_sum(x[2][j], kin.beta_h2() * qj + e[2][j]);
         s.a[j] = qj;
     }
     s.n = s.n.wrapping_add(1);

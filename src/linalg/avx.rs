@@ -94,15 +94,16 @@ fn __cpuid(leaf: u32) -> core::arch::x86_64::CpuidResult {
 #[inline(always)]
 pub(crate) fn column_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
     ops: &[[[T; N]; K]; N],
+    from: usize,
     x: &[[T; N]; K],
     out: &mut [T],
 ) {
     if PLAIN_ONLY || K * N * N * core::mem::size_of::<T>() < MIN_BYTES || !available() {
-        super::op_rows::column_blocks::<T, N, K, W>(ops, x, out);
+        super::op_rows::column_blocks::<T, N, K, W>(ops, from, x, out);
     } else {
         // SAFETY: `available()` is true: the CPU reports AVX and the OS saves its
         // registers (module docs), the precondition of `column_blocks_avx`.
-        unsafe { column_blocks_avx::<T, N, K, W>(ops, x, out) }
+        unsafe { column_blocks_avx::<T, N, K, W>(ops, from, x, out) }
     }
 }
 
@@ -111,10 +112,11 @@ pub(crate) fn column_blocks<T: Real, const N: usize, const K: usize, const W: us
 #[inline(never)]
 fn column_blocks_avx<T: Real, const N: usize, const K: usize, const W: usize>(
     ops: &[[[T; N]; K]; N],
+    from: usize,
     x: &[[T; N]; K],
     out: &mut [T],
 ) {
-    super::op_rows::column_blocks::<T, N, K, W>(ops, x, out);
+    super::op_rows::column_blocks::<T, N, K, W>(ops, from, x, out);
 }
 
 #[cfg(test)]
@@ -122,7 +124,8 @@ mod tests {
     use super::*;
 
     /// The AVX and SSE2 paths give the same bits, for operator sizes above the dispatch
-    /// threshold, both block widths and first blocks of every kind.
+    /// threshold, both block widths, first blocks of every kind, and the product of
+    /// every block or all but the first.
     fn same_bits<T: Real, const N: usize, const K: usize, const W: usize>() {
         let mut ops = [[[T::zero(); N]; K]; N];
         let mut x = [[T::zero(); N]; K];
@@ -141,15 +144,17 @@ mod tests {
         for v in x.iter_mut().flatten() {
             *v = next();
         }
-        let (mut plain, mut wide) = ([T::zero(); N], [T::zero(); N]);
-        super::super::op_rows::column_blocks::<T, N, K, W>(&ops, &x, &mut plain);
-        column_blocks::<T, N, K, W>(&ops, &x, &mut wide);
-        for (p, w) in plain.iter().zip(&wide) {
-            assert_eq!(
-                p.as_f64().to_bits(),
-                w.as_f64().to_bits(),
-                "N = {N}, K = {K}"
-            );
+        for from in [0, 1] {
+            let (mut plain, mut wide) = ([T::zero(); N], [T::zero(); N]);
+            super::super::op_rows::column_blocks::<T, N, K, W>(&ops, from, &x, &mut plain);
+            column_blocks::<T, N, K, W>(&ops, from, &x, &mut wide);
+            for (p, w) in plain.iter().zip(&wide) {
+                assert_eq!(
+                    p.as_f64().to_bits(),
+                    w.as_f64().to_bits(),
+                    "N = {N}, K = {K}, from block {from}"
+                );
+            }
         }
     }
 

@@ -140,10 +140,21 @@ impl<T: Real, const N: usize, const K: usize> OpRows<T, N, K> {
     /// `K·N²` multiply-adds; no branch on the data, no panic.
     #[inline(always)]
     pub(crate) fn mat_vec(&self, x: &[[T; N]; K], out: &mut [T]) {
+        self.mat_vec_from(0, x, out);
+    }
+
+    /// `out[i] = Σ rows[i][from..] · x[from..]`: the product of blocks `from..K` only (the
+    /// first `from` blocks of `x` are not read), each row one chain in column order from
+    /// block `from`'s first product, as [`OpRows::mat_vec`] (which is `from = 0`). For a
+    /// product by a vector that is zero in the first blocks (the compensated step's
+    /// rounding errors) at the speed of the main product. Cost: `(K − from)·N²`
+    /// multiply-adds; `from ≥ K` gives zeros; no branch on the data, no panic.
+    #[inline(always)]
+    pub(crate) fn mat_vec_from(&self, from: usize, x: &[[T; N]; K], out: &mut [T]) {
         match Self::WIDE {
-            32 => wide_blocks::<T, N, K, 32>(&self.0, x, out),
-            16 => wide_blocks::<T, N, K, 16>(&self.0, x, out),
-            _ => row_pairs(&self.0, x, out),
+            32 => wide_blocks::<T, N, K, 32>(&self.0, from, x, out),
+            16 => wide_blocks::<T, N, K, 16>(&self.0, from, x, out),
+            _ => row_pairs(&self.0, from, x, out),
         }
     }
 }
@@ -153,44 +164,51 @@ impl<T: Real, const N: usize, const K: usize> OpRows<T, N, K> {
 #[inline(always)]
 fn wide_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
     ops: &[[[T; N]; K]; N],
+    from: usize,
     x: &[[T; N]; K],
     out: &mut [T],
 ) {
     #[cfg(target_arch = "x86_64")]
-    super::avx::column_blocks::<T, N, K, W>(ops, x, out);
+    super::avx::column_blocks::<T, N, K, W>(ops, from, x, out);
     #[cfg(not(target_arch = "x86_64"))]
-    column_blocks::<T, N, K, W>(ops, x, out);
+    column_blocks::<T, N, K, W>(ops, from, x, out);
 }
 
-/// Rows in the row layout times `x`: a single row first if their number is odd, then
-/// pairs ([`dots`]).
+/// Rows in the row layout times `x` (blocks `from..K`): a single row first if their number
+/// is odd, then pairs ([`dots`]).
 #[inline(always)]
 fn row_pairs<T: Real, const N: usize, const K: usize>(
     rows: &[[[T; N]; K]],
+    from: usize,
     x: &[[T; N]; K],
     out: &mut [T],
 ) {
     let (single, pairs) = rows.as_rchunks::<2>();
     let (out_single, out_pairs) = out.as_rchunks_mut::<2>();
     for (row, o) in single.iter().zip(out_single) {
-        [*o] = dots(core::array::from_ref(row), x);
+        [*o] = dots(core::array::from_ref(row), from, x);
     }
     for (rows, o) in pairs.iter().zip(out_pairs) {
-        *o = dots(rows, x);
+        *o = dots(rows, from, x);
     }
 }
 
-/// Storage in the column-blocked layout with blocks of `W` rows, times `x`: the first
-/// block ([`first_block`] rows, dispatched to its size), then the blocks of `W`.
+/// Storage in the column-blocked layout with blocks of `W` rows, times `x` (blocks
+/// `from..K`: the flat columns from `from·N` on): the first block ([`first_block`] rows,
+/// dispatched to its size), then the blocks of `W`.
 #[inline(always)]
 pub(super) fn column_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
     ops: &[[[T; N]; K]; N],
+    from: usize,
     x: &[[T; N]; K],
     out: &mut [T],
 ) {
     let kn = K * N;
     let b0 = first_block(N, W);
+    let skip = from.saturating_mul(N);
     let (flat, xf) = (ops.as_flattened().as_flattened(), x.as_flattened());
+    // Each block's columns, and `x`, from `skip` on (none if `skip ≥ K·N`).
+    let xf = xf.get(skip..).unwrap_or(&[]);
     let (Some((first, rest)), Some((out_first, out_rest))) = (
         flat.split_at_checked(b0 * kn),
         out.split_at_mut_checked(b0.min(out.len())),
@@ -204,7 +222,7 @@ pub(super) fn column_blocks<T: Real, const N: usize, const K: usize, const W: us
             match b0 {
                 $($r => {
                     if let Ok(o) = <&mut [T; $r]>::try_from(out_first) {
-                        *o = column_block(first.as_chunks::<$r>().0, xf);
+                        *o = column_block(first.as_chunks::<$r>().0.get(skip..).unwrap_or(&[]), xf);
                     }
                 })*
                 _ => {}
@@ -219,7 +237,7 @@ pub(super) fn column_blocks<T: Real, const N: usize, const K: usize, const W: us
     let (cols, _) = rest.as_chunks::<W>();
     let (outs, _) = out_rest.as_chunks_mut::<W>();
     for (block, o) in cols.chunks_exact(kn).zip(outs) {
-        *o = column_block(block, xf);
+        *o = column_block(block.get(skip..).unwrap_or(&[]), xf);
     }
 }
 
@@ -251,17 +269,18 @@ fn column_block<T: Real, const R: usize>(cols: &[[T; R]], x: &[T]) -> [T; R] {
 #[inline(always)]
 fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
     rows: &[[[T; N]; K]; R],
+    from: usize,
     x: &[[T; N]; K],
 ) -> [T; R] {
     let mut q = [T::zero(); R];
-    if N == 0 || K == 0 {
+    if N == 0 || from >= K {
         return q;
     }
     for r in 0..R {
-        q[r] = rows[r][0][0] * x[0][0];
+        q[r] = rows[r][from][0] * x[from][0];
     }
-    for b in 0..K {
-        let first = if b == 0 { 1 } else { 0 };
+    for b in from..K {
+        let first = if b == from { 1 } else { 0 };
         for j in first..N {
             let xj = x[b][j];
             for r in 0..R {
@@ -277,18 +296,24 @@ mod tests {
     use super::{column_blocks, flat_index, layout, row_pairs};
     use crate::Real;
 
-    /// Row `i` of `rows · x` as one serial chain, first product first: the order every
-    /// layout and block shape must keep.
+    /// Row `i` of `rows[.., from..] · x[from..]` as one serial chain, first product first:
+    /// the order every layout and block shape must keep (zeros if `from ≥ K`).
     fn serial<T: Real, const N: usize, const K: usize>(
         rows: &[[[T; N]; K]; N],
+        from: usize,
         x: &[[T; N]; K],
     ) -> [T; N] {
         core::array::from_fn(|i| {
-            let (r, x) = (rows[i].as_flattened(), x.as_flattened());
-            r[1..]
-                .iter()
-                .zip(&x[1..])
-                .fold(r[0] * x[0], |q, (&a, &b)| q + a * b)
+            let (r, x) = (
+                &rows[i].as_flattened()[from * N..],
+                &x.as_flattened()[from * N..],
+            );
+            match (r.split_first(), x.split_first()) {
+                (Some((r0, r)), Some((x0, x))) => {
+                    r.iter().zip(x).fold(*r0 * *x0, |q, (&a, &b)| q + a * b)
+                }
+                _ => T::zero(),
+            }
         })
     }
 
@@ -304,27 +329,31 @@ mod tests {
         let rows: [[[T; N]; K]; N] =
             core::array::from_fn(|_| core::array::from_fn(|_| core::array::from_fn(|_| next())));
         let x: [[T; N]; K] = core::array::from_fn(|_| core::array::from_fn(|_| next()));
-        let want = serial(&rows, &x);
-        for w in [0, 16, 32] {
-            let stored = layout(rows, w);
-            let mut out = [T::zero(); N];
-            match w {
-                0 => row_pairs(&stored, &x, &mut out),
-                16 => column_blocks::<T, N, K, 16>(&stored, &x, &mut out),
-                _ => column_blocks::<T, N, K, 32>(&stored, &x, &mut out),
-            }
-            for i in 0..N {
-                assert_eq!(
-                    out[i].as_f64().to_bits(),
-                    want[i].as_f64().to_bits(),
-                    "N = {N}, K = {K}, row {i}, blocks of {w} rows"
-                );
+        // Every starting block, the whole product (0) to none (K).
+        for from in 0..=K {
+            let want = serial(&rows, from, &x);
+            for w in [0, 16, 32] {
+                let stored = layout(rows, w);
+                let mut out = [T::one(); N];
+                match w {
+                    0 => row_pairs(&stored, from, &x, &mut out),
+                    16 => column_blocks::<T, N, K, 16>(&stored, from, &x, &mut out),
+                    _ => column_blocks::<T, N, K, 32>(&stored, from, &x, &mut out),
+                }
+                for i in 0..N {
+                    assert_eq!(
+                        out[i].as_f64().to_bits(),
+                        want[i].as_f64().to_bits(),
+                        "N = {N}, K = {K}, from block {from}, row {i}, blocks of {w} rows"
+                    );
+                }
             }
         }
     }
 
     /// Every layout is bit-identical to the serial chain for every remainder of every
-    /// block size (host and Cortex-M therefore agree bit for bit: same chains, same order).
+    /// block size and every starting block (host and Cortex-M therefore agree bit for
+    /// bit: same chains, same order).
     #[test]
     fn both_layouts_sum_rows_in_serial_order() {
         macro_rules! sizes { ($($n:literal)*) => { $(
