@@ -224,15 +224,10 @@ impl NewmarkKinematics<f64> {
     /// scalar type they will be rounded to): with a large β or γ, `β h²` can overflow where
     /// `h²` does not.
     pub(crate) const fn fits(&self, max: f64) -> bool {
-        let xs = [self.h, self.c_v, self.c_u, self.gamma_h, self.beta_h2];
-        let mut i = 0;
-        while i < xs.len() {
-            if !(xs[i].is_finite() && xs[i].abs() <= max) {
-                return false;
-            }
-            i += 1;
-        }
-        true
+        crate::linalg::all_fit(
+            &[self.h, self.c_v, self.c_u, self.gamma_h, self.beta_h2],
+            max,
+        )
     }
 
     /// Rounded once to `T` (run time).

@@ -159,7 +159,7 @@ pub(crate) fn unit_ratio(x: f64) -> bool {
 ///
 /// Errors: [`Error::OperatorOverflow`](crate::Error::OperatorOverflow).
 pub(crate) fn fits<T: Real>(xs: &[f64]) -> Result<(), crate::Error> {
-    if xs.iter().all(|x| x.is_finite() && x.abs() <= T::MAX) {
+    if crate::linalg::all_fit(xs, T::MAX) {
         Ok(())
     } else {
         Err(crate::Error::OperatorOverflow)

@@ -179,20 +179,34 @@ pub(crate) fn round_vec<T: Real, const N: usize>(a: &[f64; N]) -> [T; N] {
     a.map(T::from_f64_rounded)
 }
 
-/// Every entry of `a`, rounded to `T`, is finite: an operator that overflows when rounded
-/// (e.g. `1e39` to `f32`) is rejected rather than stored as `∞`.
+/// `x` (computed in `f64`) fits the scalar type whose largest finite value is `max`:
+/// finite and at most `max` in size, so it does not round to `∞`. Values within half an
+/// ulp above `max` would still round to it, and are rejected too (harmless). The one
+/// overflow test of every build (operators, kinematics, spectra, material laws).
+pub(crate) const fn fits_value(x: f64, max: f64) -> bool {
+    x.is_finite() && x.abs() <= max
+}
+
+/// Every value of `xs` [fits](fits_value) the scalar type whose largest finite value is
+/// `max`.
+pub(crate) const fn all_fit(xs: &[f64], max: f64) -> bool {
+    let mut i = 0;
+    while i < xs.len() {
+        if !fits_value(xs[i], max) {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+/// Every entry of `a`, rounded to `T` (largest finite value `max`), is finite: an operator
+/// that overflows when rounded (e.g. `1e39` to `f32`) is rejected rather than stored as `∞`.
 pub(crate) const fn finite_as<const R: usize, const C: usize>(a: &Mat<R, C>, max: f64) -> bool {
     let mut i = 0;
     while i < R {
-        let mut j = 0;
-        while j < C {
-            // `max` is the largest finite value of the target type; values within half
-            // an ulp above it would still round to it, and are rejected too (harmless).
-            let x = a[i][j];
-            if !x.is_finite() || x.abs() > max {
-                return false;
-            }
-            j += 1;
+        if !all_fit(&a[i], max) {
+            return false;
         }
         i += 1;
     }

@@ -2,6 +2,7 @@
 
 use super::operators::{self, SdofOps};
 use super::{MAX_SUBSTEPS, Scheme, Substeps};
+use crate::linalg::{all_fit, fits_value};
 use crate::{Error, Real};
 use core::f64::consts::TAU;
 
@@ -95,12 +96,6 @@ pub(super) const fn substeps_for(rule: Substeps, dt: f64, t: f64) -> u16 {
     }
 }
 
-/// `x` finite and at most `max` in size (it fits the scalar type whose largest finite value
-/// is `max`).
-const fn fits(x: f64, max: f64) -> bool {
-    x.is_finite() && x.abs() <= max
-}
-
 /// The homogeneous part of a map is bounded as a damped oscillator's must be: the energy
 /// `(ω²u² + v²)/2` never grows, so `|uu|, |vv|, ω|uv|, |vu|/ω ≤ 1` (exactly for both
 /// schemes; here within `1e-6`). The exact scheme's matrix exponential loses that, and all
@@ -143,14 +138,7 @@ const fn oscillator_fits(op: &SdofOps, whole: &SdofOps, w: f64, z: f64, ka: f64,
         1.0 / w,
         2.0 * z * w / (w * w * w),
     ];
-    let mut i = 0;
-    while i < xs.len() {
-        if !fits(xs[i], max) {
-            return false;
-        }
-        i += 1;
-    }
-    true
+    all_fit(&xs, max)
 }
 
 /// Check the inputs and compute the `f64` operators (shared by the `f32` and `f64`
@@ -235,7 +223,7 @@ pub(super) const fn build_f64<const P: usize>(
         fits_all &= oscillator_fits(&out.ops[p], &out.whole[p], w, z, out.ka[p], max);
         p += 1;
     }
-    if !(fits_all && fits(1.0 / dt, max)) {
+    if !(fits_all && fits_value(1.0 / dt, max)) {
         return Err(Error::OperatorOverflow);
     }
     Ok(out)
