@@ -192,27 +192,28 @@ fn bench_references<T: Real, const N: usize>(
     });
 }
 
+/// Whether the CPU (and OS) run the x86 feature `$f` (a string literal); never in the
+/// SSE2-only control build (`--cfg aemstep_control="sse2-only"`), which keeps its floors on
+/// SSE2 too.
+macro_rules! runs {
+    ($f:tt) => {{
+        #[cfg(all(target_arch = "x86_64", not(aemstep_control = "sse2-only")))]
+        let yes = std::is_x86_feature_detected!($f);
+        #[cfg(not(all(target_arch = "x86_64", not(aemstep_control = "sse2-only"))))]
+        let yes = false;
+        yes
+    }};
+}
+
 /// Whether the CPU (and OS) run AVX: then the step's column-blocked product runs on AVX
 /// registers (`src/linalg/avx.rs`), and so do the floors it is compared with.
 fn has_avx() -> bool {
-    // The SSE2-only control build (`--cfg aemstep_control="sse2-only"`) keeps its floors
-    // on SSE2 too.
-    #[cfg(all(target_arch = "x86_64", not(aemstep_control = "sse2-only")))]
-    return std::is_x86_feature_detected!("avx");
-    #[cfg(aemstep_control = "sse2-only")]
-    return false;
-    #[cfg(not(target_arch = "x86_64"))]
-    false
+    runs!("avx")
 }
 
 /// Whether the CPU (and OS) run AVX2 (256-bit integer adds, for the read floor's sum).
 fn has_avx2() -> bool {
-    #[cfg(all(target_arch = "x86_64", not(aemstep_control = "sse2-only")))]
-    return std::is_x86_feature_detected!("avx2");
-    #[cfg(aemstep_control = "sse2-only")]
-    return false;
-    #[cfg(not(target_arch = "x86_64"))]
-    false
+    runs!("avx2")
 }
 
 /// One pass over `words` (a wrapping integer sum, which the compiler vectorizes freely).

@@ -300,12 +300,10 @@ pub(crate) const fn fits<const R: usize, const C: usize, const R2: usize, const 
     while i < R {
         let mut j = 0;
         while j < C {
-            // Values within half an ulp above `max` would still round to it, and are
-            // rejected too (harmless).
-            let x = a[i][j].abs();
-            if !x.is_finite() || x > max {
+            if !fits_value(a[i][j], max) {
                 return Err(crate::Error::OperatorOverflow);
             }
+            let x = a[i][j].abs();
             if x > m {
                 m = x;
             }
