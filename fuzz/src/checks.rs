@@ -1900,6 +1900,9 @@ fn laws_typed<T: Real>(d: &LawData, which: u8) {
     // `2^{1/n} z_max` when `β + γ > 0`; with `γ = −β` it does not saturate, `|z|` grows by
     // up to `2|Δ|/u_y` a step, and the unloading tangent `k |z|ⁿ` of a deformation of
     // `10 u_y` with `n = 1000` is beyond `f64` (the fuzzer's first such "NaN" was that).
+    // The slope `g` itself must fit too, as the law documents ("the unloading slope can
+    // leave `T`"): with `k = 1e-62` the tangent `k g ≈ 1e270` fits where `g ≈ 1e334`
+    // (`|z| = 2.16`, `n = 1000`) does not (found by fuzzing).
     let bw_judged = |hist: &BoucWenHistory<T>, step: f64| {
         let bg = d.beta + d.gamma;
         let zb = if bg > 0.0 {
@@ -1911,7 +1914,7 @@ fn laws_typed<T: Real>(d: &LawData, which: u8) {
             hist.z.as_f64().abs() + 2.0 * step.abs()
         };
         let log_wn = (d.beta + d.gamma.abs()).ln() + d.n * zb.ln();
-        d.k.ln() + log_wn.max(0.0) + 16f64.ln() < T::MAX.ln()
+        d.k.ln().max(0.0) + log_wn.max(0.0) + 16f64.ln() < T::MAX.ln()
     };
     if let Ok(l) = &bw {
         drive_law(l, "BoucWen", uy, d, d.k * 4.0 >= T::MAX, bw_judged);
