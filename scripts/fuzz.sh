@@ -6,6 +6,24 @@
 # executions, time, crashes and the checks' counters, and writes them to
 # fuzz/target/fuzz-stats.txt.
 #
+# Two modes:
+# - The default (what the test command runs) is reproducible: each target executes a
+#   fixed number of inputs (RUNS below, about 30 s each here) from a fixed seed
+#   (FUZZ_SEED, default 1), single process, no corpus reloading, from an empty scratch
+#   directory, and without comparison-guided mutations (-use_cmp=0: the operands libFuzzer
+#   records include addresses — a slice iterator compares pointers — which differ from
+#   process to process, and two runs diverged after 4800 executions). libFuzzer then
+#   mutates the same inputs in the same order on every run of the same commit (same
+#   toolchain and system; checked: three runs, with ASLR and different environments,
+#   identical): a commit that passed here passes in CI,
+#   and a crash CI reports is reproduced by running this script on that commit. A time
+#   cap (FUZZ_CAP seconds, default 120) bounds a slow machine; what it cuts short is a
+#   prefix of the same sequence. (Randomly seeded, the test command's 30 s found new cases
+#   in two recent CI runs, one on a commit that changed only a docs page.)
+# - --explore searches on: a random seed (printed), FUZZ_SECONDS per target, no run
+#   limit. Run it to look for new failures; each one found is fixed, its input kept in
+#   fuzz/regressions/<target>/, and --merge folds the new coverage into the corpus.
+#
 # How it is built, and why without cargo-fuzz: cargo-fuzz is only a driver — it runs
 # `cargo build` with the sanitizer-coverage flags below and runs the binaries. Doing that
 # here needs nothing but the stable toolchain and a C++ compiler (libfuzzer-sys compiles
@@ -17,7 +35,9 @@
 # overflow checks on. `--target` keeps the flags off build scripts and proc macros.
 #
 # Usage: bash scripts/fuzz.sh [options] [TARGET...]   (default: every target)
-#   FUZZ_SECONDS=N   seconds per target (default 30)
+#   FUZZ_SEED=N      the seed of the reproducible run (default 1)
+#   FUZZ_CAP=N       its time cap per target, seconds (default 120)
+#   --explore        a randomly seeded run instead, FUZZ_SECONDS per target (default 30)
 #   --merge          afterwards, minimize the kept corpus plus this run's new inputs into
 #                    fuzz/corpus/<target>/ (libFuzzer -merge=1; capped at 200 files)
 #   --record         copy the stats to fuzz/stats.txt (committed; docs/robustness.md
@@ -29,7 +49,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 TARGETS_ALL=(linear_family modal nonlinear hysteresis observer spectrum)
+# Executions per target of the reproducible run: about 30 s each on a 2-core host (the
+# targets differ in cost per input by a factor of ten).
+declare -A RUNS=([linear_family]=30000 [modal]=300000 [nonlinear]=300000
+    [hysteresis]=200000 [observer]=150000 [spectrum]=90000)
 SECS=${FUZZ_SECONDS:-30}
+SEED=${FUZZ_SEED:-1}
+CAP=${FUZZ_CAP:-120}
+explore=0
 merge=0
 record=0
 selftest=0
@@ -37,6 +64,7 @@ targets=()
 for a in "$@"; do
     case "$a" in
     --merge) merge=1 ;;
+    --explore) explore=1 ;;
     --record) record=1 ;;
     --self-test) selftest=1 ;;
     -*) echo "unknown option $a" >&2; exit 2 ;;
@@ -69,13 +97,19 @@ build() { # the instrumented binaries
 bin="$CARGO_TARGET_DIR/$host/release"
 out="$CARGO_TARGET_DIR/fuzz-run"
 
-# run TARGET SECONDS: one bounded run from the kept corpus; new inputs go to a scratch
-# directory (the committed corpus is only read). Returns libFuzzer's exit status.
+# run TARGET SECONDS [RUNS SEED]: one bounded run from the kept corpus; new inputs go to
+# an emptied scratch directory (the committed corpus is only read). With RUNS and SEED:
+# that many executions from that seed (SECONDS caps them), reproducibly; without, a random
+# seed for SECONDS. Returns libFuzzer's exit status.
 run() {
-    local t=$1 secs=$2
+    local t=$1 secs=$2 runs=${3:-} seed=${4:-0}
+    rm -rf "$out/$t/new"
     mkdir -p "$out/$t/new" "fuzz/corpus/$t"
     rm -f "$out/$t/counts" "$out/$t/crash-"*
+    local limit=()
+    [ -z "$runs" ] || limit=(-runs="$runs" -use_cmp=0)
     AEMSTEP_FUZZ_COUNTS="$out/$t/counts" "$bin/$t" "$out/$t/new" "fuzz/corpus/$t" \
+        "${limit[@]}" -seed="$seed" -reload=0 \
         -max_total_time="$secs" -max_len=1024 -timeout=20 -rss_limit_mb=2048 \
         -artifact_prefix="$out/$t/" -print_final_stats=1 >"$out/$t/log" 2>&1
 }
@@ -87,7 +121,7 @@ if [ "$selftest" = 1 ]; then
     echo "==> self-test: an injected panic must fail the fuzz run"
     build
     t=linear_family
-    if AEMSTEP_FUZZ_INJECT_PANIC=1 run "$t" 30; then
+    if AEMSTEP_FUZZ_INJECT_PANIC=1 run "$t" 30 "" "$SEED"; then
         fail "self-test: the run with an injected panic passed"
     fi
     grep -q "injected panic" "$out/$t/log" || fail "self-test: no injected panic in the log"
@@ -102,18 +136,32 @@ build
 echo "built in $(( $(date +%s) - start )) s"
 
 stats="$CARGO_TARGET_DIR/fuzz-stats.txt"
-{
-    echo "# scripts/fuzz.sh: $SECS s per target; $(rustc --version)"
-} >"$stats"
+if [ "$explore" = 1 ]; then
+    mode="exploring: a random seed, $SECS s per target"
+else
+    mode="reproducible: seed $SEED, a fixed number of executions per target"
+fi
+echo "# scripts/fuzz.sh: $mode; $(rustc --version)" >"$stats"
 crashed=()
 for t in "${targets[@]}"; do
     [ -x "$bin/$t" ] || fail "no fuzz target $t"
-    echo "==> fuzzing $t for $SECS s (from fuzz/corpus/$t: $(find "fuzz/corpus/$t" -type f 2>/dev/null | wc -l) inputs)"
+    n=$(find "fuzz/corpus/$t" -type f 2>/dev/null | wc -l)
     status=0
-    run "$t" "$SECS" || status=$?
+    t0=$(date +%s)
+    if [ "$explore" = 1 ]; then
+        echo "==> fuzzing $t for $SECS s, randomly seeded (from fuzz/corpus/$t: $n inputs)"
+        run "$t" "$SECS" || status=$?
+        sed -n 's/^INFO: Seed: /seed: /p' "$out/$t/log" | head -1
+    else
+        echo "==> fuzzing $t: ${RUNS[$t]} executions from seed $SEED (from fuzz/corpus/$t: $n inputs; cap $CAP s)"
+        run "$t" "$CAP" "${RUNS[$t]}" "$SEED" || status=$?
+    fi
     execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$out/$t/log" | tail -1)
-    time_s=$(sed -n 's/^Done [0-9]* runs in \([0-9]*\) second.*/\1/p' "$out/$t/log" | tail -1)
+    time_s=$(( $(date +%s) - t0 ))
     crashes=$(find "$out/$t" -maxdepth 1 -name 'crash-*' | wc -l)
+    if [ "$explore" = 0 ] && [ "$status" = 0 ] && [ "${execs:-0}" -lt "${RUNS[$t]}" ]; then
+        echo "note: $t stopped at its cap of $CAP s after ${execs:-0} of ${RUNS[$t]} executions (a prefix of the same sequence)"
+    fi
     if [ "$status" != 0 ] || [ "$crashes" != 0 ]; then
         crashed+=("$t")
         grep -E "property broken|panicked|ERROR: libFuzzer|data:" "$out/$t/log" | head -20 >&2 || true
@@ -121,10 +169,10 @@ for t in "${targets[@]}"; do
         [ "$crashes" != 0 ] || crashes=1
     fi
     {
-        echo "TARGET $t executions ${execs:-0} seconds ${time_s:-$SECS} crashes $crashes"
+        echo "TARGET $t executions ${execs:-0} seconds $time_s crashes $crashes"
         [ -f "$out/$t/counts" ] && cat "$out/$t/counts"
     } >>"$stats"
-    echo "$t: ${execs:-0} executions in ${time_s:-$SECS} s, $crashes crash(es)"
+    echo "$t: ${execs:-0} executions in $time_s s, $crashes crash(es)"
     if [ "$merge" = 1 ] && [ "$crashes" = 0 ]; then
         # Minimize the kept corpus and this run's new inputs into a fresh set covering all
         # of their coverage; keep it if it is small enough to commit.

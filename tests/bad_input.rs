@@ -796,6 +796,125 @@ fn bouc_wen_negative_gamma_stays_bounded_under_cyclic_steps() {
     }
 }
 
+/// Bouc–Wen at its saturation bound under huge steps (`β = γ = 1`, `n = 2`, from the test
+/// command's fuzz stage): a step of `−1.4e144 u_y` ends at `g(z) = −g₀ = −1`, i.e. `z` at
+/// the trapezoidal bound `2^{1/n} z_max = 1`, where rounding (`κ = √2` one ulp high) makes
+/// the next loading slope `g₀ = −1 − 4e-16`. The next step (`c = 2.4e142`) then had no
+/// bounded root — `g ≤ 1`, so `z − z₀ = c (g₀ + g) ≈ −c · 4e-16` — and `z = −1e127`, the
+/// step after `z = −∞`. The loading slope is now taken as at least `−1` (its value at the
+/// bound), and `z` stays within the bound under any path of huge steps, whatever `β, γ, n`.
+#[test]
+fn bouc_wen_huge_steps_at_the_saturation_bound_stay_bounded() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let uy = 0.1;
+    let law = BoucWen::<f64>::new(1e3, 1e2, 0.0, 1.0, 1.0, 2.0).unwrap();
+    let mut h = law.initial_history();
+    let path = [
+        -9.998,
+        -6.17,
+        -1.4497350084814718e144,
+        7.29,
+        4.877732109868738e142,
+        -10.0,
+    ];
+    for x in path {
+        let t = law.trial(&h, x * uy, -10.0);
+        assert!(
+            t.force.is_finite() && t.history.z.abs() <= 1.0 + 4.0 * f64::EPSILON,
+            "step to {x} u_y: {t:?}"
+        );
+        h = t.history;
+    }
+    for (beta, gamma, n) in [
+        (1.0, 1.0, 2.0),
+        (0.5, 0.5, 1.0),
+        (0.5, -0.25, 2.0),
+        (2.0, 1.0, 3.5),
+    ] {
+        let law = BoucWen::<f64>::new(1e3, 1e2, 0.0, beta, gamma, n).unwrap();
+        let bound = 2f64.powf(1.0 / n) * (beta + gamma).powf(-1.0 / n) * (1.0 + 8.0 * f64::EPSILON);
+        for amp in [1e20, 1e143, 1e300] {
+            let mut h = law.initial_history();
+            for i in 0..200 {
+                let x = [amp, -amp, 0.5 * amp, 1.0, -3.0 * amp][i % 5] * uy;
+                let t = law.trial(&h, x, 1.0);
+                assert!(
+                    t.force.is_finite() && t.history.z.abs() <= bound,
+                    "β = {beta}, γ = {gamma}, n = {n}, amplitude {amp}, step {i}: {t:?}"
+                );
+                h = t.history;
+            }
+        }
+    }
+}
+
+/// Bouc–Wen in `f32` with `β = 8.5e229`, `n = 6` (`κ = 2e38`, `z_max` subnormal) at a
+/// step of `2.8e-44` from saturation (found by fuzzing): `Δ/2u_y` underflows to 0, and
+/// the tangent's `1 − c ∂g/∂z` was `1 − 0·∞ = NaN` (`∂g/∂z ≈ n κ` overflows `f32`). Such a
+/// step does not move `z`, and its tangent is the limit `g₀/u_y`: the same as the `f64`
+/// law's (where `c ∂g/∂z ≈ 1e-11`) to `f32` rounding.
+#[test]
+fn bouc_wen_f32_step_whose_increment_underflows_has_a_finite_tangent() {
+    use aemstep::hysteresis::{BoucWen, BoucWenHistory, Law};
+    let (k, fy, alpha, beta, gamma, n) = (
+        8.050498138213321,
+        1e7,
+        0.99,
+        8.462191772460943e229,
+        0.5,
+        6.0,
+    );
+    let l32 = BoucWen::<f32>::new(k, fy, alpha, beta, gamma, n).unwrap();
+    let l64 = BoucWen::<f64>::new(k, fy, alpha, beta, gamma, n).unwrap();
+    // The fuzz input's path: saturation at z < 0, at z > 0, then d = −0 (z < 0 again).
+    let mut t0 = l32.trial(&l32.initial_history(), -8.914372e6, -1.0);
+    for d in [2.0808334e4, -0.0] {
+        t0 = l32.trial(&t0.history, d, 0.0);
+    }
+    assert!(t0.history.z < 0.0, "{t0:?}");
+    let t32 = l32.trial(&t0.history, 2.8e-44, 0.0);
+    let h64 = BoucWenHistory {
+        deformation: f64::from(t0.history.deformation),
+        z: f64::from(t0.history.z),
+    };
+    let t64 = l64.trial(&h64, f64::from(2.8e-44f32), 0.0);
+    assert_eq!(t32.history.z, t0.history.z);
+    let (s32, s64) = (f64::from(t32.stiffness), t64.stiffness);
+    assert!(
+        t32.force.is_finite() && (s32 - s64).abs() <= 4.0 * f64::from(f32::EPSILON) * s64.abs(),
+        "f32 {t32:?}, f64 {t64:?}"
+    );
+}
+
+/// Bouc–Wen with a subnormal `u_y` (`f_y = 1.1e-305`, `k = 1e3`; found by fuzzing): a
+/// trial at the committed deformation (a rate reversal, `Δ = 0`) has the slope
+/// `g₀/u_y = 2.3 × 8.8e307 = ∞`, and the tangent was `∞` where it is
+/// `α k + (1 − α) k g₀ ≈ 2.2e3`. The slope is kept in units of `1/u_y` now: the tangent is
+/// that closed form, `g₀ = 1 + (β − γ) z₀²` on unloading (`n = 2`).
+#[test]
+fn bouc_wen_tangent_with_a_subnormal_yield_deformation_is_finite() {
+    use aemstep::hysteresis::{BoucWen, Law};
+    let (k, fy, alpha, beta, gamma) = (
+        1e3,
+        1.1392378155556871e-305,
+        0.09532012939453124,
+        3.0194091796875,
+        0.5,
+    );
+    let law = BoucWen::<f64>::new(k, fy, alpha, beta, gamma, 2.0).unwrap();
+    let d = 9.99969482421875 * (fy / k);
+    let t1 = law.trial(&law.initial_history(), d, 1.0);
+    let z0 = t1.history.z;
+    assert!(z0 > 0.5 && t1.stiffness.is_finite(), "{t1:?}");
+    // Reversal at the same deformation: unloading (s z₀ < 0), g₀ = 1 + (β − γ) z₀².
+    let t2 = law.trial(&t1.history, d, -10.0);
+    let expected = alpha * k + (1.0 - alpha) * k * (1.0 + (beta - gamma) * z0 * z0);
+    assert!(
+        (t2.stiffness - expected).abs() <= 8.0 * f64::EPSILON * expected,
+        "{t2:?}, expected {expected}"
+    );
+}
+
 /// A steady-state Kalman gain whose closed loop has modes at `0.99988` (the fuzz input
 /// `riccati-residual-3e-3`: an `exact` model of an indefinite `M`, `R = 1e-6`, `Q` of
 /// rank ~1). The doubling stopped at iteration 2 — `X` had not moved by `4ε` yet, while

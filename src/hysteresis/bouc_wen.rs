@@ -42,10 +42,14 @@ const FREE_NEWTON: u32 = 8;
 /// step that does not halve, is replaced by bisection (in the ordering of the numbers, so
 /// at any scale within 64 halvings), so the solve converges for any exponent and step.
 /// `g` is evaluated in `w = (β + |γ|)^{1/n} |z|`, about 1 at saturation whatever `β`, `γ`
-/// and `n`. For `γ < 0` (unloading steeper than elastic) a step that carries `z` from the
-/// unloading branch through 0 is split there, the rule applied on each smooth piece; then
-/// `|z|` never exceeds `max(|z₀|, 2^{1/n} z_max)` for `β + γ > 0`, under any path
-/// (unsplit, cyclic steps of about `u_y` grew `z` without bound). For `γ = −β`, `z` does
+/// and `n`. For `γ < β` (unloading steeper than elastic, `g = 1 + (β − γ)|z|ⁿ`) a step that
+/// carries `z` from the unloading branch through 0 is split there, the rule applied on each
+/// smooth piece, and a loading slope below `−1` (`|z|` beyond `2^{1/n} z_max`: by rounding,
+/// or a history set there) is taken as `−1`, its value at that bound; then `|z|` never
+/// exceeds `max(|z₀|, 2^{1/n} z_max)` for `β + γ > 0`, under any path. (Unsplit, cyclic
+/// steps of about `u_y` grew `z` without bound for `γ < 0`, and huge steps for
+/// `0 ≤ γ < β` left `z` beyond the bound; with a slope below `−1` a huge step has no
+/// bounded root, and `z` overflowed two steps later.) For `γ = −β`, `z` does
 /// not saturate (`g = 1` on loading), and the unloading slope `1 + 2β |z|ⁿ` can leave
 /// `T`: then the force or tangent is not finite and the stepper reports
 /// [`Error::NonFiniteForce`].
@@ -64,6 +68,8 @@ const FREE_NEWTON: u32 = 8;
 pub struct BoucWen<T> {
     ak: T,
     cz: T,
+    /// `(1 − α) k`: the hysteretic part's stiffness, `cz / u_y`.
+    ck: T,
     inv_uy: T,
     half_inv_uy: T,
     /// `κ = (β + |γ|)^{1/n}`: `g` is evaluated in `w = κ |z|`, so that `|z|ⁿ (β ± γ) =
@@ -74,7 +80,7 @@ pub struct BoucWen<T> {
     sigma_load: T,
     /// `σ₋ = (γ − β)/(β + |γ|)` (unloading), in `[−1, 0]`.
     sigma_unload: T,
-    /// `γ < 0`: steps from the unloading branch are split where `z` crosses 0.
+    /// `γ < β`: steps from the unloading branch are split where `z` crosses 0.
     split_at_zero: bool,
     n: T,
     /// `1` or `2` for the exponents computed without `powf`, else `0`.
@@ -89,7 +95,7 @@ pub struct BoucWen<T> {
 pub struct BoucWenHistory<T> {
     /// Deformation `d` at the end of the last accepted step.
     pub deformation: T,
-    /// Hysteretic variable `z` (dimensionless, `|z| ≤ z_max`).
+    /// Hysteretic variable `z` (dimensionless; within `2^{1/n} z_max` when `β + γ > 0`).
     pub z: T,
 }
 
@@ -132,6 +138,7 @@ impl<T: Real> BoucWen<T> {
         let c = [
             alpha * k,
             (1.0 - alpha) * fy,
+            (1.0 - alpha) * k,
             k / fy,
             0.5 * k / fy,
             kappa,
@@ -159,13 +166,14 @@ impl<T: Real> BoucWen<T> {
         Ok(Self {
             ak: r(c[0]),
             cz: r(c[1]),
-            inv_uy: r(c[2]),
-            half_inv_uy: r(c[3]),
-            kappa: r(c[4]),
-            sigma_load: r(c[5]),
-            sigma_unload: r(c[6]),
-            n: r(c[7]),
-            split_at_zero: gamma < 0.0,
+            ck: r(c[2]),
+            inv_uy: r(c[3]),
+            half_inv_uy: r(c[4]),
+            kappa: r(c[5]),
+            sigma_load: r(c[6]),
+            sigma_unload: r(c[7]),
+            n: r(c[8]),
+            split_at_zero: gamma < beta,
             n_kind: if n == 1.0 {
                 1
             } else if n == 2.0 {
@@ -217,7 +225,7 @@ impl<T: Real> BoucWen<T> {
         )
     }
 
-    /// The trapezoidal update's `z` and `dz/dd` for a step with `c = Δ/(2u_y) ≠ 0` from
+    /// The trapezoidal update's `z` and `u_y dz/dd` for a step with `c = Δ/(2u_y) ≠ 0` from
     /// `z₀` (`g₀ = g(z₀, s)`): the root of `r(z) = z − z₀ − c (g₀ + g(z))`, which has slope
     /// `1 − c ∂g/∂z ≥ 1` and lies between `z₀` and the predictor `z₀ + 2c g₀`.
     ///
@@ -356,25 +364,19 @@ impl<T: Real> BoucWen<T> {
                 }
             }
         }
-        // (g₀ + g)/(2u_y (1 − c ∂g/∂z)), for |c| > 1 with numerator and denominator
-        // divided by |c| (at c = ±∞ the root has g = −g₀ and the increment does not move
-        // z). Divided before the multiplication by 1/(2u_y) where the product overflows:
-        // with n = 2.9e17, z within its tolerance of saturation has g ≈ −1e250, the
-        // denominator is as large, and (g₀ + g)/(2u_y) was −∞ at u_y = 8e-265 (found by
-        // fuzzing).
+        // u_y dz/dd = (g₀ + g)/(2 (1 − c ∂g/∂z)), for |c| > 1 with numerator and
+        // denominator divided by |c| (at c = ±∞ the root has g = −g₀ and the increment does
+        // not move z). In units of 1/u_y, which is not formed: with n = 2.9e17, z within
+        // its tolerance of saturation has g ≈ −1e250, the denominator is as large, and
+        // (g₀ + g)/(2u_y) was −∞ at u_y = 8e-265 (found by fuzzing).
         let (num, den) = if big {
             ((g0 + g) * a, a - b * dg)
         } else {
             (g0 + g, one - c * dg)
         };
-        let dz_dd = if num == zero {
-            zero
-        } else if (num * self.half_inv_uy).is_finite() {
-            num * self.half_inv_uy / den
-        } else {
-            num / den * self.half_inv_uy
-        };
-        (z, dz_dd)
+        let half = T::from_f64_rounded(0.5);
+        let slope = if num == zero { zero } else { num * half / den };
+        (z, slope)
     }
 }
 
@@ -437,16 +439,33 @@ impl<T: Real> Law<T> for BoucWen<T> {
             -one
         };
         let (g0, _) = self.g(z0, s);
-        let (z, dz_dd) = if delta == T::zero() {
-            (z0, g0 * self.inv_uy)
+        // The loading slope is at least −1 within |z| ≤ 2^{1/n} z_max, where every step
+        // keeps z; below −1 only by rounding (κ |z| one ulp beyond its bound) or from a
+        // history set beyond it. There a step of c = Δ/2u_y has no bounded root: g(z)
+        // stays ≤ 1, so the trapezoidal rule's z − z₀ = c (g₀ + g) ≈ −c (g₀ + 1) grew with
+        // c (g₀ = −1 − 4e-16 and c = 2e142 gave z = −1e127, the next step z = −∞; found
+        // by fuzzing). The slope is taken as −1, its value at the bound: the root is then
+        // between 0 and z₀.
+        let g0 = if g0 < -one { -one } else { g0 };
+        let c = delta * self.half_inv_uy;
+        // A step whose Δ/2u_y underflows to 0 does not move z either: its tangent is the
+        // limit g₀/u_y. (Solved, 1 − c ∂g/∂z was 1 − 0·∞ = NaN where ∂g/∂z overflows:
+        // Δ = 2.8e-44 at u_y = 1.2e6 in f32, with κ = 2e38 for β = 8e229; found by fuzzing.)
+        // The slope is kept in units of 1/u_y (`slope = u_y dz/dd`) and the tangent is
+        // α k + (1 − α) k · slope: g₀/u_y alone was ∞ at u_y = 1.1e-308, g₀ = 2.3, where the
+        // tangent is 2.4e3 (found by fuzzing).
+        let (z, slope) = if c == T::zero() {
+            (z0, g0)
         } else {
-            let c = delta * self.half_inv_uy;
-            // γ < 0: a step from the unloading branch that carries z through 0 is split
+            // γ < β: a step from the unloading branch that carries z through 0 is split
             // there (the trapezoidal rule on each smooth piece). Unsplit, its explicit half
-            // took the unloading slope g₀ = 1 + ρ wⁿ (ρ = (β − γ)/(β + γ) > 1) over the
-            // whole step, overshot past z_max on the other side by up to ρ, and under cyclic
-            // steps of a few u_y z grew without bound to a force of ∞ (found by testing the
-            // fuzz finding's neighbourhood). Split, z stays within max(|z₀|, 2^{1/n} z_max).
+            // took the unloading slope g₀ = 1 + ρ wⁿ (ρ = (β − γ)/(β + γ) > 0) over the
+            // whole step and overshot on the other side to wⁿσ₊ = 2 + ρ wⁿσ₊(z₀), past the
+            // bound 2: for γ < 0 (ρ > 1) cyclic steps of a few u_y grew z without bound to a
+            // force of ∞ (found by testing the fuzz finding's neighbourhood); for γ ≥ 0
+            // huge steps left z beyond the bound, with a loading slope below −1 (found by
+            // testing the fuzz finding of the clamp above). Split, z stays within
+            // max(|z₀|, 2^{1/n} z_max).
             // (c* = −z₀/(g₀ + 1): the increment that brings z₀ to 0, where g = 1.)
             let c_zero = -z0 / (g0 + one);
             if self.split_at_zero && s * z0 < T::zero() && c.abs() > c_zero.abs() {
@@ -457,7 +476,7 @@ impl<T: Real> Law<T> for BoucWen<T> {
         };
         LawTrial {
             force: self.ak * d + self.cz * z,
-            stiffness: self.ak + self.cz * dz_dd,
+            stiffness: self.ak + self.ck * slope,
             damping: T::zero(),
             history: BoucWenHistory { deformation: d, z },
             inelastic: s * z > T::zero(),
