@@ -12,7 +12,8 @@
 #   (FUZZ_SEED, default 1), single process, no corpus reloading, from an empty scratch
 #   directory, and without comparison-guided mutations (-use_cmp=0: the operands libFuzzer
 #   records include addresses — a slice iterator compares pointers — which differ from
-#   process to process, and two runs diverged after 4800 executions). libFuzzer then
+#   process to process, and two runs diverged after 4800 executions), with the corpus
+#   given as a list in name order (see run). libFuzzer then
 #   mutates the same inputs in the same order on every run of the same commit (same
 #   toolchain and system; checked: three runs, with ASLR and different environments,
 #   identical): a commit that passed here passes in CI,
@@ -83,19 +84,32 @@ fi
 host=$(rustc -vV | sed -n 's/^host: //p')
 [ -n "$host" ] || fail "rustc -vV gave no host triple"
 
-export CARGO_TARGET_DIR="$PWD/fuzz/target"
+# Built from a copy of the sources at a fixed path, into a fixed target directory: the
+# path of the build enters the binaries (debug info of libFuzzer's C++, layout), and two
+# checkouts of one commit built binaries that differ, and fuzz differently from one seed.
+# From one path, every checkout builds the same binary and runs the same inputs.
+fixed=/tmp/aemstep-fuzz-build
+export CARGO_TARGET_DIR="$fixed/target"
+work="$PWD/fuzz/target"
+mkdir -p "$work"
 flags="-Cpasses=sancov-module -Cllvm-args=-sanitizer-coverage-level=4"
 flags+=" -Cllvm-args=-sanitizer-coverage-inline-8bit-counters"
 flags+=" -Cllvm-args=-sanitizer-coverage-pc-table"
 flags+=" -Cllvm-args=-sanitizer-coverage-trace-compares --cfg fuzzing"
+# (cargo's registry may sit elsewhere on another machine)
+flags+=" --remap-path-prefix=${CARGO_HOME:-$HOME/.cargo}=/cargo"
 
-build() { # the instrumented binaries
-    RUSTFLAGS="$flags" cargo build --release --manifest-path fuzz/Cargo.toml \
-        --target "$host" --bins || fail "building the fuzz targets"
+build() { # the instrumented binaries, from the copy at $fixed/tree
+    rm -rf "$fixed/tree" && mkdir -p "$fixed/tree"
+    tar -c --exclude=./target --exclude=./fuzz/target --exclude=./.git \
+        --exclude=./fuzz/corpus --exclude=./fuzz/regressions . | tar -x -C "$fixed/tree" ||
+        fail "copying the sources to $fixed/tree"
+    (cd "$fixed/tree" && RUSTFLAGS="$flags" cargo build --release --manifest-path fuzz/Cargo.toml \
+        --target "$host" --bins) || fail "building the fuzz targets"
 }
 
 bin="$CARGO_TARGET_DIR/$host/release"
-out="$CARGO_TARGET_DIR/fuzz-run"
+out="$work/fuzz-run"
 
 # run TARGET SECONDS [RUNS SEED]: one bounded run from the kept corpus; new inputs go to
 # an emptied scratch directory (the committed corpus is only read). With RUNS and SEED:
@@ -106,9 +120,17 @@ run() {
     rm -rf "$out/$t/new"
     mkdir -p "$out/$t/new" "fuzz/corpus/$t"
     rm -f "$out/$t/counts" "$out/$t/crash-"*
-    local limit=()
-    [ -z "$runs" ] || limit=(-runs="$runs" -use_cmp=0)
-    AEMSTEP_FUZZ_COUNTS="$out/$t/counts" "$bin/$t" "$out/$t/new" "fuzz/corpus/$t" \
+    local limit=() seeds=("fuzz/corpus/$t")
+    if [ -n "$runs" ]; then
+        # The kept corpus as a list in name order: libFuzzer sorts its seed inputs by size
+        # alone, with an unstable sort, so inputs of equal size kept the order the directory
+        # listed them in — which differs between checkouts (the counts of two clones of one
+        # commit differed). A list in a fixed order is sorted the same way everywhere.
+        find "fuzz/corpus/$t" -type f | LC_ALL=C sort | paste -sd, - >"$out/$t/seeds"
+        seeds=(-seed_inputs="@$out/$t/seeds")
+        limit=(-runs="$runs" -use_cmp=0)
+    fi
+    AEMSTEP_FUZZ_COUNTS="$out/$t/counts" "$bin/$t" "$out/$t/new" "${seeds[@]}" \
         "${limit[@]}" -seed="$seed" -reload=0 \
         -max_total_time="$secs" -max_len=1024 -timeout=20 -rss_limit_mb=2048 \
         -artifact_prefix="$out/$t/" -print_final_stats=1 >"$out/$t/log" 2>&1
@@ -135,7 +157,7 @@ start=$(date +%s)
 build
 echo "built in $(( $(date +%s) - start )) s"
 
-stats="$CARGO_TARGET_DIR/fuzz-stats.txt"
+stats="$work/fuzz-stats.txt"
 if [ "$explore" = 1 ]; then
     mode="exploring: a random seed, $SECS s per target"
 else

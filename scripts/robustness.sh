@@ -59,7 +59,8 @@ compared with the unchecked step, each failed step's state compared bit by bit, 
 data given to every constructor that takes it (the same error expected where the data
 is bad). The recorded run is the test command's: from a fixed seed, a fixed number of
 executions per target, single process, without comparison-guided mutations (their
-operands include addresses, which vary from run to run), so the inputs, executions and counts are the same
+operands include addresses, which vary from run to run), with the kept corpus given in name
+order, and built from a fixed path, so the inputs, executions and counts are the same
 on every run of this commit with the same toolchain (the time is the host's).
 
 | target | constructors and steps | executions (host run) | time, s (host run) | inputs: finite (host run) | extreme (host run) | non-finite (host run) | built (host run) | rejected, typed error (host run) | checked steps (host run) | failed checked steps (host run) | crashes | garbage accepted | failed steps that changed state |
@@ -161,6 +162,9 @@ Library fixes (each `Ok` with garbage, or a wrong error, before):
 - Bouc–Wen with a subnormal `u_y` (`f_y = 1.1e-305`, `k = 1e3`): at a rate reversal the
   slope `g₀/u_y` was `∞` where the tangent `α k + (1 − α) k g₀` is 2.2e3. The slope is
   kept in units of `1/u_y` now, and the tangent formed with `(1 − α) k`.
+- A measurement-noise covariance singular to rounding (relative determinant `−3e-21`)
+  passed `Kalman::new`'s Cholesky test and failed `SteadyState`'s LU: `Ok` from one,
+  `InvalidCovariance` from the other. Definiteness needs both factorizations now.
 - `ShearBuilding` with a floor mass of 6.2e-322 kg: 0 in `f32`, and the start failed with
   `SingularMass`. A mass below the smallest normal number of the scalar type is
   `OperatorUnderflow`.

@@ -666,6 +666,40 @@ fn riccati_solution_that_is_not_a_covariance_is_rejected() {
     );
 }
 
+/// A measurement-noise covariance singular to rounding (relative determinant `−3e-21`,
+/// entries near 1e-272; found by fuzzing) passed `Kalman::new`'s Cholesky test and failed
+/// `SteadyState`'s LU: the same `R` got `Ok` from one and `InvalidCovariance` from the
+/// other. Definiteness needs both factorizations now: `InvalidCovariance` from each, and a
+/// well-conditioned `R` at that scale still passes both.
+#[test]
+fn covariance_singular_to_rounding_is_invalid_for_every_observer() {
+    use aemstep::observer::{Kalman, Outputs, StateSpace, SteadyState};
+    let ss = StateSpace::<2, 4, 1>::aem(
+        &(M2::identity() * 2.0),
+        &M2::zeros(),
+        &(M2::identity() * 3.0),
+        &matrix![1.0; 0.0],
+        0.1,
+    )
+    .unwrap();
+    let meas = ss
+        .outputs(&Outputs::displacements(Outputs::<2, 1, 2>::select([0, 1])))
+        .unwrap();
+    let q = SMatrix::<f64, 4, 4>::zeros();
+    let r = matrix![9.95123147964477e-273, 9.975281506776804e-273;
+                    9.975281506776804e-273, 9.99938965775072e-273];
+    assert_eq!(
+        Kalman::<f64, 4, 1, 2>::new(&ss, &meas, &q, &r).err(),
+        Some(Error::InvalidCovariance)
+    );
+    assert_eq!(
+        SteadyState::new(&ss, &meas, &q, &r).err(),
+        Some(Error::InvalidCovariance)
+    );
+    let well = M2::identity() * 1e-272;
+    assert!(Kalman::<f64, 4, 1, 2>::new(&ss, &meas, &q, &well).is_ok());
+}
+
 /// Friction with `v_r = 1.25e-308`: `1/v_r` fits `f64` but `f_s/v_r` does not, and the
 /// trial's damping `(f_s/v_r)(1 − tanh²)` was `∞ · 0 = NaN`. Now `OperatorOverflow`.
 #[test]
