@@ -12,7 +12,7 @@
 //! `python3 scripts/bench_spectrum.py` runs it beside `sdof.spectrum` and writes
 //! `docs/spectrum.md`.
 
-#[path = "../examples/modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 
 use std::hint::black_box;

@@ -7,9 +7,9 @@
 //! Run: `cargo run --release --example hysteresis_report` (`python3 scripts/check_docs.py
 //! --write` writes the page; the test command regenerates and compares it).
 
-#[path = "hysteretic_fw/building.rs"]
+#[path = "../scenes/hysteretic/building.rs"]
 mod building;
-#[path = "modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "../tests/support/hyst.rs"]
 mod hyst;
@@ -84,7 +84,7 @@ fn main() {
 
     println!("## The yielding building under El Centro\n");
     println!(
-        "3 storeys (examples/hysteretic_fw/building.rs), the whole record, Newton to 1e-12; \
+        "3 storeys (scenes/hysteretic/building.rs), the whole record, Newton to 1e-12; \
          closure = max over the run of |E_in − (E_k + E_s + E_v + E_h)| / max E_in.\n"
     );
     let rs = [1u64, 2, 4, 8, 16, 32];

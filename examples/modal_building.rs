@@ -13,7 +13,7 @@
 //! Timing: a loop over the record, best of 7 runs of 100 passes, `black_box` on the input
 //! and the output; ns per step, including reading the one output (roof drift).
 
-#[path = "modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 
 use std::hint::black_box;

@@ -5,14 +5,14 @@
 //! Writes `docs/observer.md` (the table: error of each estimator against the truth, per
 //! storey) and `docs/observer.svg` (storey-1 drift: truth, observer estimate, open-loop
 //! model). The scene's constants (noise, seed, covariances) are in
-//! `examples/observer_fw/scene.rs`, shared with the firmware and the tests.
+//! `scenes/observer/scene.rs`, shared with the firmware and the tests.
 //!
 //! Run: `cargo run --release --example observer_building [DIR]` (default `docs`;
 //! `scripts/check_docs.py` regenerates into a temporary directory and compares).
 
-#[path = "modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
-#[path = "observer_fw/scene.rs"]
+#[path = "../scenes/observer/scene.rs"]
 mod scene;
 
 use std::fmt::Write as _;
@@ -357,7 +357,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     writeln!(
         md,
-        "agree to the digits shown (the firmware's bound against the host's `f64` run: `examples/observer_fw/reference.rs`),"
+        "agree to the digits shown (the firmware's bound against the host's `f64` run: `scenes/observer/reference.rs`),"
     )?;
     writeln!(
         md,

@@ -1,6 +1,6 @@
 //! Firmware: a yielding structure on a Cortex-M4F (QEMU `mps2-an386`) — the 3-storey
 //! shear building with bilinear (kinematic hardening) storeys of
-//! `examples/hysteretic_fw/building.rs` under the whole El Centro record, h = 0.02 s (one
+//! `scenes/hysteretic/building.rs` under the whole El Centro record, h = 0.02 s (one
 //! step per record sample), `f32`, exactly `ITERATIONS` Newton iterations a step
 //! (constant work, as a hard real-time loop needs), the storey histories committed only
 //! with a converged step.
@@ -11,7 +11,7 @@
 //! takes the next ground-acceleration sample, steps the building from the committed
 //! state and histories, and sends `(n, roof, report)` through a `heapless::spsc::Queue`;
 //! the main loop checks every 10th roof displacement against the host's f64 run
-//! (`examples/hysteretic_fw/reference.rs`, generated and bounded by
+//! (`scenes/hysteretic/reference.rs`, generated and bounded by
 //! `tests/firmware_hysteretic.rs`). Fails if a step is refused or not converged, if the
 //! roof leaves the bound, or if the two passes do not end on the same bits.
 //!
@@ -25,13 +25,13 @@
 #[macro_use]
 #[path = "fw/mod.rs"]
 mod fw;
-#[path = "hysteretic_fw/building.rs"]
+#[path = "../scenes/hysteretic/building.rs"]
 mod building;
-#[path = "modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "fw/periodic.rs"]
 mod periodic;
-#[path = "hysteretic_fw/reference.rs"]
+#[path = "../scenes/hysteretic/reference.rs"]
 mod reference;
 
 use core::cell::RefCell;

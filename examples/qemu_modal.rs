@@ -2,14 +2,14 @@
 //! (QEMU `mps2-an386`): only what the scene needs.
 //!
 //! The benchmark 5-storey building under the El Centro 1940 NS record (embedded at build
-//! time and parsed by the compiler, `examples/modal_fw/elcentro.rs`), 2 of its 5 modes,
+//! time and parsed by the compiler, `scenes/modal/elcentro.rs`), 2 of its 5 modes,
 //! roof drift as the one output: `Modal<f32, 5, 2>`, a `static` whose modes the compiler
 //! solved (no eigen-solver in flash). SysTick fires every h = 0.02 s of the
 //! core clock; its handler takes the next ground-acceleration sample, steps the modes and
 //! reads the roof drift (`R·I + 7R` + `O·R` multiply-adds), and pushes it through a
 //! `heapless::spsc::Queue` to the main loop. The main loop compares every 10th sample
 //! with the full model's roof drift computed on the host (`Linear<f64, 5>`,
-//! `examples/modal_fw/reference.rs`, generated and checked by `tests/firmware_modal.rs`)
+//! `scenes/modal/reference.rs`, generated and checked by `tests/firmware_modal.rs`)
 //! and exits with failure if the difference exceeds the truncation bound measured there.
 //!
 //! Before the timer starts it counts the instructions of one step (SysTick under
@@ -26,11 +26,11 @@
 #[macro_use]
 #[path = "fw/mod.rs"]
 mod fw;
-#[path = "modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "fw/periodic.rs"]
 mod periodic;
-#[path = "modal_fw/reference.rs"]
+#[path = "../scenes/modal/reference.rs"]
 mod reference;
 
 use core::cell::RefCell;

@@ -2,13 +2,13 @@
 //! ground-acceleration sample at a time, as a structural-monitoring node would compute it.
 //!
 //! The El Centro 1940 NS record (embedded and parsed by the compiler,
-//! `examples/modal_fw/elcentro.rs`) feeds a `static` `Bank<f32, 100>` (5 % damping, 100
+//! `scenes/modal/elcentro.rs`) feeds a `static` `Bank<f32, 100>` (5 % damping, 100
 //! periods log-spaced 0.01–10 s, exact scheme, default sub-steps; operators computed by the
-//! compiler into flash, `examples/spectrum_fw/config.rs`). SysTick fires every
+//! compiler into flash, `scenes/spectrum/config.rs`). SysTick fires every
 //! dt = 0.02 s of the core clock; its handler takes the next sample and steps the bank.
 //! After the last sample the main loop continues the bank in free vibration
 //! (`free_vibration_samples()`), then checks every Sd, Sv, Sa against the host's `f64`
-//! spectrum (`examples/spectrum_fw/reference.rs`, generated and checked by
+//! spectrum (`scenes/spectrum/reference.rs`, generated and checked by
 //! `tests/firmware_spectrum.rs`) within the relative bound measured there, and the bits of
 //! the whole spectrum against the host's `f32` run (hash). Exits with failure otherwise.
 //!
@@ -29,11 +29,11 @@
 #[macro_use]
 #[path = "fw/mod.rs"]
 mod fw;
-#[path = "spectrum_fw/config.rs"]
+#[path = "../scenes/spectrum/config.rs"]
 mod config;
-#[path = "modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
-#[path = "spectrum_fw/reference.rs"]
+#[path = "../scenes/spectrum/reference.rs"]
 mod reference;
 
 use core::cell::RefCell;

@@ -20,7 +20,7 @@
 //! - Generalized-α and HHT get the load as the textbook scheme does,
 //!   `(1 − α_f) p_n + α_f p_{n−1}` (`step_with_previous_input`).
 
-#[path = "modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "../tests/support/mod.rs"]
 mod support;

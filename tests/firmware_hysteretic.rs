@@ -1,8 +1,8 @@
 //! Host side of the `qemu_hysteretic` firmware example: the yielding 3-storey bilinear
-//! building (`examples/hysteretic_fw/building.rs`) under the whole El Centro record,
+//! building (`scenes/hysteretic/building.rs`) under the whole El Centro record,
 //! h = 0.02 s (one step per record sample), roof displacement as the output.
 //!
-//! - Generates the firmware's reference (`examples/hysteretic_fw/reference.rs`): the roof
+//! - Generates the firmware's reference (`scenes/hysteretic/reference.rs`): the roof
 //!   displacement of the f64 run (Newton to 1e-12) at every 10th step, and the bound the
 //!   firmware's f32 run (exactly `ITERATIONS` Newton iterations a step) must stay within.
 //!   The committed file must equal what this test generates (rewrite it with
@@ -12,15 +12,15 @@
 //! - Prints the host f32 roof displacement at the last step as bits (host and Cortex-M4F
 //!   f32 arithmetic are the same IEEE operations).
 
-#[path = "../examples/hysteretic_fw/building.rs"]
+#[path = "../scenes/hysteretic/building.rs"]
 mod building;
 #[path = "support/checks.rs"]
 mod checks;
-#[path = "../examples/modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "support/hyst.rs"]
 mod hyst;
-#[path = "../examples/hysteretic_fw/reference.rs"]
+#[path = "../scenes/hysteretic/reference.rs"]
 mod reference;
 
 use hyst::roof;
@@ -84,7 +84,7 @@ fn reference_is_current_and_host_f32_run_is_within_bound() {
     assert_eq!(unconverged, 0);
     // It yields: the firmware runs a hysteretic model, not a linear one (measured 5.7).
     assert!(ductility > 4.0, "ductility {ductility}");
-    checks::reference_is_current("examples/hysteretic_fw/reference.rs", &generate(&r64));
+    checks::reference_is_current("scenes/hysteretic/reference.rs", &generate(&r64));
     // The f64 run with the firmware's fixed iteration count is the converged run.
     let (fixed, _, u) = roof::<f64>(
         NewtonSettings::exactly(ITERATIONS, 1e-12),

@@ -1,7 +1,7 @@
 //! Host side of the `qemu_modal` firmware example: the 5-storey building under El Centro,
 //! `Modal<f32, 5, 2>`, roof drift as the one output.
 //!
-//! - Generates the firmware's reference (`examples/modal_fw/reference.rs`): the roof
+//! - Generates the firmware's reference (`scenes/modal/reference.rs`): the roof
 //!   drift of the FULL model (`Linear<f64, 5>`, same h = 0.02 s, f64 record) at every 10th
 //!   step, and the bound the firmware checks against it. The committed file must equal
 //!   what this test generates (rewrite it with
@@ -17,9 +17,9 @@ use nalgebra::{SMatrix, SVector};
 
 #[path = "support/checks.rs"]
 mod checks;
-#[path = "../examples/modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
-#[path = "../examples/modal_fw/reference.rs"]
+#[path = "../scenes/modal/reference.rs"]
 mod reference;
 
 /// Every how many steps the reference keeps a sample (0.2 s).
@@ -113,7 +113,7 @@ fn const_parser_matches_str_parse() {
 #[test]
 fn reference_is_current_and_host_f32_run_is_within_bound() {
     let full = full_roof();
-    checks::reference_is_current("examples/modal_fw/reference.rs", &generate(&full));
+    checks::reference_is_current("scenes/modal/reference.rs", &generate(&full));
     assert_eq!(reference::EVERY, EVERY);
     assert_eq!(reference::BOUND, BOUND);
 

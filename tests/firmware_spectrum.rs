@@ -2,7 +2,7 @@
 //! `Bank<f32, 100>` and `Bank<f32, 10>` (exact scheme, default sub-steps, free vibration
 //! after the record).
 //!
-//! - Generates the firmware's reference (`examples/spectrum_fw/reference.rs`): the same
+//! - Generates the firmware's reference (`scenes/spectrum/reference.rs`): the same
 //!   spectra in `f64` on the host (the f64 record), the relative bound the firmware's `f32`
 //!   spectra must stay within, and a hash of the host `f32` run's bits. The committed file
 //!   must equal what this test generates (rewrite it with
@@ -15,11 +15,11 @@ use aemstep::spectrum::{Bank, Response};
 
 #[path = "support/checks.rs"]
 mod checks;
-#[path = "../examples/spectrum_fw/config.rs"]
+#[path = "../scenes/spectrum/config.rs"]
 mod config;
-#[path = "../examples/modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
-#[path = "../examples/spectrum_fw/reference.rs"]
+#[path = "../scenes/spectrum/reference.rs"]
 mod reference;
 
 /// The relative bound the firmware checks every `Sd`, `Sv`, `Sa` of both banks against.
@@ -108,7 +108,7 @@ fn generate() -> String {
 
 #[test]
 fn reference_is_current_and_host_f32_run_is_within_bound() {
-    checks::reference_is_current("examples/spectrum_fw/reference.rs", &generate());
+    checks::reference_is_current("scenes/spectrum/reference.rs", &generate());
     assert_eq!(reference::BOUND, BOUND);
     let w100 = worst(&run_f32(config::PERIODS_100), &run_f64(config::PERIODS_100));
     let w10 = worst(&run_f32(config::PERIODS_10), &run_f64(config::PERIODS_10));

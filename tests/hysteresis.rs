@@ -7,11 +7,11 @@
 //! value measured when it was set; `docs/hysteresis.md` gives the figures and
 //! `cargo run --release --example hysteresis_report` prints them.
 
-#[path = "../examples/hysteretic_fw/building.rs"]
+#[path = "../scenes/hysteretic/building.rs"]
 mod building;
 #[path = "support/checks.rs"]
 mod checks;
-#[path = "../examples/modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "support/hyst.rs"]
 mod hyst;

@@ -13,7 +13,7 @@
 #[path = "support/checks.rs"]
 mod checks;
 /// El Centro NS 1940 ground acceleration (m/s²) at dt = 0.02 s.
-#[path = "../examples/modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 mod support;
 

@@ -9,7 +9,7 @@
 
 /// The El Centro 1940 NS record (m/s²); `tests/firmware_modal.rs` checks its parser against
 /// `str::parse` bit for bit.
-#[path = "../examples/modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 
 use aemstep::Error;

@@ -11,7 +11,7 @@
 
 mod support;
 
-#[path = "../examples/modal_fw/elcentro.rs"]
+#[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 
 use aemstep::models::{self, base_excitation};
