@@ -62,6 +62,14 @@ python3 scripts/check_docs.py ||
 
 step "docs build without warnings"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps || fail "rustdoc"
+# The way docs.rs builds them (Cargo.toml [package.metadata.docs.rs]): nightly, every feature,
+# `--cfg docsrs`, so each feature-gated item is labelled with its feature.
+rustup toolchain install nightly --profile minimal || fail "installing the nightly toolchain"
+RUSTDOCFLAGS="--cfg docsrs -D warnings" cargo +nightly doc --no-deps --all-features ||
+    fail "rustdoc as docs.rs builds it (nightly, --all-features, --cfg docsrs)"
+
+step "the published package: cargo publish --dry-run clean, its size as docs/package.md states"
+bash scripts/package.sh || fail "package (bash scripts/package.sh; --write regenerates docs/package.md)"
 
 read -r passed failed < <(awk '/^test result:/ { for (i = 1; i < NF; i++) {
     if ($(i + 1) ~ /^passed;/) p += $i; if ($(i + 1) ~ /^failed;/) f += $i } }

@@ -41,6 +41,8 @@
 //!
 //! Scalars are `f32` or `f64` ([`Real`]); sizes are const generics; nothing allocates.
 #![no_std]
+// docs.rs builds with `--cfg docsrs`: feature-gated items say which feature they need.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![deny(missing_docs)]
 // Denied everywhere; allowed only in `linalg::avx` (run-time AVX dispatch, argued there).
 #![deny(unsafe_code)]

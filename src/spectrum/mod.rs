@@ -54,6 +54,7 @@ mod operators;
 mod rotd;
 
 #[cfg(feature = "std")]
+#[cfg_attr(docsrs, doc(cfg(feature = "std")))]
 pub mod batch;
 
 pub use bank::{Bank, Response};
