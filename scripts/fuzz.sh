@@ -88,7 +88,8 @@ host=$(rustc -vV | sed -n 's/^host: //p')
 # path of the build enters the binaries (debug info of libFuzzer's C++, layout), and two
 # checkouts of one commit built binaries that differ, and fuzz differently from one seed.
 # From one path, every checkout builds the same binary and runs the same inputs.
-fixed=/tmp/aemstep-fuzz-build
+# FUZZ_BUILD_DIR moves it (one path for every run that is to be compared).
+fixed=${FUZZ_BUILD_DIR:-/tmp/aemstep-fuzz-build}
 export CARGO_TARGET_DIR="$fixed/target"
 work="$PWD/fuzz/target"
 mkdir -p "$work"
