@@ -2,7 +2,7 @@
 # Fuzzing (issue 10): builds the fuzz targets of fuzz/ (libFuzzer through the crates.io
 # crate libfuzzer-sys) and runs each for a bounded time, starting from its kept corpus
 # fuzz/corpus/<target>/; fails on any crash (a panic, i.e. a broken property: the checks
-# in fuzz/src/checks.rs panic, and libfuzzer-sys aborts on a panic). Prints per-target
+# in fuzz/src/checks/ panic, and libfuzzer-sys aborts on a panic). Prints per-target
 # executions, time, crashes and the checks' counters, and writes them to
 # fuzz/target/fuzz-stats.txt.
 #
