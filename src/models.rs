@@ -270,6 +270,7 @@ mod tests {
 /// With `u0 = 0`, `v0 = 1` and `p(t) = −0.01 e^{−0.1t} sin t + e^{−0.3t} sin³ t` the exact
 /// solution is `u = e^{−0.1t} sin t`. Units: any consistent set (the paper's are
 /// dimensionless). Cost: `force` 4 multiplies and 2 adds, `tangent` 3 and 1.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Duffing;
 

@@ -64,6 +64,7 @@ const FREE_NEWTON: u32 = 8;
 /// bracket is bisected to two neighbouring numbers); no panic. A trial whose
 /// data is not finite, or whose `z` is beyond `T`, returns a non-finite force, which the
 /// stepper reports as [`Error::NonFiniteForce`] without taking the step.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWen<T> {
     ak: T,
@@ -91,6 +92,7 @@ pub struct BoucWen<T> {
 }
 
 /// The history of a [`BoucWen`] law: the committed deformation and hysteretic variable.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWenHistory<T> {
     /// Deformation `d` at the end of the last accepted step.

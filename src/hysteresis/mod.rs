@@ -109,6 +109,7 @@ pub trait HistoryModel<T: Real, const N: usize> {
 }
 
 /// One uniaxial law's response at a trial deformation.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LawTrial<T, H> {
     /// The force `f` (force units).

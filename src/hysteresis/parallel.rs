@@ -14,6 +14,7 @@ use crate::Real;
 /// taking the step.
 ///
 /// Cost per trial: one trial of each law and 3 additions; no panic.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Parallel<A, B>(pub A, pub B);
 

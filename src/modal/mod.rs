@@ -43,6 +43,7 @@ const SYMMETRY_TOL: f64 = 64.0 * f64::EPSILON;
 pub const CLASSICAL_COUPLING_TOL: f64 = 1e-6;
 
 /// How the structure is damped; every form here is classical (diagonal in the modes).
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Damping<const N: usize> {
     /// No damping (`C = 0`).
@@ -65,6 +66,7 @@ pub enum Damping<const N: usize> {
 /// The state of a [`Modal`] stepper at step `n`: modal displacements `η`, velocities `η'`
 /// and accelerations `η''` of the `R` kept modes. Plain data, `3R + 1` words;
 /// [`Modal::full_state`] rebuilds the `N`-DOF state from it.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModalState<T, const R: usize> {
     eta: [T; R],
