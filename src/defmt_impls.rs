@@ -119,24 +119,73 @@ impl<T: Real + Format, L: Law<T> + Format, const N: usize> Format for ShearBuild
     }
 }
 
-/// Steppers: name, size and time step (defmt needs the format string as a literal).
-macro_rules! stepper_summary {
-    ($($ty:ident => $fmt:literal),*) => {$(
-        impl<T: Real + Format, const N: usize> Format for $ty<T, N> {
-            fn format(&self, f: Formatter) {
-                write!(f, $fmt, N, Stepper::time_step(self))
-            }
-        }
-    )*};
+// Steppers: name, size and time step.
+
+impl<T: Real + Format, const N: usize> Format for Linear<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "Linear {{ N: {=usize}, h: {} }}",
+            N,
+            Stepper::time_step(self)
+        )
+    }
 }
-stepper_summary!(
-    Linear => "Linear {{ N: {=usize}, h: {} }}",
-    AForm => "AForm {{ N: {=usize}, h: {} }}",
-    Newmark => "Newmark {{ N: {=usize}, h: {} }}",
-    Exact => "Exact {{ N: {=usize}, h: {} }}",
-    GeneralizedAlpha => "GeneralizedAlpha {{ N: {=usize}, h: {} }}",
-    CompensatedLinear => "CompensatedLinear {{ N: {=usize}, h: {} }}"
-);
+
+impl<T: Real + Format, const N: usize> Format for AForm<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "AForm {{ N: {=usize}, h: {} }}",
+            N,
+            Stepper::time_step(self)
+        )
+    }
+}
+
+impl<T: Real + Format, const N: usize> Format for Newmark<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "Newmark {{ N: {=usize}, h: {} }}",
+            N,
+            Stepper::time_step(self)
+        )
+    }
+}
+
+impl<T: Real + Format, const N: usize> Format for Exact<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "Exact {{ N: {=usize}, h: {} }}",
+            N,
+            Stepper::time_step(self)
+        )
+    }
+}
+
+impl<T: Real + Format, const N: usize> Format for GeneralizedAlpha<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "GeneralizedAlpha {{ N: {=usize}, h: {} }}",
+            N,
+            Stepper::time_step(self)
+        )
+    }
+}
+
+impl<T: Real + Format, const N: usize> Format for CompensatedLinear<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "CompensatedLinear {{ N: {=usize}, h: {} }}",
+            N,
+            Stepper::time_step(self)
+        )
+    }
+}
 
 impl<T: Real + Format, const N: usize, const I: usize> Format for LinearInput<T, N, I> {
     fn format(&self, f: Formatter) {
