@@ -173,6 +173,7 @@ pub fn spectral_radius(a: &Matrix3) -> f64 {
 }
 
 /// What the analysis of one scheme at one `(s, ξ)` gives.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SdofProperties {
     /// `s = ωh`.
@@ -234,6 +235,7 @@ impl SdofProperties {
 }
 
 /// The schemes of the crate, for [`sdof`].
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Scheme {
     /// The AEM, eliminated form ([`Linear`]).

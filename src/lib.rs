@@ -84,6 +84,10 @@ pub mod modal;
 pub mod models;
 pub mod observer;
 
+// `defmt::Format` for the types that hold nalgebra data (feature `defmt`).
+#[cfg(feature = "defmt")]
+mod defmt_impls;
+
 pub use error::Error;
 pub use modal::{Damping, Modal, ModalState};
 pub use nonlinear::varying::{Coefficients, TimeVarying, Varying};

@@ -21,6 +21,7 @@ use crate::{Error, Real};
 /// parallelogram of area `4 f_y (1 − α)(U − u_y)`.
 ///
 /// Cost per trial: 8 flops and 2 comparisons; no panic.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bilinear<T> {
     k: T,
@@ -34,6 +35,7 @@ pub struct Bilinear<T> {
 
 /// The history of a [`Bilinear`] law: the plastic deformation `d_p` (deformation units;
 /// the back force is `H d_p`).
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BilinearHistory<T> {
     /// Plastic deformation `d_p`.

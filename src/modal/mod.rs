@@ -43,6 +43,7 @@ const SYMMETRY_TOL: f64 = 64.0 * f64::EPSILON;
 pub const CLASSICAL_COUPLING_TOL: f64 = 1e-6;
 
 /// How the structure is damped; every form here is classical (diagonal in the modes).
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Damping<const N: usize> {
     /// No damping (`C = 0`).
@@ -65,6 +66,7 @@ pub enum Damping<const N: usize> {
 /// The state of a [`Modal`] stepper at step `n`: modal displacements `η`, velocities `η'`
 /// and accelerations `η''` of the `R` kept modes. Plain data, `3R + 1` words;
 /// [`Modal::full_state`] rebuilds the `N`-DOF state from it.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModalState<T, const R: usize> {
     eta: [T; R],
@@ -605,6 +607,11 @@ macro_rules! const_ctor {
             /// it. In a `static`, the compiler solves the eigenproblem and no eigen-solver
             /// code is linked into the firmware.
             ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+            /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+            /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+            /// which reads columns.
+            ///
             /// **Size limit at compile time.** The Jacobi sweeps cost about `4N³` flops
             /// each; measured with rustc 1.95, `Modal<f32, N, 2>` compiles in a `static` up
             /// to `N = 49` and stops at 50 with the `long_running_const_eval` lint (deny by
@@ -625,6 +632,11 @@ macro_rules! const_ctor {
             }
 
             /// `const fn` twin of [`Modal::with_modes`], bit-identical to it.
+            ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+            /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+            /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+            /// which reads columns.
             ///
             /// Errors: as [`Modal::with_modes`].
             pub const fn from_rows_with_modes(

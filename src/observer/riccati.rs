@@ -27,6 +27,7 @@ use nalgebra::SMatrix;
 use super::state_space::{Measurement, StateSpace, lu_of};
 use crate::Error;
 use crate::linalg::cholesky::cholesky;
+use crate::linalg::lu::Lu;
 use crate::linalg::{
     Mat, add_scaled, all_finite, identity, is_symmetric, max_abs, mul, rows_f64, sqrt, transpose,
 };
@@ -84,20 +85,28 @@ pub(crate) const fn symmetrize<const N: usize>(a: &Mat<N, N>) -> Mat<N, N> {
     s
 }
 
+/// The LU (with row scales) of `a` if `a` is a positive definite covariance: finite,
+/// symmetric, with a Cholesky factorization and that LU, which [`SteadyState`] solves
+/// with. Both: at the edge of singularity the two judge rounding differently (an `R` with
+/// relative determinant `−3e-21` passed the Cholesky and failed the LU, so `Kalman` took
+/// what `SteadyState` refused; found by fuzzing). Cost: `N³/6 + N³/3` multiply-adds.
+pub(crate) const fn definite_lu<const N: usize>(a: &Mat<N, N>) -> Option<Lu<N>> {
+    if !symmetric(a) || cholesky(a).is_none() {
+        return None;
+    }
+    lu_of(a)
+}
+
 /// `a` is a valid covariance: finite, symmetric and positive semidefinite (`definite`:
-/// positive definite). Semidefiniteness is tested by a Cholesky factorization of
-/// `a + δI`, `δ = 16 N ε max|a|`: a rank-deficient `a` passes, an eigenvalue below `−δ`
-/// fails. Definiteness needs a Cholesky factorization of `a` and the LU with row scales
-/// that [`SteadyState`] solves with: at the edge of singularity the two tests judge
-/// rounding differently (an `R` with relative determinant `−3e-21` passed the Cholesky
-/// and failed the LU, so `Kalman` took what `SteadyState` refused; found by fuzzing).
-/// Cost: `N³/6` flops (`N³/2` more for `definite`).
+/// positive definite, as [`definite_lu`] judges it). Semidefiniteness is tested by a
+/// Cholesky factorization of `a + δI`, `δ = 16 N ε max|a|`: a rank-deficient `a` passes,
+/// an eigenvalue below `−δ` fails. Cost: `N³/6` flops (`N³/3` more for `definite`).
 pub(crate) const fn is_covariance<const N: usize>(a: &Mat<N, N>, definite: bool) -> bool {
+    if definite {
+        return definite_lu(a).is_some();
+    }
     if !symmetric(a) {
         return false;
-    }
-    if definite {
-        return cholesky(a).is_some() && lu_of(a).is_some();
     }
     let delta = 16.0 * N as f64 * f64::EPSILON * max_abs(a) + f64::MIN_POSITIVE;
     let mut b = *a;
@@ -388,17 +397,17 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         q: &[[f64; S]; S],
         r: &[[f64; O]; O],
     ) -> Result<Self, Error> {
-        if !(is_covariance(q, false) && is_covariance(r, true)) {
+        if !is_covariance(q, false) {
             return Err(Error::InvalidCovariance);
         }
+        let lu_r = match definite_lu(r) {
+            Some(lu) => lu,
+            None => return Err(Error::InvalidCovariance),
+        };
         let h = &meas.h;
         if !all_finite(h) {
             return Err(Error::NonFiniteInput);
         }
-        let lu_r = match lu_of(r) {
-            Some(lu) => lu,
-            None => return Err(Error::InvalidCovariance),
-        };
         let id: Mat<S, S> = identity();
         let mut a = transpose(&model.phi);
         let mut g = symmetrize(&mul(&transpose(h), &lu_r.solve(h)));

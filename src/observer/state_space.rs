@@ -329,6 +329,11 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// `f64`; `h` in s. The same data as the steppers' `from_rows`. The same numbers, bit
     /// for bit, as [`StateSpace::newmark_from_rows`] with β = 1/4, γ = 1/2.
     ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+    /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+    /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+    /// which reads columns.
+    ///
     /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`],
     /// [`Error::InvalidTimeStep`], [`Error::SingularEffectiveMatrix`],
     /// [`Error::SingularMass`] (the state-space form needs `a = M⁻¹(…)`),
@@ -364,6 +369,11 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// row-major `f64`; `h` in s. Reproduces the stepper driven with `p_n = B w_n` from
     /// any state whose acceleration satisfies the equation of motion — its start
     /// (`Stepper::start`) and every state after a step.
+    ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+    /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+    /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+    /// which reads columns.
     ///
     /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`] (also for
     /// `B`), then those of [`Newmark::new`](crate::Newmark::new) for the same data, in its
@@ -434,6 +444,11 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// `t_{n−α_f}`, so `Γ₀ ≠ 0`). The stepper's `step(p)` takes `p_{n−1} = p_n`: its form
     /// has `Γ₀ + Γ₁` in place of `Γ₁` and no `Γ₀`. Start from
     /// [`StateSpace::initial_state`], what the stepper's `start` computes.
+    ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+    /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+    /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+    /// which reads columns.
     ///
     /// Outputs: the acceleration map `a = A_x x + A_w w` ([`StateSpace::outputs`]) is the
     /// *physical* acceleration `M⁻¹ (B w − C v − K u)`, what an accelerometer measures (the
@@ -646,6 +661,11 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// `η'' + 2ξω η' + ω² η = Γ w`, so each of the four `R×R` blocks of `Φ` is diagonal
     /// (`const fn`). Same data and checks as `Modal::from_rows_with_modes`; `U = [Φ_R 0]`,
     /// `V = [0 Φ_R]`, `A_x = [−Φ_R ω², −Φ_R 2ξω]`, `A_w = Φ_R Γ`.
+    ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+    /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+    /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+    /// which reads columns.
     ///
     /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2R`) and those of
     /// [`Modal::new`](crate::Modal::new).

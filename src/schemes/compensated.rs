@@ -135,6 +135,11 @@ macro_rules! const_ctor {
             /// in s), bit-identical to it and to
             /// [`Linear::from_rows`](crate::Linear::from_rows)'s operators. Size limit at
             /// compile time and errors: as [`Linear::from_rows`](crate::Linear::from_rows).
+            ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`); convert with
+            /// [`models::matrix_of`](crate::models::matrix_of) /
+            /// [`models::rows_of`](crate::models::rows_of), not `SMatrix::from`, which
+            /// reads columns.
             pub const fn from_rows(
                 m: Rows<N>,
                 c: Rows<N>,

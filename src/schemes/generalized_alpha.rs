@@ -33,6 +33,7 @@ use crate::linalg::{
 use crate::{Error, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AlphaParameters {
     /// Weight of the previous acceleration in the inertia term.

@@ -174,6 +174,11 @@ macro_rules! const_ctor {
             /// [`LinearInput::new`] given the same values. In a `static`, no factorization
             /// code is linked in.
             ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+            /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+            /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+            /// which reads columns.
+            ///
             /// **Size limit at compile time**, as for
             /// [`Linear::from_rows`](crate::Linear::from_rows): measured with rustc 1.95,
             /// `LinearInput<f32, N, 1>` compiles in a `static` up to `N = 63` and stops at 64

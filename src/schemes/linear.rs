@@ -123,6 +123,11 @@ macro_rules! const_ctor {
             /// (`m[i][j]` is row `i`, column `j`), `h` in seconds. Bit-identical to
             /// [`Linear::new`] given the same values.
             ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+            /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+            /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+            /// which reads columns.
+            ///
             /// In a `static`, the operators are evaluated by the compiler and no
             /// factorization code is linked in:
             ///

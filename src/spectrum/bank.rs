@@ -356,6 +356,7 @@ bank_ctor!(f64);
 ///
 /// Units follow the samples: with `a_g` in m/s², displacements are m, velocities m/s and
 /// accelerations m/s². Size: `5P + 1` values of `T` and two counters.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Response<T, const P: usize> {
     pub(super) u: [T; P],

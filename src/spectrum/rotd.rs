@@ -13,6 +13,7 @@ use crate::Real;
 /// both components gives the peak `max_t |u_θ|` for every angle. RotD100 is the largest
 /// of the `K` peaks, RotD50 their median (Boore 2010); both are spectral displacements
 /// (m), [`Bank::psa`] turns them into pseudo-accelerations.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RotD<T, const K: usize> {
     cos: [T; K],
@@ -22,6 +23,7 @@ pub struct RotD<T, const K: usize> {
 /// The running two-component response: each component's [`Response`] and the peak
 /// rotated displacement of every oscillator at every angle. Size: `2·(5P + 1) + K·P`
 /// values of `T`.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RotDResponse<T, const P: usize, const K: usize> {
     x: Response<T, P>,
