@@ -57,6 +57,11 @@ extern crate std;
 /// so your matrices and vectors are the same types as the crate's.
 pub use nalgebra;
 
+// `matrix!` and `vector!` (exported at the crate root) and the helper they expand to.
+mod macros;
+#[doc(hidden)]
+pub use macros::rows_to_columns as __rows_to_columns;
+
 // The state and the interface every scheme shares.
 mod error;
 mod scalar;
