@@ -94,7 +94,10 @@ mod tests {
         assert_eq!(tall.transpose(), nalgebra::matrix![1, 3, 5; 2, 4, 6]);
 
         let square = crate::matrix![2.0, -1.0, 0.5; 7.0, 3.0, -4.0; 0.0, 9.0, 1.0;];
-        assert_eq!(square, nalgebra::matrix![2.0, -1.0, 0.5; 7.0, 3.0, -4.0; 0.0, 9.0, 1.0]);
+        assert_eq!(
+            square,
+            nalgebra::matrix![2.0, -1.0, 0.5; 7.0, 3.0, -4.0; 0.0, 9.0, 1.0]
+        );
         assert_ne!(square, square.transpose());
 
         let row = crate::matrix![1.0f32, 2.0, 3.0];
