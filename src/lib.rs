@@ -38,6 +38,8 @@
 //!   Kalman filter, modal observers.
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
+//! - [`matrix!`], [`vector!`]: nalgebra's literal syntax for the crate's matrix and vector
+//!   types, also in `const` and `static` items, with no `nalgebra` dependency of your own.
 //!
 //! Scalars are `f32` or `f64` ([`Real`]); sizes are const generics; nothing allocates.
 #![no_std]
@@ -120,3 +122,18 @@ pub struct NonlinearDocDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/schemes.md")]
 pub struct SchemesDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/hysteresis.md")]
+pub struct HysteresisDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/spectrum.md")]
+pub struct SpectrumDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/observer.md")]
+pub struct ObserverDocDoctests;
