@@ -284,8 +284,25 @@ def copy_repo(root, dest):
     shutil.copytree(root, dest, ignore=skip, symlinks=True)
 
 
+# Blocks of every kind, appended to the self-test's copy as docs/zz_self_test.md:
+# (attributes, code, what the check must report: None = passes, or the failure).
+KINDS = [
+    ("rust,compile_fail", ['let x: u32 = "not a number";'], None),
+    ("compile_fail", ["let x: u32 = 1;"], "compile_fail but compiles"),
+    ("should_panic", ['panic!("as it must");'], None),
+    ("rust,should_panic", ["let x = 1;"], "should_panic but did not panic"),
+    ("no_run", ["loop {}"], None),  # would time out if it were run
+    ("ignore", ["not Rust"], "ignored without a reason"),
+    ("rust,ignore", [IGNORE_REASON + " a self-test block.", "not Rust"], None),
+    ("text", ["not Rust, not a block"], None),
+    ("python", ["print('not a block')"], None),
+    ("", ["# fn hidden() -> u32 { 2 }", "assert_eq!(hidden(), 2);"], None),  # rustdoc's hidden lines
+    ("rust", ["fn main() {", "    std::process::exit(3);", "}"], "fails when run"),
+]
+
+
 def self_test(target_dir):
-    """A copy of the repository with two broken blocks must fail, naming exactly those two."""
+    """A copy of the repository with broken blocks must fail, naming exactly those."""
     tmp = tempfile.mkdtemp(prefix="aemstep-downstream-selftest-")
     try:
         copy = os.path.join(tmp, "aemstep")
@@ -304,16 +321,29 @@ def self_test(target_dir):
             lines.insert(b.line, indent + new)  # right after the opening fence
             with open(path, "w", encoding="utf-8") as f:
                 f.write("\n".join(lines))
+        # 3. One block of every kind, each attribute handled as rustdoc does.
+        want = [(readme.where, "does not compile"), (doc.where, "fails when run")]
+        page, rel = ["# Self-test blocks", ""], os.path.join("docs", "zz_self_test.md")
+        rust_kinds = 0
+        for info, code, outcome in KINDS:
+            where = f"{rel}:{len(page) + 1}"
+            page += ["```" + info, *code, "```", ""]
+            if outcome:
+                want.append((where, outcome))
+            rust_kinds += rust_attrs(info) is not None
+        with open(os.path.join(copy, rel), "w", encoding="utf-8") as f:
+            f.write("\n".join(page))
         failures, checked, _ = check(copy, target_dir, quiet=True)
         got = sorted((w, what) for w, what, _ in failures)
-        want = sorted([(readme.where, "does not compile"), (doc.where, "fails when run")])
         detail = "\n".join(d for w, _, d in failures if w == readme.where)
-        if got != want or "nalgebra" not in detail:
+        if got != sorted(want) or "nalgebra" not in detail or len(checked) != len(blocks) + rust_kinds:
             report(failures)
-            raise SystemExit(f"downstream self-test FAILED: expected exactly {want}, got {got}")
-        print(f"downstream self-test: {len(checked)} blocks; the two broken ones fail as they must: "
-              f"{readme.where} (`use nalgebra::Matrix3;`: {detail.splitlines()[0] if detail else ''}), "
-              f"{doc.where} (a failing assert when run)")
+            raise SystemExit(f"downstream self-test FAILED: expected exactly {sorted(want)}, got {got} "
+                             f"({len(checked)} blocks, expected {len(blocks) + rust_kinds})")
+        print(f"downstream self-test: {len(checked)} blocks; the broken ones fail as they must, and only "
+              f"they: {readme.where} (`use nalgebra::Matrix3;`: {detail.splitlines()[0] if detail else ''}), "
+              f"{doc.where} (a failing assert when run), and {len(want) - 2} of the {len(KINDS)} blocks of "
+              f"every kind (compile_fail, should_panic, no_run, ignore, hidden lines, fn main)")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
