@@ -38,6 +38,8 @@
 //!   Kalman filter, modal observers.
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
+//! - [`matrix!`], [`vector!`]: nalgebra's literal syntax for the crate's matrix and vector
+//!   types, also in `const` and `static` items, with no `nalgebra` dependency of your own.
 //!
 //! Scalars are `f32` or `f64` ([`Real`]); sizes are const generics; nothing allocates.
 #![no_std]
@@ -56,6 +58,11 @@ extern crate std;
 /// The `nalgebra` this crate's API is written in (version 0.35): use `aemstep::nalgebra`
 /// so your matrices and vectors are the same types as the crate's.
 pub use nalgebra;
+
+// `matrix!` and `vector!` (exported at the crate root) and the helper they expand to.
+mod macros;
+#[doc(hidden)]
+pub use macros::rows_to_columns as __rows_to_columns;
 
 // The state and the interface every scheme shares.
 mod error;
@@ -119,3 +126,18 @@ pub struct NonlinearDocDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/schemes.md")]
 pub struct SchemesDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/hysteresis.md")]
+pub struct HysteresisDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/spectrum.md")]
+pub struct SpectrumDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/observer.md")]
+pub struct ObserverDocDoctests;

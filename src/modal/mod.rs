@@ -129,7 +129,7 @@ pub const fn lowest_modes<const R: usize>() -> [usize; R] {
 /// ```
 /// use aemstep::{models, Damping, Modal, Stepper};
 /// use aemstep::models::{base_excitation, storey_drifts};
-/// use aemstep::nalgebra::vector;
+/// use aemstep::vector;
 ///
 /// // The benchmark 5-storey building: 2 modes, base excitation, roof drift out.
 /// let (m, _c, k) = models::five_storey_building();

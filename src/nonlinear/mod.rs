@@ -186,7 +186,8 @@ pub struct NewtonReport<T> {
 ///
 /// ```
 /// use aemstep::{Model, NewtonSettings, Nonlinear, Tangent};
-/// use aemstep::nalgebra::{matrix, vector, SMatrix, SVector};
+/// use aemstep::{matrix, vector};
+/// use aemstep::nalgebra::{SMatrix, SVector};
 ///
 /// struct Duffing;
 /// impl Model<f32, 1> for Duffing {

@@ -64,7 +64,7 @@ impl<T: Real, const N: usize, F: Fn(T) -> Coefficients<T, N>> TimeVarying<T, N> 
 ///
 /// ```
 /// use aemstep::{Coefficients, Varying};
-/// use aemstep::nalgebra::{matrix, vector};
+/// use aemstep::{matrix, vector};
 ///
 /// // u'' + (1 + t/10) u = 0: a stiffening oscillator.
 /// let coeffs = |t: f64| Coefficients {

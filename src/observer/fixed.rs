@@ -90,7 +90,8 @@ pub(crate) fn initial_estimate<T: Real, const S: usize, const I: usize>(
 /// ```
 /// use aemstep::models::{self, base_excitation};
 /// use aemstep::observer::{Observer, Outputs, StateSpace, SteadyState};
-/// use aemstep::nalgebra::{SMatrix, vector};
+/// use aemstep::vector;
+/// use aemstep::nalgebra::SMatrix;
 ///
 /// // The 5-storey building, ground acceleration in, absolute accelerations of floors 2
 /// // and 5 measured.

@@ -528,7 +528,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     ///
     /// ```
     /// use aemstep::observer::StateSpace;
-    /// use aemstep::nalgebra::{matrix, vector};
+    /// use aemstep::{matrix, vector};
     /// use aemstep::{AlphaParameters, GeneralizedAlpha, Stepper};
     /// let (m, c, k, b, h) = (matrix![2.0], matrix![0.3], matrix![50.0], matrix![1.0], 0.01);
     /// let p = AlphaParameters::chung_hulbert(0.8)?;

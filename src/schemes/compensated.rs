@@ -82,7 +82,7 @@ impl<T: Real, const N: usize> StepState for CompensatedState<T, N> {
 ///
 /// ```
 /// use aemstep::{CompensatedLinear, Stepper};
-/// use aemstep::nalgebra::{matrix, vector};
+/// use aemstep::{matrix, vector};
 /// let sys = CompensatedLinear::<f32, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![1.0], 1e-2)?;
 /// let mut s = sys.start(&vector![1.0], &vector![0.0], &vector![0.0])?;
 /// for _ in 0..1000 {

@@ -35,7 +35,7 @@ use crate::{Error, Real, State, Stepper};
 ///
 /// ```
 /// use aemstep::{models, LinearInput, Stepper};
-/// use aemstep::nalgebra::vector;
+/// use aemstep::vector;
 ///
 /// // The benchmark 5-storey building under base acceleration a_g: B = −M ι.
 /// let (m, c, k) = models::five_storey_building();

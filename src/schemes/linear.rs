@@ -33,7 +33,7 @@ use crate::{AForm, Error, Real};
 ///
 /// ```
 /// use aemstep::{Linear, Stepper};
-/// use aemstep::nalgebra::{matrix, vector};
+/// use aemstep::{matrix, vector};
 ///
 /// // u'' + 25 u = 0 (paper Example 1), h = 0.01 s
 /// let sys = Linear::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], 0.01)?;
