@@ -15,6 +15,9 @@ const SKIP: &[(&str, &str)] = &[
     ("ModalDocDoctests", "cfg(doctest) marker"),
     ("NonlinearDocDoctests", "cfg(doctest) marker"),
     ("SchemesDocDoctests", "cfg(doctest) marker"),
+    ("HysteresisDocDoctests", "cfg(doctest) marker"),
+    ("SpectrumDocDoctests", "cfg(doctest) marker"),
+    ("ObserverDocDoctests", "cfg(doctest) marker"),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
