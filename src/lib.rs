@@ -79,6 +79,7 @@ mod nonlinear;
 
 // Modal reduction, stability analysis, ready-made models.
 pub mod analysis;
+pub mod estimation;
 pub mod hysteresis;
 pub mod modal;
 pub mod models;
