@@ -18,7 +18,7 @@
 //! # The model the filters use
 //!
 //! The crate's linear schemes carry the input at both ends of a step
-//! ([`StateSpace`](crate::observer::StateSpace)):
+//! ([`StateSpace`]):
 //!
 //! ```text
 //! x_n = Φ x_{n−1} + Γ₀ w_{n−1} + Γ₁ w_n,        y_n = H x_n + D w_n
@@ -76,6 +76,35 @@
 //! trapezoidal rule cannot see an input alternating at the Nyquist frequency); the two
 //! together have none. `tests/estimation.rs` checks both on an oscillator (closed form) and
 //! on the 5-storey building.
+//!
+//! # The joint input–state filter (Gillijns & De Moor 2007)
+//!
+//! On the standard form `ξ_n = A ξ_{n−1} + B w_{n−1} + q`, `y_n = C ξ_n + D̃ w_n + r`
+//! ([`InputModel`]), `E q qᵀ = Q`, `E r rᵀ = R`, one step is
+//!
+//! ```text
+//! ξ⁻ = A ξ̂_{n−1} + B ŵ_{n−1}              P⁻ = [A B] [P, Pˣʷ; Pʷˣ, Pʷ]_{n−1} [A B]ᵀ + Q
+//! R̃ = C P⁻ Cᵀ + R                           Pʷ = (D̃ᵀ R̃⁻¹ D̃)⁻¹,   M = Pʷ D̃ᵀ R̃⁻¹
+//! ŵ_n = M (y_n − C ξ⁻)                      K = P⁻ Cᵀ R̃⁻¹
+//! ξ̂_n = ξ⁻ + K (y_n − C ξ⁻ − D̃ ŵ_n)        P = P⁻ − K (R̃ − D̃ Pʷ D̃ᵀ) Kᵀ,  Pˣʷ = −K D̃ Pʷ
+//! ```
+//!
+//! ## Steady state
+//!
+//! With the fixed left inverse `M₀ = F₀⁻¹ D̃ᵀ R⁻¹`, `F₀ = D̃ᵀ R⁻¹ D̃`, and `N` a basis of
+//! the left null space of `D̃`: `R̃⁻¹ (I − D̃ M) = N (Nᵀ R̃ N)⁻¹ Nᵀ`, and `M` is the unique
+//! `X` with `X D̃ = I`, `X R̃ N = 0`, so `M = M₀ − M₀ R̃ N (Nᵀ R̃ N)⁻¹ Nᵀ`. The a-priori
+//! error then obeys `e⁻_{n+1} = (Ā − 𝒦 C_r) e⁻_n + …` with `Ā = A − B M₀ C`,
+//! `C_r = Nᵀ C` and the filter's gain `𝒦 = Ā P⁻ C_rᵀ (C_r P⁻ C_rᵀ + Nᵀ R N)⁻¹` — exactly
+//! the Kalman predictor's gain of that pair — and its covariance the Riccati difference
+//! equation of the Kalman
+//! predictor of `(Ā, C_r)` with process noise `Q̄ = Q + B F₀⁻¹ Bᵀ` and measurement noise
+//! `Nᵀ R N` (the cross covariance `−B M₀ R N` is zero since `M₀ R N = 0`). Its information
+//! matrix `C_rᵀ (Nᵀ R N)⁻¹ C_r = Cᵀ Π₀ C`, `Π₀ = R⁻¹ − R⁻¹ D̃ F₀⁻¹ D̃ᵀ R⁻¹`, needs no `N`.
+//! [`InputStateGains::solve`] solves this algebraic Riccati equation by the same doubling
+//! algorithm as [`SteadyState`](crate::observer::SteadyState) and forms `K`, `M`, `Pʷ`
+//! from its `P⁻` with the step's equations above. `tests/estimation.rs` checks them
+//! against the limit of the paper's time-varying recursion.
 
 pub mod augmented;
 mod joint;
