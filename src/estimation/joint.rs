@@ -269,10 +269,10 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
 /// The physical state is `x̂_n = ξ̂_n + Γ₁ ŵ_n` ([`InputStateObserver::state`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct JointEstimate<T, const S: usize, const I: usize> {
-    xi: SVector<T, S>,
-    w: SVector<T, I>,
-    n: u64,
-    missing: u64,
+    pub(super) xi: SVector<T, S>,
+    pub(super) w: SVector<T, I>,
+    pub(super) n: u64,
+    pub(super) missing: u64,
 }
 
 impl<T: Real, const S: usize, const I: usize> JointEstimate<T, S, I> {
@@ -307,7 +307,7 @@ impl<T: Real, const S: usize, const I: usize> StepState for JointEstimate<T, S, 
 }
 
 /// `x − Γ₁ w` (or `+` with `sign = 1`) in `T`.
-fn shift<T: Real, const S: usize, const I: usize>(
+pub(super) fn shift<T: Real, const S: usize, const I: usize>(
     gamma1: &[[T; I]; S],
     x: &SVector<T, S>,
     w: &SVector<T, I>,
@@ -323,7 +323,7 @@ fn shift<T: Real, const S: usize, const I: usize>(
 }
 
 /// The start of a joint estimate: `ξ̂_0 = x0 − Γ₁ w0`, `ŵ_0 = w0`, all finite.
-fn joint_start<T: Real, const S: usize, const I: usize>(
+pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
     gamma1: &[[T; I]; S],
     x0: &SVector<T, S>,
     w0: &SVector<T, I>,

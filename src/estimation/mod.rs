@@ -14,6 +14,8 @@
 //! - [`augmented`]: the augmented Kalman filter (Lourens et al. 2012), the state `[ξ; w]`
 //!   with a random-walk force, reusing [`SteadyState`](crate::observer::SteadyState),
 //!   [`Observer`](crate::observer::Observer) and [`Kalman`](crate::observer::Kalman).
+//! - [`dual`]: the dual Kalman filter (Eftekhar Azam et al. 2015), an input and a state
+//!   filter in sequence, each with a steady gain from [`SteadyState`](crate::observer::SteadyState).
 //!
 //! # The model the filters use
 //!
@@ -107,6 +109,7 @@
 //! against the limit of the paper's time-varying recursion.
 
 pub mod augmented;
+pub mod dual;
 mod joint;
 
 pub use joint::{InputStateFilter, InputStateFilterState, InputStateGains, InputStateObserver};
