@@ -14,6 +14,8 @@
 //! - [`augmented`]: the augmented Kalman filter (Lourens et al. 2012), the state `[ξ; w]`
 //!   with a random-walk force, reusing [`SteadyState`](crate::observer::SteadyState),
 //!   [`Observer`](crate::observer::Observer) and [`Kalman`](crate::observer::Kalman).
+//! - [`smoother`]: a fixed-lag smoother with steady gains on any observer model (on the
+//!   augmented one it smooths the force too), `L` samples late.
 //! - [`dual`]: the dual Kalman filter (Eftekhar Azam et al. 2015), an input and a state
 //!   filter in sequence, each with a steady gain from [`SteadyState`](crate::observer::SteadyState).
 //!
@@ -111,6 +113,7 @@
 pub mod augmented;
 pub mod dual;
 mod joint;
+pub mod smoother;
 
 pub use joint::{InputStateFilter, InputStateFilterState, InputStateGains, InputStateObserver};
 pub use joint::{JointEstimate, STEADY_MAX_ITERATIONS, ZERO_SQUARINGS};
