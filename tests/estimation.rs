@@ -1045,3 +1045,70 @@ fn fixed_lag_smoother_matches_rts_on_each_window() {
         .unwrap();
     assert_eq!(st.missing(), 1);
 }
+
+#[test]
+fn modal_model_and_f32_time_varying_filter() {
+    // The joint filter on a modal model of R = 3 modes (x = [η; η'], S = 6) fed by the
+    // full building's measurements: a reduced-order estimator as Lourens et al. use. The
+    // truncation is a model error, so only the measured errors are pinned (regression
+    // pins), beside the full model's.
+    let ss = building();
+    let out = with_displacement();
+    let modal = StateSpace::<5, 6, 1>::modal::<3>(
+        &SMatrix::from_fn(|i, j| BLD.0[i][j]),
+        &SMatrix::from_fn(|i, j| BLD.2[i][j]),
+        &aemstep::Damping::Ratios([0.05; 5]),
+        &SMatrix::from_fn(|i, _| ROOF[i][0]),
+        H,
+    )
+    .unwrap();
+    let model = InputModel::from_parts(&modal, &modal.outputs(&out).unwrap()).unwrap();
+    let q = SMatrix::<f64, 6, 6>::identity() * 1e-12;
+    let gains = InputStateGains::new(&model, &q, &sensor_noise()).unwrap();
+    let f = InputStateObserver::<f32, 6, 1, 4>::new(&model, &gains).unwrap();
+    let w = wind(1500, 12);
+    let (_, ys) = truth_run(&ss, &out, &w);
+    let ys = noisy(&ys, 13);
+    let mut e = f.start_at_rest();
+    let (mut err, mut peak) = (0.0f64, 0.0f64);
+    for n in 1..ys.len() {
+        f.try_step(&mut e, &ys[n].cast::<f32>()).unwrap();
+        if n > 500 {
+            err = err.max((e.input()[0] as f64 - w[n]).abs());
+            peak = peak.max(w[n].abs());
+        }
+    }
+    println!("modal R = 3, f32: force error {err:.3e} N (peak {peak:.3e})");
+    // Regression pin: measured 8.9 % of the peak.
+    assert!(err <= 0.15 * peak);
+    // The time-varying filter in f32 on the full model runs (the covariances stay
+    // definite) and follows its f64 twin (regression pin: measured 1.9e-6 of the peak).
+    let full = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
+    let q = process_noise(&ss);
+    let f32f = InputStateFilter::<f32, 10, 1, 4>::new(&full, &q, &sensor_noise()).unwrap();
+    let f64f = InputStateFilter::<f64, 10, 1, 4>::new(&full, &q, &sensor_noise()).unwrap();
+    let mut s32 = f32f
+        .start(
+            &SVector::zeros(),
+            &(SMatrix::identity() * 1e-8),
+            &SVector::zeros(),
+            &SMatrix::from([[1e10]]),
+        )
+        .unwrap();
+    let mut s64 = f64f
+        .start(
+            &SVector::zeros(),
+            &(SMatrix::identity() * 1e-8),
+            &SVector::zeros(),
+            &SMatrix::from([[1e10]]),
+        )
+        .unwrap();
+    let mut d = 0.0f64;
+    for n in 1..ys.len() {
+        f32f.try_step(&mut s32, &ys[n].cast::<f32>()).unwrap();
+        f64f.try_step(&mut s64, &ys[n]).unwrap();
+        d = d.max((s32.estimate().input()[0] as f64 - s64.estimate().input()[0]).abs());
+    }
+    println!("time-varying f32 vs f64: {d:.3e} N");
+    assert!(d <= 1e-4 * peak);
+}
