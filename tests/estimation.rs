@@ -1112,3 +1112,10 @@ fn modal_model_and_f32_time_varying_filter() {
     println!("time-varying f32 vs f64: {d:.3e} N");
     assert!(d <= 1e-4 * peak);
 }
+
+#[test]
+fn the_new_error_reads_as_the_others() {
+    let e = Error::InputNotIdentifiable;
+    assert_eq!(format!("{e}"), e.as_str());
+    assert!(e.as_str().contains("not identifiable"));
+}

@@ -110,6 +110,9 @@ const fn certified_stable<const S: usize>(e: &Mat<S, S>) -> bool {
         if n <= A_SMALL {
             return true;
         }
+        if k == ZERO_SQUARINGS {
+            return false;
+        }
         b = mul(&b, &b);
         k += 1;
     }
