@@ -830,6 +830,34 @@ fn acceleration_only_drifts() {
     }
     println!("acceleration only: trace P at 1000..4000 steps {traces:?}");
     assert!(traces.windows(2).all(|t| t[1] > 1.2 * t[0]));
+    // The augmented Kalman filter likewise: the variance of the force estimate grows
+    // without bound (no steady state: `steady_state` refuses it, building_identifiability);
+    // measured: it grows by the random walk's whole 1000 · Q_w = 1e11 N² every 1000 steps,
+    // the data do not reduce it.
+    let aug = AugmentedModel::<10, 1, 11, 3>::from_parts(&model, &rows(&q), &[[1e8]]).unwrap();
+    let kf = Kalman::<f64, 11, 0, 3>::new(
+        &aug.model,
+        &aug.measurement,
+        &SMatrix::from_fn(|i, j| aug.process_noise[i][j]),
+        &r,
+    )
+    .unwrap();
+    let p0 = SMatrix::<f64, 11, 11>::from_fn(|i, j| match (i == j, i < 10) {
+        (false, _) => 0.0,
+        (true, true) => 1e-8,
+        (true, false) => 1e10,
+    });
+    let mut s = kf.start(&SVector::zeros(), &p0, &SVector::zeros()).unwrap();
+    let mut var_w = Vec::new();
+    for n in 1..=4000 {
+        kf.try_step(&mut s, &SVector::zeros(), &SVector::zeros())
+            .unwrap();
+        if n % 1000 == 0 {
+            var_w.push(s.covariance()[(10, 10)]);
+        }
+    }
+    println!("augmented KF, acceleration only: force variance at 1000..4000 steps {var_w:?}");
+    assert!(var_w.windows(2).all(|t| t[1] > 1.2 * t[0]));
 }
 
 /// The dual filter's joint error matrix `(S + I)×(S + I)`, column by column from
