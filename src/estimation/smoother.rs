@@ -18,7 +18,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::linalg::{Mat, add_scaled, all_finite, finite_as, identity, mul, round_rows};
+use crate::linalg::{self, Mat, add_scaled, all_finite, finite_as, identity, mul, round_rows};
 use crate::linalg::{rows_f64, transpose};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance, lu_of, symmetrize};
 use crate::{Error, Real, StepState};
@@ -127,7 +127,7 @@ impl<T: Real, const S: usize, const I: usize, const L: usize> StepState
 ///
 /// Cost of a step: `S² + 2S·I + 2S·O + O·I + L·S·O` multiply-adds (the observer's plus
 /// `L·S·O`). Size: `S² + 2S·I + O·(S + I) + (L + 1)·S·O` values of `T`; the state
-/// `(L + 1)·(S + I)`.
+/// `(L + 1)·(S + I)`. [`FixedLag::new`] and `from_parts` (`const fn`) are bit-identical.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FixedLag<T, const S: usize, const I: usize, const O: usize, const L: usize> {
     phi: [[T; S]; S],
@@ -303,3 +303,47 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize>
         Ok(())
     }
 }
+
+macro_rules! lag_const {
+    ($t:ident) => {
+        impl<const S: usize, const I: usize, const O: usize, const L: usize>
+            FixedLag<$t, S, I, O, L>
+        {
+            /// `const fn` twin of [`FixedLag::new`] with `r` row-major (a `static` keeps
+            /// the gains in flash); bit-identical to it.
+            ///
+            /// Errors: as [`FixedLag::new`].
+            pub const fn from_parts<const N: usize>(
+                model: &StateSpace<N, S, I>,
+                meas: &Measurement<S, I, O>,
+                steady: &SteadyState<S, O>,
+                r: &[[f64; O]; O],
+            ) -> Result<Self, Error> {
+                let (k0, ks) = match lag_gains::<N, S, I, O, L>(model, meas, steady, r) {
+                    Ok(g) => g,
+                    Err(e) => return Err(e),
+                };
+                if let Err(e) = fit_checks(model, meas, &k0, &ks, $t::MAX as f64) {
+                    return Err(e);
+                }
+                let mut kt = [[[0.0 as $t; O]; S]; L];
+                let mut i = 0;
+                while i < L {
+                    kt[i] = linalg::const_round!($t, rows ks[i]);
+                    i += 1;
+                }
+                Ok(Self {
+                    phi: linalg::const_round!($t, rows model.phi),
+                    gamma0: linalg::const_round!($t, rows model.gamma0),
+                    gamma1: linalg::const_round!($t, rows model.gamma1),
+                    h: linalg::const_round!($t, rows meas.h),
+                    d: linalg::const_round!($t, rows meas.d),
+                    k0: linalg::const_round!($t, rows k0),
+                    ks: kt,
+                })
+            }
+        }
+    };
+}
+lag_const!(f32);
+lag_const!(f64);
