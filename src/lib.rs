@@ -86,6 +86,7 @@ mod nonlinear;
 
 // Modal reduction, stability analysis, ready-made models.
 pub mod analysis;
+pub mod estimation;
 pub mod hysteresis;
 pub mod modal;
 pub mod models;

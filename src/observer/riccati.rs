@@ -144,7 +144,7 @@ const RICCATI_RESIDUAL_REFINE: f64 = 4.0;
 
 /// The doubling has converged once `‖A_k‖∞ ≤ 2^-26` (`√ε`): the updates of `X` still to
 /// come are quadratic in it.
-const A_SMALL: f64 = 1.4901161193847656e-8;
+pub(crate) const A_SMALL: f64 = 1.4901161193847656e-8;
 
 /// `|a|` entry by entry.
 const fn abs_of<const R: usize, const C: usize>(a: &Mat<R, C>) -> Mat<R, C> {
@@ -239,7 +239,7 @@ const fn residual_units<const S: usize>(res: &Mat<S, S>, bound: &Mat<S, S>) -> f
 }
 
 /// `max_i Σ_j |a_ij|` (NaN if an entry is NaN).
-const fn inf_norm<const N: usize>(a: &Mat<N, N>) -> f64 {
+pub(crate) const fn inf_norm<const N: usize>(a: &Mat<N, N>) -> f64 {
     let mut m = 0.0f64;
     let mut i = 0;
     while i < N {
@@ -262,7 +262,7 @@ const fn inf_norm<const N: usize>(a: &Mat<N, N>) -> f64 {
 /// off-diagonal sums. A badly scaled closed loop (`H ≈ 7e41` of a modal form with
 /// `M = 2e-84`) has a norm far above its spectral radius, and its squares would be all
 /// rounding. Cost: `O(S²)` a sweep, a few sweeps.
-const fn balance<const N: usize>(a: &Mat<N, N>) -> (Mat<N, N>, [f64; N]) {
+pub(crate) const fn balance<const N: usize>(a: &Mat<N, N>) -> (Mat<N, N>, [f64; N]) {
     let mut b = *a;
     let mut d = [1.0f64; N];
     let mut sweep = 0;
