@@ -30,11 +30,11 @@ def fuzz_section(path):
         elif f and f[0] == "COUNT":
             counts[f[1]][" ".join(f[2:-1])] = int(f[-1])
     covers = dict(
-        linear_family="`Linear` (new, from_rows), `AForm`, `CompensatedLinear`, `LinearInput`, `Newmark` (β, γ; three presets), `GeneralizedAlpha` (ρ∞, HHT), `Exact`; N = 1, 2, 3",
-        modal="`Modal` (new, with_modes, from_rows, from_rows_with_modes; every `Damping`); N = 2, 3",
+        linear_family="`Linear` (new, from_rows_f32/_f64), `AForm`, `CompensatedLinear`, `LinearInput`, `Newmark` (β, γ; three presets), `GeneralizedAlpha` (ρ∞, HHT), `Exact`; N = 1, 2, 3",
+        modal="`Modal` (new, with_modes, from_rows_f32/_f64, from_rows_with_modes_f32/_f64; every `Damping`); N = 2, 3",
         nonlinear="`Nonlinear` (cubic springs, analytic or finite-difference tangent; Newton settings), `Varying`; N = 1, 2",
         hysteresis="`Bilinear`, `BoucWen`, `Friction`, `Parallel` (trials along a path), `ShearBuilding`, its `Nonlinear` steps with history",
-        observer="`StateSpace` (aem, aem_from_rows, exact, modal; wrong S), outputs, `SteadyState`, `Observer` (new, from_parts), `Kalman`, `Readout`",
+        observer="`StateSpace` (aem, from_rows_aem, exact, modal; wrong S), outputs, `SteadyState`, `Observer` (new, from_parts_f32/_f64), `Kalman`, `Readout`",
         spectrum="`Bank` (new, with: both schemes, every sub-step rule), `RotD`, `batch::spectra`",
     )
     order = ["linear_family", "modal", "nonlinear", "hysteresis", "observer", "spectrum"]
