@@ -29,7 +29,8 @@ type Drifts = Vec<[f64; 5]>;
 /// The truth's drifts and the accelerometer samples (`y[n]` for `n ≥ 1`; `y[0]` unused).
 fn truth(ag: &[f64]) -> (Drifts, Vec<[f64; 2]>, [f64; 2]) {
     let (m, c, k) = scene::TRUTH;
-    let sys = LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, base_excitation(&m), scene::H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, base_excitation(&m), scene::H).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();
     let mut noise = scene::Noise::new();
@@ -52,7 +53,8 @@ fn truth(ag: &[f64]) -> (Drifts, Vec<[f64; 2]>, [f64; 2]) {
 /// The open-loop model (the nominal building, no measurement).
 fn open_loop(ag: &[f64]) -> Drifts {
     let (m, c, k) = scene::MODEL;
-    let sys = LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, base_excitation(&m), scene::H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, base_excitation(&m), scene::H).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();
     let mut d = vec![[0.0; 5]];

@@ -103,12 +103,11 @@ macro_rules! from_rows {
     };
 }
 
-
 /// `Linear<$t, $n>` of the `$n`-storey building: a `static`, `reps` steps.
 macro_rules! linear {
     ($syst:expr, $t:ident, $n:literal, $reps:expr, $sym:ident) => {{
         const B: (Rows<$n>, Rows<$n>, Rows<$n>) = building::<$n>();
-        static S: Linear<$t, $n> = match from_rows!($t, Linear<$t, $n>, B.0, B.1, B.2, H) {
+    static S: Linear<$t, $n> = match from_rows!($t, Linear<$t, $n>, B.0, B.1, B.2, H) {
             Ok(s) => s,
             Err(e) => panic!("{}", e.as_str()),
         };

@@ -57,12 +57,11 @@ macro_rules! from_rows {
     };
 }
 
-
 /// `static` operators for an `N`-storey building in type `$t`, computed by the compiler.
 macro_rules! ops {
     ($t:ident, $n:literal) => {{
         const B: (Rows<$n>, Rows<$n>, Rows<$n>) = building::<$n>();
-        static S: Linear<$t, $n> = match from_rows!($t, Linear<$t, $n>, B.0, B.1, B.2, H) {
+    static S: Linear<$t, $n> = match from_rows!($t, Linear<$t, $n>, B.0, B.1, B.2, H) {
             Ok(s) => s,
             Err(e) => panic!("{}", e.as_str()),
         };

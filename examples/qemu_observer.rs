@@ -76,7 +76,8 @@ static OBSERVER: Observer<f32, 10, 1, 2> = ok(Observer::<f32, 10, 1, 2>::from_pa
     &scene::GAIN.gain,
 ));
 /// Every drift from the estimate.
-static DRIFTS: Readout<f32, 10, 1, 5> = ok(Readout::<f32, 10, 1, 5>::from_parts_f32(&scene::DRIFT_OUT));
+static DRIFTS: Readout<f32, 10, 1, 5> =
+    ok(Readout::<f32, 10, 1, 5>::from_parts_f32(&scene::DRIFT_OUT));
 /// The modal observer (2 modes; for the cost line).
 static MODAL: Observer<f32, 4, 1, 2> = ok(Observer::<f32, 4, 1, 2>::from_parts_f32(
     &scene::MODAL_SS,

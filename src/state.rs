@@ -52,7 +52,12 @@ impl<T: Real, const N: usize> State<T, N> {
     }
 
     /// A state from its parts, unchecked (the steppers' own results).
-    pub(crate) fn unchecked(u: SVector<T, N>, v: SVector<T, N>, a: SVector<T, N>, steps: u64) -> Self {
+    pub(crate) fn unchecked(
+        u: SVector<T, N>,
+        v: SVector<T, N>,
+        a: SVector<T, N>,
+        steps: u64,
+    ) -> Self {
         Self { u, v, a, n: steps }
     }
     /// Displacement `u_n` (model units, e.g. m).

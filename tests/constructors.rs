@@ -7,7 +7,7 @@
 
 use aemstep::models::{Rows, base_excitation, rayleigh, rayleigh_coefficients, shear_building};
 use aemstep::nalgebra::SMatrix;
-use aemstep::{Damping, Linear, LinearInput, Modal, Stepper};
+use aemstep::{Damping, Linear, LinearInput, Modal};
 
 /// A 4-storey building, storeys not uniform, Rayleigh damping ξ = 0.07 in modes 1 and 2.
 fn building() -> (Rows<4>, Rows<4>, Rows<4>) {
@@ -86,7 +86,8 @@ fn modal_new_equals_from_rows_bit_for_bit() {
         H,
     )
     .unwrap();
-    let b = Modal::<f32, 4, 2, 1, 2>::from_rows_with_modes_f32(m, k, ratios, b, y, [3, 1], H).unwrap();
+    let b =
+        Modal::<f32, 4, 2, 1, 2>::from_rows_with_modes_f32(m, k, ratios, b, y, [3, 1], H).unwrap();
     assert_eq!(bits(&a), bits(&b));
 }
 
@@ -111,11 +112,15 @@ mod largest_const_sizes {
         a
     }
 
-    static LINEAR_63: Linear<f32, 63> =
-        match Linear::<f32, 63>::from_rows_f32(chain(1.0, 0.0), chain(0.0, 0.0), chain(2.0, -1.0), H) {
-            Ok(s) => s,
-            Err(e) => panic!("{}", e.as_str()),
-        };
+    static LINEAR_63: Linear<f32, 63> = match Linear::<f32, 63>::from_rows_f32(
+        chain(1.0, 0.0),
+        chain(0.0, 0.0),
+        chain(2.0, -1.0),
+        H,
+    ) {
+        Ok(s) => s,
+        Err(e) => panic!("{}", e.as_str()),
+    };
 
     static MODAL_49: Modal<f32, 49, 2> = match Modal::<f32, 49, 2>::from_rows_f32(
         chain(1.0, 0.0),

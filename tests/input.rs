@@ -198,9 +198,14 @@ fn errors_and_failed_step_leaves_state_unchanged() {
     );
     // Singular M with nonsingular M_eff: steps fine, start needs the acceleration.
     let z = [[0.0; 2]; 2];
-    let sys =
-        LinearInput::<f64, 2, 1>::from_rows_f64(z, z, [[2.0, -1.0], [-1.0, 1.0]], [[1.0], [0.0]], 0.1)
-            .unwrap();
+    let sys = LinearInput::<f64, 2, 1>::from_rows_f64(
+        z,
+        z,
+        [[2.0, -1.0], [-1.0, 1.0]],
+        [[1.0], [0.0]],
+        0.1,
+    )
+    .unwrap();
     let zero = SVector::<f64, 2>::zeros();
     assert_eq!(
         sys.start(&zero, &zero, &SVector::from([1.0])),

@@ -60,7 +60,8 @@ fn recurrence_bound(n: usize, terms: usize, scale: f64) -> f64 {
 #[test]
 fn aem_state_space_reproduces_linear_input() {
     let ss = building();
-    let sys = LinearInput::<f64, 5, 1>::from_rows_f64(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap();
     let ag = &elcentro::AG_F64;
     let z = SVector::<f64, 5>::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();
@@ -452,7 +453,8 @@ fn zero_gain_observer_is_the_open_loop_stepper() {
     let ss = building();
     let meas = ss.outputs(&accelerometers()).unwrap();
     let obs = Observer::<f64, 10, 1, 2>::new(&ss, &meas, &SMatrix::zeros()).unwrap();
-    let sys = LinearInput::<f64, 5, 1>::from_rows_f64(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap();
     let ag = &elcentro::AG_F64;
     let z = SVector::<f64, 5>::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();
@@ -575,10 +577,12 @@ fn f32_observer_from_the_compiler_is_bit_identical_to_run_time() {
             Outputs::<5, 1, 2>::select([1, 4]),
             0,
         )) {
-            Ok(meas) => match Observer::<f32, 10, 1, 2>::from_parts_f32(&SS, &meas, &CONST_GAIN.gain) {
-                Ok(o) => o,
-                Err(e) => panic!("{}", e.as_str()),
-            },
+            Ok(meas) => {
+                match Observer::<f32, 10, 1, 2>::from_parts_f32(&SS, &meas, &CONST_GAIN.gain) {
+                    Ok(o) => o,
+                    Err(e) => panic!("{}", e.as_str()),
+                }
+            }
             Err(e) => panic!("{}", e.as_str()),
         }
     };
@@ -696,7 +700,8 @@ const EVERY: usize = 10;
 /// `LinearInput<f64, 5, 1>` in soft-float f64 (IEEE: bit-identical).
 fn truth_measurements() -> (Vec<[f64; 2]>, [f64; 2]) {
     let (m, c, k) = scene::TRUTH;
-    let sys = LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, base_excitation(&m), scene::H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, base_excitation(&m), scene::H).unwrap();
     let ag = &elcentro::AG_F64;
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();

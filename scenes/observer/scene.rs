@@ -99,8 +99,12 @@ pub const MODAL_DRIFT_OUT: Measurement<4, 1, 5> = ok(MODAL_SS.outputs(&DRIFTS));
 pub const MODAL_Q: [[f64; 4]; 4] = MODAL_FORCES.input_noise(&diag([SIGMA_F * SIGMA_F; 5]));
 /// The modal observer's steady-state gain. The dropped modes' response is measurement
 /// error to it; it is in the accelerometers' noise budget here.
-pub const MODAL_GAIN: SteadyState<4, 2> =
-    ok(SteadyState::from_parts(&MODAL_SS, &MODAL_MEAS, &MODAL_Q, &R));
+pub const MODAL_GAIN: SteadyState<4, 2> = ok(SteadyState::from_parts(
+    &MODAL_SS,
+    &MODAL_MEAS,
+    &MODAL_Q,
+    &R,
+));
 
 /// `diag(d)`.
 pub const fn diag<const N: usize>(d: [f64; N]) -> [[f64; N]; N] {

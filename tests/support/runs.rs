@@ -271,7 +271,9 @@ pub fn cross_check<const N: usize>() -> CrossCheck<N> {
     let tn = nm
         .iter()
         .enumerate()
-        .map(|(n, (u, v, a))| State::restore(sv(u), sv(v), sv(a), n as u64).expect("a finite reference"))
+        .map(|(n, (u, v, a))| {
+            State::restore(sv(u), sv(v), sv(a), n as u64).expect("a finite reference")
+        })
         .collect();
     CrossCheck {
         tf: trajectory(&fast, steps),
