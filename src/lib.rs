@@ -76,9 +76,9 @@
 //!     Err(e) => panic!("{}", e.as_str()),
 //! };
 //! const H: f32 = SYS.time_step(); // s
-//! const RATE_HZ: f32 = 1.0 / H;
+//! const STEPS_PER_SECOND: u32 = (1.0 / H + 0.5) as u32;
 //! assert_eq!(H, 0.002);
-//! assert_eq!(RATE_HZ, 500.0);
+//! assert_eq!(STEPS_PER_SECOND, 500);
 //! ```
 //!
 //! ```
