@@ -51,7 +51,7 @@ mod flash_modal {
     use aemstep::models::base_excitation;
     use aemstep::{Damping, Modal};
 
-    static MODAL: Modal<f32, 5, 2> = match Modal::<f32, 5, 2>::from_rows_f32(
+    static MODAL: Modal<f32, 5, 2> = match Modal::from_rows_f32(
         BUILDING.0,
         BUILDING.2,
         Damping::Matrix(BUILDING.1),

@@ -66,7 +66,7 @@ static FULL: Linear<f32, 5> =
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };
-static FULL_INPUT: LinearInput<f32, 5, 1> = match LinearInput::<f32, 5, 1>::from_rows_f32(
+static FULL_INPUT: LinearInput<f32, 5, 1> = match LinearInput::from_rows_f32(
     BUILDING.0,
     BUILDING.1,
     BUILDING.2,
@@ -82,7 +82,7 @@ static FULL_INPUT: LinearInput<f32, 5, 1> = match LinearInput::<f32, 5, 1>::from
 /// (`scripts/qemu.sh` checks the symbol list).
 macro_rules! modal {
     ($r:literal) => {{
-        static S: Modal<f32, 5, $r> = match Modal::<f32, 5, $r>::from_rows_f32(
+        static S: Modal<f32, 5, $r> = match Modal::from_rows_f32(
             BUILDING.0,
             BUILDING.2,
             Damping::Matrix(BUILDING.1),

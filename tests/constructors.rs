@@ -112,17 +112,13 @@ mod largest_const_sizes {
         a
     }
 
-    static LINEAR_63: Linear<f32, 63> = match Linear::<f32, 63>::from_rows_f32(
-        chain(1.0, 0.0),
-        chain(0.0, 0.0),
-        chain(2.0, -1.0),
-        H,
-    ) {
-        Ok(s) => s,
-        Err(e) => panic!("{}", e.as_str()),
-    };
+    static LINEAR_63: Linear<f32, 63> =
+        match Linear::from_rows_f32(chain(1.0, 0.0), chain(0.0, 0.0), chain(2.0, -1.0), H) {
+            Ok(s) => s,
+            Err(e) => panic!("{}", e.as_str()),
+        };
 
-    static MODAL_49: Modal<f32, 49, 2> = match Modal::<f32, 49, 2>::from_rows_f32(
+    static MODAL_49: Modal<f32, 49, 2> = match Modal::from_rows_f32(
         chain(1.0, 0.0),
         chain(2.0, -1.0),
         Damping::None,

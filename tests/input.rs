@@ -142,7 +142,7 @@ fn base_excitation_f32_matches_linear() {
 fn const_and_runtime_constructors_agree_bit_for_bit() {
     let (m, c, k) = models::five_storey_building();
     let b = base_excitation(&m);
-    static SYS: LinearInput<f32, 5, 1> = match LinearInput::<f32, 5, 1>::from_rows_f32(
+    static SYS: LinearInput<f32, 5, 1> = match LinearInput::from_rows_f32(
         models::five_storey_building().0,
         models::five_storey_building().1,
         models::five_storey_building().2,

@@ -417,11 +417,11 @@ const EX4_K: [[f64; 3]; 3] = [
 ];
 
 /// Evaluated by the compiler (a `static` initializer must be a constant).
-static EX4_F64: Linear<f64, 3> = match Linear::<f64, 3>::from_rows_f64(EX4_M, EX4_C, EX4_K, 0.01) {
+static EX4_F64: Linear<f64, 3> = match Linear::from_rows_f64(EX4_M, EX4_C, EX4_K, 0.01) {
     Ok(s) => s,
     Err(e) => panic!("{}", e.as_str()),
 };
-static EX4_F32: Linear<f32, 3> = match Linear::<f32, 3>::from_rows_f32(EX4_M, EX4_C, EX4_K, 0.01) {
+static EX4_F32: Linear<f32, 3> = match Linear::from_rows_f32(EX4_M, EX4_C, EX4_K, 0.01) {
     Ok(s) => s,
     Err(e) => panic!("{}", e.as_str()),
 };

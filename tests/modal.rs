@@ -409,7 +409,7 @@ fn f32_modal_tracks_f64_modal() {
 fn const_and_runtime_constructors_agree_bit_for_bit() {
     const B: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();
     const ROOF: [[f64; 5]; 1] = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    static S32: Modal<f32, 5, 2> = match Modal::<f32, 5, 2>::from_rows_f32(
+    static S32: Modal<f32, 5, 2> = match Modal::from_rows_f32(
         B.0,
         B.2,
         Damping::Matrix(B.1),
@@ -420,7 +420,7 @@ fn const_and_runtime_constructors_agree_bit_for_bit() {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };
-    static S64: Modal<f64, 5, 3, 1, 5> = match Modal::<f64, 5, 3, 1, 5>::from_rows_with_modes_f64(
+    static S64: Modal<f64, 5, 3, 1, 5> = match Modal::from_rows_with_modes_f64(
         B.0,
         B.2,
         Damping::Matrix(B.1),
