@@ -53,7 +53,7 @@ bit patterns; `h` from 1e-324 to 1e300 and invalid ones (0, −0, < 0, NaN, ∞,
 overflowing); structured matrices (SPD at any scale, singular and near-singular
 `v vᵀ + δ I`, non-symmetric, effective matrices cancelled to rounding `K = −4M/h²`,
 `C = −2M/h` and near them); scheme parameters in and out of range — and run the checks
-of `fuzz/src/checks.rs` on them: every constructor of the group in `f32` and `f64`, every
+of `fuzz/src/checks/` on them: every constructor of the group in `f32` and `f64`, every
 built stepper started and stepped with checked steps (a NaN load among them), each `Ok`
 compared with the unchecked step, each failed step's state compared bit by bit, the same
 data given to every constructor that takes it (the same error expected where the data
