@@ -184,14 +184,18 @@ fn from_rows_modal<T: Real, const N: usize, const R: usize>(
 ) -> String {
     if eps::<T>() > 1e-10 {
         match modes {
-            None => bits(&Modal::<f32, N, R, 2, 2>::from_rows_f32(m, k, damp, b, y, h)),
+            None => bits(&Modal::<f32, N, R, 2, 2>::from_rows_f32(
+                m, k, damp, b, y, h,
+            )),
             Some(md) => bits(&Modal::<f32, N, R, 2, 2>::from_rows_with_modes_f32(
                 m, k, damp, b, y, md, h,
             )),
         }
     } else {
         match modes {
-            None => bits(&Modal::<f64, N, R, 2, 2>::from_rows_f64(m, k, damp, b, y, h)),
+            None => bits(&Modal::<f64, N, R, 2, 2>::from_rows_f64(
+                m, k, damp, b, y, h,
+            )),
             Some(md) => bits(&Modal::<f64, N, R, 2, 2>::from_rows_with_modes_f64(
                 m, k, damp, b, y, md, h,
             )),

@@ -475,9 +475,17 @@ fn observers_typed<T: Real>(
         );
     }
     let fp = if eps::<T>() > 1e-10 {
-        bits(&Observer::<f32, 4, 1, 2>::from_parts_f32(ss, meas, &rows(gain)))
+        bits(&Observer::<f32, 4, 1, 2>::from_parts_f32(
+            ss,
+            meas,
+            &rows(gain),
+        ))
     } else {
-        bits(&Observer::<f64, 4, 1, 2>::from_parts_f64(ss, meas, &rows(gain)))
+        bits(&Observer::<f64, 4, 1, 2>::from_parts_f64(
+            ss,
+            meas,
+            &rows(gain),
+        ))
     };
     check!(
         fp == bits(&ob),
