@@ -175,7 +175,8 @@ fn generic_bank_fails_as_the_const_banks() {
     assert_eq!(Bank::<f32, 1>::new(t, z, h), Bank::new_f32(t, z, h));
     assert!(Bank::<f64, 1>::new(t, z, h).is_ok());
     // Bad data: the same variant from both.
-    let cases: [([f64; 2], [f64; 2], f64, Substeps, Error); 5] = [
+    type Case = ([f64; 2], [f64; 2], f64, Substeps, Error);
+    let cases: [Case; 5] = [
         (
             [0.1, 1.0],
             [0.05; 2],
