@@ -29,7 +29,8 @@ type Drifts = Vec<[f64; 5]>;
 /// The truth's drifts and the accelerometer samples (`y[n]` for `n ≥ 1`; `y[0]` unused).
 fn truth(ag: &[f64]) -> (Drifts, Vec<[f64; 2]>, [f64; 2]) {
     let (m, c, k) = scene::TRUTH;
-    let sys = LinearInput::<f64, 5, 1>::from_rows(m, c, k, base_excitation(&m), scene::H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, base_excitation(&m), scene::H).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();
     let mut noise = scene::Noise::new();
@@ -52,7 +53,8 @@ fn truth(ag: &[f64]) -> (Drifts, Vec<[f64; 2]>, [f64; 2]) {
 /// The open-loop model (the nominal building, no measurement).
 fn open_loop(ag: &[f64]) -> Drifts {
     let (m, c, k) = scene::MODEL;
-    let sys = LinearInput::<f64, 5, 1>::from_rows(m, c, k, base_excitation(&m), scene::H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, base_excitation(&m), scene::H).unwrap();
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();
     let mut d = vec![[0.0; 5]];
@@ -251,28 +253,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (truth, y, peak) = truth(ag);
     let open = open_loop(ag);
     let gain = scene::GAIN.gain;
-    let obs64 = Observer::<f64, 10, 1, 2>::from_parts(&scene::MODEL_SS, &scene::MEAS, &gain)?;
-    let obs32 = Observer::<f32, 10, 1, 2>::from_parts(&scene::MODEL_SS, &scene::MEAS, &gain)?;
+    let obs64 = Observer::<f64, 10, 1, 2>::from_parts_f64(&scene::MODEL_SS, &scene::MEAS, &gain)?;
+    let obs32 = Observer::<f32, 10, 1, 2>::from_parts_f32(&scene::MODEL_SS, &scene::MEAS, &gain)?;
     let est64 = observe(
         &obs64,
-        &Readout::<f64, 10, 1, 5>::from_parts(&scene::DRIFT_OUT)?,
+        &Readout::<f64, 10, 1, 5>::from_parts_f64(&scene::DRIFT_OUT)?,
         ag,
         &y,
     );
     let est32 = observe(
         &obs32,
-        &Readout::<f32, 10, 1, 5>::from_parts(&scene::DRIFT_OUT)?,
+        &Readout::<f32, 10, 1, 5>::from_parts_f32(&scene::DRIFT_OUT)?,
         ag,
         &y,
     );
-    let modal = Observer::<f64, 4, 1, 2>::from_parts(
+    let modal = Observer::<f64, 4, 1, 2>::from_parts_f64(
         &scene::MODAL_SS,
         &scene::MODAL_MEAS,
         &scene::MODAL_GAIN.gain,
     )?;
     let est_modal = observe(
         &modal,
-        &Readout::<f64, 4, 1, 5>::from_parts(&scene::MODAL_DRIFT_OUT)?,
+        &Readout::<f64, 4, 1, 5>::from_parts_f64(&scene::MODAL_DRIFT_OUT)?,
         ag,
         &y,
     );
@@ -435,11 +437,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     writeln!(
         md,
-        "`StateSpace::aem` / `aem_from_rows` (`Linear`, `LinearInput`), `newmark` / `newmark_from_rows` (`Newmark`,"
+        "`StateSpace::aem` / `from_rows_aem` (`Linear`, `LinearInput`), `newmark` / `from_rows_newmark` (`Newmark`,"
     )?;
     writeln!(
         md,
-        "any β, γ), `generalized_alpha` / `generalized_alpha_from_rows` (`GeneralizedAlpha`, HHT-α: its acceleration is"
+        "any β, γ), `generalized_alpha` / `from_rows_generalized_alpha` (`GeneralizedAlpha`, HHT-α: its acceleration is"
     )?;
     writeln!(
         md,
@@ -447,7 +449,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     writeln!(
         md,
-        "`modal` / `modal_from_rows` (`Modal`). Each reproduces its stepper to rounding (`tests/state_space.rs`,"
+        "`modal` / `from_rows_modal` (`Modal`). Each reproduces its stepper to rounding (`tests/state_space.rs`,"
     )?;
     writeln!(
         md,

@@ -7,7 +7,7 @@
 //! Portable across ARMv6-M (no FPU), ARMv7-M, ARMv7E-M and ARMv8-M Mainline: no FPU-only
 //! code, no A-form (its `f64` N = 12 operators would not fit the 16 KiB of RAM of the
 //! Cortex-M0 board), nothing kept on the stack beyond one state. Operators are `static`s
-//! computed by the compiler (`from_rows`). Prints one line per case:
+//! computed by the compiler (`from_rows_f32`/`_f64`). Prints one line per case:
 //!
 //! ```text
 //! CORE <form> <T> <N> <instructions per step> <multiply-adds> <symbol>
@@ -92,11 +92,22 @@ fn row(form: &str, ty: &str, n: usize, tenths: u32, madds: usize, sym: &str) {
     );
 }
 
+/// `<$ty>::from_rows_f32(…)` or `<$ty>::from_rows_f64(…)` as the scalar `$t` says (the
+/// `const fn` constructors name their scalar).
+macro_rules! from_rows {
+    (f32, $ty:ty, $($a:expr),* $(,)?) => {
+        <$ty>::from_rows_f32($($a),*)
+    };
+    (f64, $ty:ty, $($a:expr),* $(,)?) => {
+        <$ty>::from_rows_f64($($a),*)
+    };
+}
+
 /// `Linear<$t, $n>` of the `$n`-storey building: a `static`, `reps` steps.
 macro_rules! linear {
     ($syst:expr, $t:ident, $n:literal, $reps:expr, $sym:ident) => {{
         const B: (Rows<$n>, Rows<$n>, Rows<$n>) = building::<$n>();
-        static S: Linear<$t, $n> = match Linear::<$t, $n>::from_rows(B.0, B.1, B.2, H) {
+    static S: Linear<$t, $n> = match from_rows!($t, Linear<$t, $n>, B.0, B.1, B.2, H) {
             Ok(s) => s,
             Err(e) => panic!("{}", e.as_str()),
         };
@@ -137,7 +148,9 @@ const ROOF: [[f64; 5]; 1] = [[0.0, 0.0, 0.0, 0.0, 1.0]];
 /// and the roof drift: `R·I + 7R + O·R = 18` multiply-adds (as `examples/qemu_modal.rs`).
 macro_rules! modal {
     ($syst:expr, $t:ident, $reps:expr, $sym:ident) => {{
-        static S: Modal<$t, 5, 2> = match Modal::<$t, 5, 2>::from_rows(
+        static S: Modal<$t, 5, 2> = match from_rows!(
+            $t,
+            Modal<$t, 5, 2>,
             BUILDING5.0,
             BUILDING5.2,
             Damping::Matrix(BUILDING5.1),

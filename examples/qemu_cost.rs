@@ -46,11 +46,22 @@ const fn building<const N: usize>() -> (Rows<N>, Rows<N>, Rows<N>) {
     (m, c, k)
 }
 
+/// `<$ty>::from_rows_f32(…)` or `<$ty>::from_rows_f64(…)` as the scalar `$t` says (the
+/// `const fn` constructors name their scalar).
+macro_rules! from_rows {
+    (f32, $ty:ty, $($a:expr),* $(,)?) => {
+        <$ty>::from_rows_f32($($a),*)
+    };
+    (f64, $ty:ty, $($a:expr),* $(,)?) => {
+        <$ty>::from_rows_f64($($a),*)
+    };
+}
+
 /// `static` operators for an `N`-storey building in type `$t`, computed by the compiler.
 macro_rules! ops {
-    ($t:ty, $n:literal) => {{
+    ($t:ident, $n:literal) => {{
         const B: (Rows<$n>, Rows<$n>, Rows<$n>) = building::<$n>();
-        static S: Linear<$t, $n> = match Linear::<$t, $n>::from_rows(B.0, B.1, B.2, H) {
+    static S: Linear<$t, $n> = match from_rows!($t, Linear<$t, $n>, B.0, B.1, B.2, H) {
             Ok(s) => s,
             Err(e) => panic!("{}", e.as_str()),
         };
@@ -200,7 +211,7 @@ macro_rules! case {
         }
         const B: (Rows<$n>, Rows<$n>, Rows<$n>) = building::<$n>();
         static S: aemstep::CompensatedLinear<$t, $n> =
-            match aemstep::CompensatedLinear::<$t, $n>::from_rows(B.0, B.1, B.2, H) {
+            match from_rows!($t, aemstep::CompensatedLinear<$t, $n>, B.0, B.1, B.2, H) {
                 Ok(s) => s,
                 Err(e) => panic!("{}", e.as_str()),
             };

@@ -3,7 +3,7 @@
 //! Default build: only `Linear<f32, 5>` (operators a compiler-built `static`), stepping the
 //! benchmark building under a synthetic ground motion. With `--cfg aemstep_control="footprint-modal"`
 //! it also steps `Modal<f32, 5, 2>` whose modes the compiler solved (`static`,
-//! `Modal::from_rows`). With `--cfg aemstep_control="footprint-all"` it also steps the nonlinear
+//! `Modal::from_rows_f32`). With `--cfg aemstep_control="footprint-all"` it also steps the nonlinear
 //! stepper (`Nonlinear<f32, 5>`, the building with hardening storey springs, Newton) and a
 //! `Modal<f32, 5, 2>` built at start-up (`Modal::new`: the eigen-solver runs on target).
 //! `scripts/qemu.sh` builds and runs all three, compares their flash (`llvm-size`) and
@@ -29,7 +29,7 @@ const STEPS: u32 = 1000;
 const BUILDING: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();
 
 static FULL: Linear<f32, 5> =
-    match Linear::<f32, 5>::from_rows(BUILDING.0, BUILDING.1, BUILDING.2, H) {
+    match Linear::<f32, 5>::from_rows_f32(BUILDING.0, BUILDING.1, BUILDING.2, H) {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };
@@ -51,7 +51,7 @@ mod flash_modal {
     use aemstep::models::base_excitation;
     use aemstep::{Damping, Modal};
 
-    static MODAL: Modal<f32, 5, 2> = match Modal::<f32, 5, 2>::from_rows(
+    static MODAL: Modal<f32, 5, 2> = match Modal::from_rows_f32(
         BUILDING.0,
         BUILDING.2,
         Damping::Matrix(BUILDING.1),

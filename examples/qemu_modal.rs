@@ -62,11 +62,11 @@ const ROOF: [[f64; 5]; 1] = [[0.0, 0.0, 0.0, 0.0, 1.0]];
 
 /// The full models, operators computed by the compiler into flash.
 static FULL: Linear<f32, 5> =
-    match Linear::<f32, 5>::from_rows(BUILDING.0, BUILDING.1, BUILDING.2, H) {
+    match Linear::<f32, 5>::from_rows_f32(BUILDING.0, BUILDING.1, BUILDING.2, H) {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };
-static FULL_INPUT: LinearInput<f32, 5, 1> = match LinearInput::<f32, 5, 1>::from_rows(
+static FULL_INPUT: LinearInput<f32, 5, 1> = match LinearInput::from_rows_f32(
     BUILDING.0,
     BUILDING.1,
     BUILDING.2,
@@ -78,11 +78,11 @@ static FULL_INPUT: LinearInput<f32, 5, 1> = match LinearInput::<f32, 5, 1>::from
 };
 
 /// `Modal<f32, 5, R>` of the building, its modes solved by the compiler (`const fn`
-/// `from_rows`): the operators sit in flash and no eigen-solver code is linked
+/// `from_rows_f32`): the operators sit in flash and no eigen-solver code is linked
 /// (`scripts/qemu.sh` checks the symbol list).
 macro_rules! modal {
     ($r:literal) => {{
-        static S: Modal<f32, 5, $r> = match Modal::<f32, 5, $r>::from_rows(
+        static S: Modal<f32, 5, $r> = match Modal::from_rows_f32(
             BUILDING.0,
             BUILDING.2,
             Damping::Matrix(BUILDING.1),

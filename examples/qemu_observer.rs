@@ -70,21 +70,22 @@ const fn ok<T: Copy>(r: Result<T, aemstep::Error>) -> T {
 }
 
 /// The observer: model and gain computed by the compiler into flash.
-static OBSERVER: Observer<f32, 10, 1, 2> = ok(Observer::<f32, 10, 1, 2>::from_parts(
+static OBSERVER: Observer<f32, 10, 1, 2> = ok(Observer::<f32, 10, 1, 2>::from_parts_f32(
     &scene::MODEL_SS,
     &scene::MEAS,
     &scene::GAIN.gain,
 ));
 /// Every drift from the estimate.
-static DRIFTS: Readout<f32, 10, 1, 5> = ok(Readout::<f32, 10, 1, 5>::from_parts(&scene::DRIFT_OUT));
+static DRIFTS: Readout<f32, 10, 1, 5> =
+    ok(Readout::<f32, 10, 1, 5>::from_parts_f32(&scene::DRIFT_OUT));
 /// The modal observer (2 modes; for the cost line).
-static MODAL: Observer<f32, 4, 1, 2> = ok(Observer::<f32, 4, 1, 2>::from_parts(
+static MODAL: Observer<f32, 4, 1, 2> = ok(Observer::<f32, 4, 1, 2>::from_parts_f32(
     &scene::MODAL_SS,
     &scene::MODAL_MEAS,
     &scene::MODAL_GAIN.gain,
 ));
 /// The "true" building (plays the sensors), `f64`.
-static TRUTH: LinearInput<f64, 5, 1> = ok(LinearInput::<f64, 5, 1>::from_rows(
+static TRUTH: LinearInput<f64, 5, 1> = ok(LinearInput::<f64, 5, 1>::from_rows_f64(
     scene::TRUTH.0,
     scene::TRUTH.1,
     scene::TRUTH.2,

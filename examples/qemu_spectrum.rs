@@ -58,16 +58,14 @@ const BOUND: f64 = reference::BOUND;
 #[cfg(aemstep_broken = "spectrum-tight-bound")]
 const BOUND: f64 = reference::BOUND / 1000.0;
 
-static BANK100: Bank<f32, 100> =
-    match Bank::<f32, 100>::new(config::PERIODS_100, [config::ZETA; 100], DT) {
-        Ok(b) => b,
-        Err(e) => panic!("{}", e.as_str()),
-    };
-static BANK10: Bank<f32, 10> =
-    match Bank::<f32, 10>::new(config::PERIODS_10, [config::ZETA; 10], DT) {
-        Ok(b) => b,
-        Err(e) => panic!("{}", e.as_str()),
-    };
+static BANK100: Bank<f32, 100> = match Bank::new_f32(config::PERIODS_100, [config::ZETA; 100], DT) {
+    Ok(b) => b,
+    Err(e) => panic!("{}", e.as_str()),
+};
+static BANK10: Bank<f32, 10> = match Bank::new_f32(config::PERIODS_10, [config::ZETA; 10], DT) {
+    Ok(b) => b,
+    Err(e) => panic!("{}", e.as_str()),
+};
 
 /// One incoming sample through the 100-oscillator bank. Out of line so its code size
 /// (symbol `qemu_spectrum_step`) and stack can be measured alone.

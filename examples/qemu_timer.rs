@@ -51,7 +51,7 @@ const BOUND: f64 = 1.2e-7;
 /// The operators, computed by the compiler (in f64, rounded once to f32) into flash.
 #[cfg_attr(aemstep_control = "runtime-ops", allow(dead_code))]
 static SYS: Linear<f32, 1> =
-    match Linear::<f32, 1>::from_rows([[1.0]], [[2.0 * XI * OMEGA]], [[OMEGA * OMEGA]], H) {
+    match Linear::<f32, 1>::from_rows_f32([[1.0]], [[2.0 * XI * OMEGA]], [[OMEGA * OMEGA]], H) {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };

@@ -348,7 +348,7 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "| firmware | flash (bytes) |"
     echo "|---|---:|"
     echo "| \`Linear<f32, 5>\` only | $FP_LEAN |"
-    echo "| + \`Modal<f32, 5, 2>\` (\`static\`, \`from_rows\`) | $FP_MODAL |"
+    echo "| + \`Modal<f32, 5, 2>\` (\`static\`, \`from_rows_f32\`) | $FP_MODAL |"
     echo "| + \`Nonlinear<f32, 5>\` + \`Modal<f32, 5, 2>\` (\`Modal::new\` on target) | $FP_ALL |"
     echo
     echo "## Memory of each example"

@@ -121,7 +121,7 @@ pub use crate::hysteresis::ShearBuilding;
 /// `K_ii = k_i + k_{i+1}` (`k_{N+1} = 0`), `K_{i,i+1} = K_{i+1,i} = −k_{i+1}`.
 ///
 /// Units: kg and N/m (or any consistent set). DOF `i` is the displacement of floor `i+1`
-/// relative to the ground. No checks here: `Linear::new`/`from_rows` check the result.
+/// relative to the ground. No checks here: `Linear::new`/`from_rows_f32`/`from_rows_f64` check the result.
 pub const fn shear_building<const N: usize>(m: [f64; N], k: [f64; N]) -> (Rows<N>, Rows<N>) {
     let mut mm = [[0.0; N]; N];
     let mut kk = [[0.0; N]; N];

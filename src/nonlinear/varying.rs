@@ -183,7 +183,7 @@ impl<T: Real, const N: usize> Varying<T, N> {
             return Err(Error::SingularEffectiveMatrixAtStep { step: n });
         }
         let (v, u) = self.kin.correct_all(&vh, &uh, &q);
-        let next = State::from_parts(u, v, q, n);
+        let next = State::unchecked(u, v, q, n);
         if !next.is_finite() {
             return Err(Error::NonFiniteState);
         }

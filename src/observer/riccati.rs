@@ -135,7 +135,7 @@ pub(crate) const fn gain_of<const S: usize, const O: usize>(
     Some(transpose(&lu.solve(&hp)))
 }
 
-/// Newton refinements of the doubling's solution at most ([`SteadyState::solve`]).
+/// Newton refinements of the doubling's solution at most ([`SteadyState::from_parts`]).
 const RICCATI_REFINEMENTS: u32 = 3;
 
 /// A residual at or below this many units (of [`RICCATI_RESIDUAL_UNITS`]'s `(2S + 5) ε`)
@@ -389,9 +389,9 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
     /// each refinement; a few `S×S` `f64` temporaries on the stack. In a `static` the
     /// compiler evaluates it; `S = 10` (the 5-storey building, 10 iterations) is pinned by
     /// `tests/observer.rs` (`CONST_GAIN`). Much larger `S` may stop rustc with the
-    /// `long_running_const_eval` lint, as for the steppers' `from_rows`: allow it at the
+    /// `long_running_const_eval` lint, as for the steppers' `from_rows_f32`/`_f64`: allow it at the
     /// firmware's crate root, or solve at run time with [`SteadyState::new`].
-    pub const fn solve<const N: usize, const I: usize>(
+    pub const fn from_parts<const N: usize, const I: usize>(
         model: &StateSpace<N, S, I>,
         meas: &Measurement<S, I, O>,
         q: &[[f64; S]; S],
@@ -502,16 +502,16 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         }
     }
 
-    /// [`SteadyState::solve`] with `nalgebra` covariances (run time; same numbers).
+    /// [`SteadyState::from_parts`] with `nalgebra` covariances (run time; same numbers).
     ///
-    /// Errors and cost: as [`SteadyState::solve`].
+    /// Errors and cost: as [`SteadyState::from_parts`].
     pub fn new<const N: usize, const I: usize>(
         model: &StateSpace<N, S, I>,
         meas: &Measurement<S, I, O>,
         q: &SMatrix<f64, S, S>,
         r: &SMatrix<f64, O, O>,
     ) -> Result<Self, Error> {
-        Self::solve(model, meas, &rows_f64(q), &rows_f64(r))
+        Self::from_parts(model, meas, &rows_f64(q), &rows_f64(r))
     }
 
     /// `P` as a `nalgebra` matrix.

@@ -1,6 +1,6 @@
 //! Fuzz target `linear_family` (`fuzz_targets/linear_family.rs`): checks Linear, AForm,
 //! CompensatedLinear, LinearInput, Newmark, GeneralizedAlpha, Exact — every constructor
-//! (and `from_rows`), f32 and f64, N = 1, 2, 3.
+//! (and `from_rows_f32`/`_f64`), f32 and f64, N = 1, 2, 3.
 //!
 //! The decoder and the checks every target shares are in `common.rs`.
 
@@ -293,23 +293,23 @@ fn linear_cross<const N: usize>(d: &LinearInputs<N>) {
     let (mr, cr, kr, br) = (rows(m), rows(c), rows(k), rows(&d.b));
     check!(
         bits(&Linear::<f64, N>::new(m, c, k, h))
-            == bits(&Linear::<f64, N>::from_rows(mr, cr, kr, h))
+            == bits(&Linear::<f64, N>::from_rows_f64(mr, cr, kr, h))
             && bits(&Linear::<f32, N>::new(m, c, k, h))
-                == bits(&Linear::<f32, N>::from_rows(mr, cr, kr, h)),
+                == bits(&Linear::<f32, N>::from_rows_f32(mr, cr, kr, h)),
         "{LIN}: Linear::from_rows differs from Linear::new"
     );
     check!(
         bits(&CompensatedLinear::<f64, N>::new(m, c, k, h))
-            == bits(&CompensatedLinear::<f64, N>::from_rows(mr, cr, kr, h))
+            == bits(&CompensatedLinear::<f64, N>::from_rows_f64(mr, cr, kr, h))
             && bits(&CompensatedLinear::<f32, N>::new(m, c, k, h))
-                == bits(&CompensatedLinear::<f32, N>::from_rows(mr, cr, kr, h)),
+                == bits(&CompensatedLinear::<f32, N>::from_rows_f32(mr, cr, kr, h)),
         "{LIN}: CompensatedLinear::from_rows differs from new"
     );
     check!(
         bits(&LinearInput::<f64, N, N>::new(m, c, k, &d.b, h))
-            == bits(&LinearInput::<f64, N, N>::from_rows(mr, cr, kr, br, h))
+            == bits(&LinearInput::<f64, N, N>::from_rows_f64(mr, cr, kr, br, h))
             && bits(&LinearInput::<f32, N, N>::new(m, c, k, &d.b, h))
-                == bits(&LinearInput::<f32, N, N>::from_rows(mr, cr, kr, br, h)),
+                == bits(&LinearInput::<f32, N, N>::from_rows_f32(mr, cr, kr, br, h)),
         "{LIN}: LinearInput::from_rows differs from new"
     );
     count(LIN, "from_rows compared");

@@ -1,5 +1,5 @@
-//! Fuzz target `modal` (`fuzz_targets/modal.rs`): checks Modal::new, with_modes, from_rows,
-//! from_rows_with_modes, every Damping form, f32 and f64; N = 2 (R = 1, 2) and N = 3
+//! Fuzz target `modal` (`fuzz_targets/modal.rs`): checks Modal::new, with_modes, from_rows_f32/_f64,
+//! from_rows_with_modes_f32/_f64, every Damping form, f32 and f64; N = 2 (R = 1, 2) and N = 3
 //! (R = 2).
 //!
 //! The decoder and the checks every target shares are in `common.rs`.
@@ -113,8 +113,8 @@ where
         );
     }
     let (mr, kr, br, yr) = (rows(&s.m), rows(&s.k), rows(&d.b), rows(&d.y));
-    let fr = modal_from_rows::<T, N, R>(mr, kr, d.damp, br, yr, s.h, None);
-    let frm = modal_from_rows::<T, N, R>(mr, kr, d.damp, br, yr, s.h, Some(d.modes));
+    let fr = from_rows_modal::<T, N, R>(mr, kr, d.damp, br, yr, s.h, None);
+    let frm = from_rows_modal::<T, N, R>(mr, kr, d.damp, br, yr, s.h, Some(d.modes));
     check!(
         fr == bits(&new) && frm == bits(&with),
         "{MOD}: from_rows differs from new / with_modes"
@@ -173,7 +173,7 @@ where
     with.err()
 }
 
-fn modal_from_rows<T: Real, const N: usize, const R: usize>(
+fn from_rows_modal<T: Real, const N: usize, const R: usize>(
     m: [[f64; N]; N],
     k: [[f64; N]; N],
     damp: Damping<N>,
@@ -184,15 +184,19 @@ fn modal_from_rows<T: Real, const N: usize, const R: usize>(
 ) -> String {
     if eps::<T>() > 1e-10 {
         match modes {
-            None => bits(&Modal::<f32, N, R, 2, 2>::from_rows(m, k, damp, b, y, h)),
-            Some(md) => bits(&Modal::<f32, N, R, 2, 2>::from_rows_with_modes(
+            None => bits(&Modal::<f32, N, R, 2, 2>::from_rows_f32(
+                m, k, damp, b, y, h,
+            )),
+            Some(md) => bits(&Modal::<f32, N, R, 2, 2>::from_rows_with_modes_f32(
                 m, k, damp, b, y, md, h,
             )),
         }
     } else {
         match modes {
-            None => bits(&Modal::<f64, N, R, 2, 2>::from_rows(m, k, damp, b, y, h)),
-            Some(md) => bits(&Modal::<f64, N, R, 2, 2>::from_rows_with_modes(
+            None => bits(&Modal::<f64, N, R, 2, 2>::from_rows_f64(
+                m, k, damp, b, y, h,
+            )),
+            Some(md) => bits(&Modal::<f64, N, R, 2, 2>::from_rows_with_modes_f64(
                 m, k, damp, b, y, md, h,
             )),
         }

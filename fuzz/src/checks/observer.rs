@@ -1,6 +1,6 @@
 //! Fuzz target `observer` (`fuzz_targets/observer.rs`): checks StateSpace (aem,
-//! aem_from_rows, exact, modal; a wrong S), outputs, the steady-state Kalman gain, Observer
-//! (new, from_parts), Kalman, Readout; f32, f64.
+//! from_rows_aem, exact, modal; a wrong S), outputs, the steady-state Kalman gain, Observer
+//! (new, from_parts_f32/_f64), Kalman, Readout; f32, f64.
 //!
 //! The decoder and the checks every target shares are in `common.rs`.
 
@@ -83,7 +83,7 @@ pub fn observer(data: &[u8]) {
     let ss = match kind {
         0 => {
             let a = StateSpace::<2, 4, 1>::aem(&s.m, &s.c, &s.k, &bm, s.h);
-            let fr = StateSpace::<2, 4, 1>::aem_from_rows(
+            let fr = StateSpace::<2, 4, 1>::from_rows_aem(
                 rows(&s.m),
                 rows(&s.c),
                 rows(&s.k),
@@ -92,7 +92,7 @@ pub fn observer(data: &[u8]) {
             );
             check!(
                 bits(&a) == bits(&fr),
-                "{OB}: aem_from_rows differs from aem"
+                "{OB}: from_rows_aem differs from aem"
             );
             expect_data(OB, "StateSpace::aem", &a, want);
             // The AEM stepper on the same data: the same verdict on the data and on
@@ -142,7 +142,7 @@ pub fn observer(data: &[u8]) {
             let (ea, em) = (a.as_ref().err().copied(), m.as_ref().err().copied());
             // (And it judges a mode's effective mass by an LU with row scales where Modal
             // asks for `1 + … > ε`: `SingularEffectiveMatrix` from it where Modal builds is
-            // an open difference of `StateSpace::modal_from_rows`, docs/robustness.md.)
+            // an open difference of `StateSpace::from_rows_modal`, docs/robustness.md.)
             check!(
                 ea == em
                     || (em.is_none()
@@ -475,9 +475,17 @@ fn observers_typed<T: Real>(
         );
     }
     let fp = if eps::<T>() > 1e-10 {
-        bits(&Observer::<f32, 4, 1, 2>::from_parts(ss, meas, &rows(gain)))
+        bits(&Observer::<f32, 4, 1, 2>::from_parts_f32(
+            ss,
+            meas,
+            &rows(gain),
+        ))
     } else {
-        bits(&Observer::<f64, 4, 1, 2>::from_parts(ss, meas, &rows(gain)))
+        bits(&Observer::<f64, 4, 1, 2>::from_parts_f64(
+            ss,
+            meas,
+            &rows(gain),
+        ))
     };
     check!(
         fp == bits(&ob),

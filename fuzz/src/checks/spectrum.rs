@@ -71,16 +71,16 @@ where
     let (bank, default) = if eps::<T>() > 1e-10 {
         (
             cast_bank::<T>(
-                Bank::<f32, 3>::with(*period, *damping, dt, scheme, sub).map(BankAny::F32),
+                Bank::<f32, 3>::with_f32(*period, *damping, dt, scheme, sub).map(BankAny::F32),
             ),
-            cast_bank::<T>(Bank::<f32, 3>::new(*period, *damping, dt).map(BankAny::F32)),
+            cast_bank::<T>(Bank::<f32, 3>::new_f32(*period, *damping, dt).map(BankAny::F32)),
         )
     } else {
         (
             cast_bank::<T>(
-                Bank::<f64, 3>::with(*period, *damping, dt, scheme, sub).map(BankAny::F64),
+                Bank::<f64, 3>::with_f64(*period, *damping, dt, scheme, sub).map(BankAny::F64),
             ),
-            cast_bank::<T>(Bank::<f64, 3>::new(*period, *damping, dt).map(BankAny::F64)),
+            cast_bank::<T>(Bank::<f64, 3>::new_f64(*period, *damping, dt).map(BankAny::F64)),
         )
     };
     outcome(SP, &bank);
@@ -121,7 +121,7 @@ where
     check!(
         bank.periods() == period
             && bank.damping() == damping
-            && bank.dt() == dt
+            && bank.time_step() == dt
             && bank.scheme() == scheme,
         "{SP}: the bank does not keep its data"
     );
@@ -243,17 +243,17 @@ fn cast_bank<T: Real + 'static>(b: Result<BankAny, Error>) -> Result<Bank<T, 3>,
 fn at_rest<T: Real + 'static>(
     bank: &Bank<T, 3>,
 ) -> (RotD<T, 4>, Response<T, 3>, RotDResponse<T, 3, 4>) {
-    // `at_rest` and `RotD::new` are `const fn` of each scalar type: pick the one of `T`.
+    // `at_rest` and `RotD::new_f32`/`new_f64` are `const fn` of each scalar type: pick `T`'s.
     let bk: &dyn std::any::Any = bank;
     let x: Box<dyn std::any::Any> = if let Some(b) = bk.downcast_ref::<Bank<f32, 3>>() {
-        let rot = RotD::<f32, 4>::new();
+        let rot = RotD::<f32, 4>::new_f32();
         let rr = rot.at_rest(b);
         Box::new((rot, b.at_rest(), rr))
     } else {
         let b = bk
             .downcast_ref::<Bank<f64, 3>>()
             .expect("a bank of f32 or f64");
-        let rot = RotD::<f64, 4>::new();
+        let rot = RotD::<f64, 4>::new_f64();
         let rr = rot.at_rest(b);
         Box::new((rot, b.at_rest(), rr))
     };
