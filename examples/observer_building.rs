@@ -214,7 +214,7 @@ use aemstep::vector;
 // The model: M, C, K (kg, N·s/m, N/m), input the ground acceleration (m/s²), h = 0.02 s.
 let (m, c, k) = models::five_storey_building();
 let h = 0.02;
-let model = StateSpace::<5, 10, 1>::aem_from_rows(m, c, k, base_excitation(&m), h)?;
+let model = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), h)?;
 // Measured: absolute accelerations of floors 2 and 5 (m/s²). Estimated: storey drifts (m).
 let sensors = Outputs::absolute_accelerations(Outputs::<5, 1, 2>::select([1, 4]), 0);
 let meas = model.outputs(&sensors)?;
@@ -227,11 +227,11 @@ for i in 0..5 {
     b[i][i] = 1.0;
     qw[i][i] = 5e4 * 5e4; // N²
 }
-let q = StateSpace::<5, 10, 5>::aem_from_rows(m, c, k, b, h)?.input_noise(&qw);
+let q = StateSpace::<5, 10, 5>::from_rows_aem(m, c, k, b, h)?.input_noise(&qw);
 // Measurement noise R: each accelerometer's variance ((m/s²)²).
 let r = [[0.18 * 0.18, 0.0], [0.0, 0.26 * 0.26]];
 
-let gain = SteadyState::solve(&model, &meas, &q, &r)?; // `const fn`: also in a `static`
+let gain = SteadyState::from_parts(&model, &meas, &q, &r)?; // `const fn`: also in a `static`
 let observer = Observer::<f32, 10, 1, 2>::new(&model, &meas, &gain.gain_matrix())?;
 let readout = Readout::<f32, 10, 1, 5>::new(&drifts)?;
 

@@ -24,7 +24,7 @@ use crate::Real;
 /// ```
 /// use aemstep::Linear;
 /// static SYS: Linear<f32, 1> =
-///     aemstep::unwrap_const!(Linear::<f32, 1>::from_rows([[1.0]], [[0.28]], [[4.0]], 0.002));
+///     aemstep::unwrap_const!(Linear::<f32, 1>::from_rows_f32([[1.0]], [[0.28]], [[4.0]], 0.002));
 /// const M: aemstep::models::Rows<2> = aemstep::models::diagonal([1.0e5, 2.0e5]);
 /// assert_eq!(M[1][1], 2.0e5);
 /// # let _ = &SYS;
@@ -36,7 +36,7 @@ use crate::Real;
 /// use aemstep::Linear;
 /// // h = 0 is not a time step: error[E0080] ... "invalid time step"
 /// static SYS: Linear<f32, 1> =
-///     aemstep::unwrap_const!(Linear::<f32, 1>::from_rows([[1.0]], [[0.0]], [[4.0]], 0.0));
+///     aemstep::unwrap_const!(Linear::<f32, 1>::from_rows_f32([[1.0]], [[0.0]], [[4.0]], 0.0));
 /// ```
 #[macro_export]
 macro_rules! unwrap_const {

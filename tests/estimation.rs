@@ -29,7 +29,7 @@ const ROOF: [[f64; 1]; 5] = [[0.0], [0.0], [0.0], [0.0], [1.0]];
 
 /// The building with an unknown force at the roof (N), fixed base.
 fn building() -> StateSpace<5, 10, 1> {
-    StateSpace::aem_from_rows(BLD.0, BLD.1, BLD.2, ROOF, H).unwrap()
+    StateSpace::from_rows_aem(BLD.0, BLD.1, BLD.2, ROOF, H).unwrap()
 }
 
 /// Accelerations of floors 1, 3, 5 (fixed base: absolute = relative).
@@ -57,7 +57,7 @@ fn sensor_noise() -> SMatrix<f64, 4, 4> {
 
 /// Small process noise on `ξ`: unmodelled forces of 100 N on every floor.
 fn process_noise(ss: &StateSpace<5, 10, 1>) -> SMatrix<f64, 10, 10> {
-    let f = StateSpace::<5, 10, 5>::aem_from_rows(BLD.0, BLD.1, BLD.2, eye5(), ss.dt).unwrap();
+    let f = StateSpace::<5, 10, 5>::from_rows_aem(BLD.0, BLD.1, BLD.2, eye5(), ss.time_step).unwrap();
     let qw: [[f64; 5]; 5] =
         core::array::from_fn(|i| core::array::from_fn(|j| if i == j { 1e4 } else { 0.0 }));
     SMatrix::from_fn(|i, j| f.input_noise(&qw)[i][j])
@@ -172,7 +172,7 @@ fn truth_run<const O: usize>(
         SMatrix::<f64, 5, 5>::from_fn(|i, j| BLD.2[i][j]),
     );
     let b = SVector::<f64, 5>::from_fn(|i, _| ROOF[i][0]);
-    let sys = Linear::<f64, 5>::new(&m, &c, &k, ss.dt).unwrap();
+    let sys = Linear::<f64, 5>::new(&m, &c, &k, ss.time_step).unwrap();
     let mut s = sys
         .start(&SVector::zeros(), &SVector::zeros(), &(b * w[0]))
         .unwrap();
@@ -218,7 +218,7 @@ fn standard_form_reproduces_the_stepper() {
 
 /// An oscillator `m = 2 kg`, `c = 0.3 N·s/m`, `k = 50 N/m`, force input, `h = 0.01 s`.
 fn sdof() -> StateSpace<1, 2, 1> {
-    StateSpace::aem_from_rows([[2.0]], [[0.3]], [[50.0]], [[1.0]], 0.01).unwrap()
+    StateSpace::from_rows_aem([[2.0]], [[0.3]], [[50.0]], [[1.0]], 0.01).unwrap()
 }
 
 #[test]
@@ -284,7 +284,7 @@ fn building_identifiability() {
     let aug = AugmentedModel::<10, 1, 11, 4>::from_parts(&model, &rows(&q), &[[1e8]]).unwrap();
     aug.steady_state(&rows(&sensor_noise())).unwrap();
     // Fewer sensors than inputs; a feedthrough without full rank (no sensor at all).
-    let two = StateSpace::<5, 10, 2>::aem_from_rows(
+    let two = StateSpace::<5, 10, 2>::from_rows_aem(
         BLD.0,
         BLD.1,
         BLD.2,
@@ -460,7 +460,7 @@ fn steady_gains_are_the_limit_of_the_recursion() {
 
 /// The steady gains of the building with the roof displacement, evaluated by the compiler.
 const MODEL: InputModel<10, 1, 4> = {
-    let ss = match StateSpace::<5, 10, 1>::aem_from_rows(BLD.0, BLD.1, BLD.2, ROOF, H) {
+    let ss = match StateSpace::<5, 10, 1>::from_rows_aem(BLD.0, BLD.1, BLD.2, ROOF, H) {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };
@@ -482,7 +482,7 @@ const MODEL: InputModel<10, 1, 4> = {
     }
 };
 const Q_CONST: [[f64; 10]; 10] = {
-    let f = match StateSpace::<5, 10, 5>::aem_from_rows(BLD.0, BLD.1, BLD.2, IDENTITY5, H) {
+    let f = match StateSpace::<5, 10, 5>::from_rows_aem(BLD.0, BLD.1, BLD.2, IDENTITY5, H) {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };

@@ -7,7 +7,7 @@ use aemstep::nalgebra::{SMatrix, SVector, vector};
 use aemstep::{Linear, Stepper, models};
 
 /// A `static` built through the macro, as a downstream firmware would.
-static SYS: Linear<f64, 2> = aemstep::unwrap_const!(Linear::<f64, 2>::from_rows(
+static SYS: Linear<f64, 2> = aemstep::unwrap_const!(Linear::<f64, 2>::from_rows_f64(
     models::diagonal([2.0, 1.0]),
     [[0.0; 2]; 2],
     [[6.0, -2.0], [-2.0, 4.0]],
@@ -16,7 +16,7 @@ static SYS: Linear<f64, 2> = aemstep::unwrap_const!(Linear::<f64, 2>::from_rows(
 
 #[test]
 fn unwrap_const_builds_statics_and_panics_with_the_reason_at_run_time() {
-    let direct = Linear::<f64, 2>::from_rows(
+    let direct = Linear::<f64, 2>::from_rows_f64(
         [[2.0, 0.0], [0.0, 1.0]],
         [[0.0; 2]; 2],
         [[6.0, -2.0], [-2.0, 4.0]],
@@ -26,7 +26,7 @@ fn unwrap_const_builds_statics_and_panics_with_the_reason_at_run_time() {
     assert_eq!(SYS, direct);
     // At run time the macro panics with `Error::as_str`.
     let r = std::panic::catch_unwind(|| {
-        aemstep::unwrap_const!(Linear::<f64, 1>::from_rows([[1.0]], [[0.0]], [[1.0]], 0.0))
+        aemstep::unwrap_const!(Linear::<f64, 1>::from_rows_f64([[1.0]], [[0.0]], [[1.0]], 0.0))
     });
     let msg = r
         .expect_err("h = 0 is refused")
@@ -74,7 +74,7 @@ fn row_major_arrays_convert_by_matrix_of_and_not_by_smatrix_from() {
     let c = [[0.1, 0.0], [0.05, 0.2]];
     let k = [[6.0, -2.0], [-1.0, 4.0]];
     let h = 0.01;
-    let rows = Linear::<f64, 2>::from_rows(m, c, k, h).unwrap();
+    let rows = Linear::<f64, 2>::from_rows_f64(m, c, k, h).unwrap();
     let conv = Linear::<f64, 2>::new(
         &models::matrix_of(&m),
         &models::matrix_of(&c),

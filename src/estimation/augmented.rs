@@ -116,7 +116,7 @@ impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedMo
                 dof_v: [],
                 dof_a: [],
                 dof_a_input: [],
-                dt: m.dt,
+                time_step: m.time_step,
             },
             measurement: Measurement {
                 h,
@@ -128,17 +128,17 @@ impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedMo
     }
 
     /// The steady-state Kalman gain of the augmented model with measurement noise `r`
-    /// ([`SteadyState::solve`], `const fn`), for an
+    /// ([`SteadyState::from_parts`], `const fn`), for an
     /// [`Observer`](crate::observer::Observer) on `(self.model, self.measurement)`.
     ///
     /// Errors: [`Error::InputNotIdentifiable`] where the Riccati equation has no
     /// stabilizing solution (the random walk not detectable: an invariant zero at `z = 1`,
-    /// acceleration-only sensing), and the other errors of [`SteadyState::solve`]
+    /// acceleration-only sensing), and the other errors of [`SteadyState::from_parts`]
     /// ([`Error::InvalidCovariance`], [`Error::OperatorOverflow`]).
     ///
-    /// Cost: that of [`SteadyState::solve`] with `S = Z`.
+    /// Cost: that of [`SteadyState::from_parts`] with `S = Z`.
     pub const fn steady_state(&self, r: &[[f64; O]; O]) -> Result<SteadyState<Z, O>, Error> {
-        match SteadyState::solve(&self.model, &self.measurement, &self.process_noise, r) {
+        match SteadyState::from_parts(&self.model, &self.measurement, &self.process_noise, r) {
             Ok(s) => Ok(s),
             Err(Error::RiccatiNotConverged) => Err(Error::InputNotIdentifiable),
             Err(e) => Err(e),

@@ -53,7 +53,7 @@ impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
     /// [`Error::RiccatiNotConverged`] (the state stage has none: `(A, C)` not detectable
     /// or not stabilizable by `q`), [`Error::OperatorOverflow`].
     ///
-    /// Cost: two [`SteadyState::solve`]s, sizes `I` and `S`.
+    /// Cost: two [`SteadyState::from_parts`]s, sizes `I` and `S`.
     pub const fn solve(
         model: &InputModel<S, I, O>,
         q: &[[f64; S]; S],
@@ -68,13 +68,13 @@ impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
             dof_v: [],
             dof_a: [],
             dof_a_input: [],
-            dt: model.dt,
+            time_step: model.time_step,
         };
         let input_meas = Measurement::<I, 0, O> {
             h: model.d,
             d: [[0.0; 0]; O],
         };
-        let input = match SteadyState::solve(&input_model, &input_meas, qw, r) {
+        let input = match SteadyState::from_parts(&input_model, &input_meas, qw, r) {
             Ok(s) => s,
             Err(Error::RiccatiNotConverged) => return Err(Error::InputNotIdentifiable),
             Err(e) => return Err(e),
@@ -87,13 +87,13 @@ impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
             dof_v: [],
             dof_a: [],
             dof_a_input: [],
-            dt: model.dt,
+            time_step: model.time_step,
         };
         let state_meas = Measurement::<S, 0, O> {
             h: model.c,
             d: [[0.0; 0]; O],
         };
-        let state = match SteadyState::solve(&state_model, &state_meas, q, r) {
+        let state = match SteadyState::from_parts(&state_model, &state_meas, q, r) {
             Ok(s) => s,
             Err(e) => return Err(e),
         };
@@ -130,7 +130,7 @@ pub struct DualFilter<T, const S: usize, const I: usize, const O: usize> {
     gain_w: [[T; O]; I],
     gain_x: [[T; O]; S],
     gamma1: [[T; I]; S],
-    dt: T,
+    time_step: T,
 }
 
 /// Every operator finite and fitting `T`.
@@ -150,7 +150,7 @@ const fn dual_checks<const S: usize, const I: usize, const O: usize>(
     {
         return Err(Error::NonFiniteInput);
     }
-    if let Err(e) = crate::kinematics::check_time_step_as(model.dt, max) {
+    if let Err(e) = crate::kinematics::check_time_step_as(model.time_step, max) {
         return Err(e);
     }
     if !(finite_as(&model.a, max)
@@ -181,13 +181,13 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
             gain_w: round_rows(&gains.input.gain),
             gain_x: round_rows(&gains.state.gain),
             gamma1: round_rows(&model.gamma1),
-            dt: T::from_f64_rounded(model.dt),
+            time_step: T::from_f64_rounded(model.time_step),
         })
     }
 
     /// The time step `h` (s).
     pub fn time_step(&self) -> T {
-        self.dt
+        self.time_step
     }
 
     /// The start from a physical state `x0` and input `w0` (`ξ̂_0 = x0 − Γ₁ w0`).
@@ -349,7 +349,7 @@ macro_rules! dual_const {
                     gain_w: linalg::const_round!($t, rows gains.input.gain),
                     gain_x: linalg::const_round!($t, rows gains.state.gain),
                     gamma1: linalg::const_round!($t, rows model.gamma1),
-                    dt: model.dt as $t,
+                    time_step: model.time_step as $t,
                 })
             }
         }

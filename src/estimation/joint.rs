@@ -371,7 +371,7 @@ pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
 /// // floors 1, 3, 5 and the roof displacement measured (fixed base: no ground input).
 /// let (m, c, k) = models::five_storey_building();
 /// let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
-/// let ss = StateSpace::<5, 10, 1>::aem_from_rows(m, c, k, roof, 0.02)?;
+/// let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02)?;
 /// let mut out = Outputs::<5, 1, 4>::zero();
 /// out.a = [[1.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 1.0], [0.0; 5]];
 /// out.u[3] = [0.0, 0.0, 0.0, 0.0, 1.0];
@@ -394,7 +394,7 @@ pub struct InputStateObserver<T, const S: usize, const I: usize, const O: usize>
     gain_x: [[T; O]; S],
     gain_w: [[T; O]; I],
     gamma1: [[T; I]; S],
-    dt: T,
+    time_step: T,
 }
 
 /// `L = K (I − D̃ M)` and the checks that every operator fits `T`.
@@ -413,7 +413,7 @@ const fn observer_parts<const S: usize, const I: usize, const O: usize>(
     {
         return Err(Error::NonFiniteInput);
     }
-    if let Err(e) = crate::kinematics::check_time_step_as(model.dt, max) {
+    if let Err(e) = crate::kinematics::check_time_step_as(model.time_step, max) {
         return Err(e);
     }
     let kd = mul(&gains.state_gain, &model.d);
@@ -433,7 +433,7 @@ const fn observer_parts<const S: usize, const I: usize, const O: usize>(
 impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver<T, S, I, O> {
     /// The fixed-gain filter of `model` with the steady-state `gains`, rounded once to `T`.
     ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (the model's `dt` in
+    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (the model's `time_step` in
     /// `T`), [`Error::OperatorOverflow`]. Cost: `O(S²·O)`.
     pub fn new(
         model: &InputModel<S, I, O>,
@@ -447,13 +447,13 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
             gain_x: round_rows(&l),
             gain_w: round_rows(&gains.input_gain),
             gamma1: round_rows(&model.gamma1),
-            dt: T::from_f64_rounded(model.dt),
+            time_step: T::from_f64_rounded(model.time_step),
         })
     }
 
     /// The time step `h` (s).
     pub fn time_step(&self) -> T {
-        self.dt
+        self.time_step
     }
 
     /// The start from a physical state `x0` and input `w0`: `ξ̂_0 = x0 − Γ₁ w0`,
@@ -563,7 +563,7 @@ macro_rules! joint_const {
                     gain_x: linalg::const_round!($t, rows l),
                     gain_w: linalg::const_round!($t, rows gains.input_gain),
                     gamma1: linalg::const_round!($t, rows model.gamma1),
-                    dt: model.dt as $t,
+                    time_step: model.time_step as $t,
                 })
             }
         }

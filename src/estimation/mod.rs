@@ -141,7 +141,7 @@ pub struct InputModel<const S: usize, const I: usize, const O: usize> {
     /// `Γ₁` (`S×I`): the physical state is `x = ξ + Γ₁ w`.
     pub gamma1: [[f64; I]; S],
     /// The time step `h` (s).
-    pub dt: f64,
+    pub time_step: f64,
 }
 
 /// Relative pivot tolerance of the rank test of `D̃` (see the [module docs](self)):
@@ -183,7 +183,7 @@ impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
             c: meas.h,
             d,
             gamma1: model.gamma1,
-            dt: model.dt,
+            time_step: model.time_step,
         })
     }
 
