@@ -79,6 +79,7 @@ mod nonlinear;
 
 // Modal reduction, stability analysis, ready-made models.
 pub mod analysis;
+pub mod detection;
 pub mod hysteresis;
 pub mod modal;
 pub mod models;
