@@ -31,12 +31,12 @@ type Rows<const N: usize> = [[f64; N]; N];
 /// `ln Γ(a)` for `a = k/2`, `k ≥ 1` an integer, exactly from the recurrences
 /// `Γ(a + 1) = a Γ(a)`, `Γ(1) = 1`, `Γ(½) = √π` (a sum of logarithms).
 fn ln_gamma_half(k: u64) -> f64 {
-    let mut s = if k % 2 == 0 {
+    let mut s = if k.is_multiple_of(2) {
         0.0
     } else {
         0.5 * std::f64::consts::PI.ln()
     };
-    let mut a = if k % 2 == 0 { 1.0 } else { 0.5 };
+    let mut a = if k.is_multiple_of(2) { 1.0 } else { 0.5 };
     while a < k as f64 / 2.0 - 1e-9 {
         s += a.ln();
         a += 1.0;
@@ -680,6 +680,10 @@ fn storey_1_damage_is_detected_and_located() {
         "  bank ranking at the record's end: {rank:?} (0 = intact, i = storey i), storey 1 \
          on top from {:?} s after the damage",
         named
+    );
+    println!(
+        "  largest window sum after the damage {max_after:.1} (threshold {:.1})",
+        det.test.threshold()
     );
     let best = ll[rank[0]];
     for m in 0..HYPOTHESES {
