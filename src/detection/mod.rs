@@ -44,7 +44,7 @@
 //! let obs = Observer::<f64, 10, 1, 2>::new(&ss, &meas, &kf.gain_matrix())?;
 //! // The innovation covariance S = H P Hᵀ + R, and a 1 s window at α = 10⁻³.
 //! let s = innovation_covariance(&kf, &meas, &r)?;
-//! let det = Detector::<f64, 2, 50>::new(Whitener::from_rows(&s)?, ChiSquareTest::new(2, 1e-3)?);
+//! let det = Detector::<f64, 2, 50>::new(Whitener::new(&s)?, ChiSquareTest::new(2, 1e-3)?);
 //! let mut win = Window::<50>::new();
 //! let mut e = obs.start_at_rest(&vector![0.0])?;
 //! let nu = obs.step_innovation(&mut e, &vector![0.1], &vector![0.05, 0.02]);
