@@ -10,8 +10,8 @@
 #![allow(clippy::needless_range_loop)] // matrix and record indices read best explicitly
 
 use aemstep::detection::{
-    ChiSquareTest, Detector, ModelBank, NIS_FRACTION_BITS, Whitener, Window, chi_square_quantile,
-    innovation_covariance, normal_quantile,
+    ChiSquareTest, Cusum, CusumState, Detector, ModelBank, NIS_FRACTION_BITS, Whitener, Window,
+    chi_square_quantile, innovation_covariance, normal_quantile,
 };
 use aemstep::models::{self, base_excitation};
 use aemstep::observer::{Measurement, Observer, Outputs, StateSpace, SteadyState};
@@ -249,6 +249,33 @@ fn const_threshold_is_the_run_time_one_and_bad_parameters_are_typed() {
         ChiSquareTest::<2_000_000>::new(1, 0.01),
         Err(Error::InvalidParameter)
     );
+    // CUSUM: λ ≤ 1 or not finite, α outside (0, 1), no outputs.
+    for (o, l, a) in [
+        (3, 1.0, 0.01),
+        (3, 0.5, 0.01),
+        (3, f64::INFINITY, 0.01),
+        (3, f64::NAN, 0.01),
+        (3, 2.0, 0.0),
+        (3, 2.0, 1.0),
+        (3, 2.0, f64::NAN),
+        (0, 2.0, 0.01),
+    ] {
+        assert_eq!(
+            Cusum::new(o, l, a),
+            Err(Error::InvalidParameter),
+            "{o} {l} {a}"
+        );
+    }
+    // Its increments are the log-likelihood ratio of N(0, λS) against N(0, S) (written
+    // from the densities): q = 4, O = 2, λ = 2 → ½ (1 − ½) 4 − ln 2.
+    let c = Cusum::new(2, 2.0, 1e-3).unwrap();
+    let mut cs = CusumState::new();
+    assert!(!c.update(&mut cs, 4.0));
+    assert!((cs.statistic() - (1.0 - 2f64.ln())).abs() <= 4.0 * f64::EPSILON);
+    assert!((c.threshold() - 1e3f64.ln()).abs() <= 4.0 * f64::EPSILON * c.threshold());
+    assert!(!c.update(&mut cs, f64::NAN));
+    assert_eq!(cs.skipped(), 1);
+    assert!(c.update(&mut cs, f64::INFINITY));
     // Whitener: not symmetric, not definite, not finite; f32 overflow of C⁻¹.
     assert_eq!(
         Whitener::<f64, 2>::new(&[[1.0, 0.5], [0.4, 1.0]]),
@@ -494,18 +521,29 @@ fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
     let (mut trials, mut alarms) = (0u64, 0u64);
     let (mut evals, mut alarm_samples) = (0u64, 0u64);
     let (mut nis_sum, mut nis_n) = (0.0f64, 0u64);
+    // The CUSUM beside it, tuned to a 50 % covariance increase, its false-alarm rate
+    // bounded by 10⁻³ per sample (restarted after each alarm).
+    const ALPHA_CUSUM: f64 = 1e-3;
+    let cusum = Cusum::new(3, 1.5, ALPHA_CUSUM).unwrap();
+    let mut cusum_alarms = 0u64;
     for seed in 0..SEEDS {
         let mut g = Gauss::new(1000 + seed);
         let mut x = root * SVector::<f64, 10>::from_fn(|_, _| g.next());
         let mut e = obs.start_at_rest(&SVector::from([ag[0]])).unwrap();
         let mut win = Window::<W>::new();
+        let mut cs = CusumState::new();
         for n in 1..ag.len() {
             let (w0, w1) = (SVector::from([ag[n - 1]]), SVector::from([ag[n]]));
             x = phi * x + g0 * w0 + g1 * w1 + gf * SVector::<f64, 5>::from_fn(|_, _| g.next());
             let y = h * x + d * w1 + SVector::<f64, 3>::from_fn(|o, _| sigma[o] * g.next());
             let nu = obs.step_innovation(&mut e, &w1, &y);
-            nis_sum += det.whitener.nis(&nu);
+            let q = det.whitener.nis(&nu);
+            nis_sum += q;
             nis_n += 1;
+            if cusum.update(&mut cs, q) {
+                cusum_alarms += 1;
+                cs.reset();
+            }
             let alarm = det.update(&mut win, &nu);
             if win.is_full() {
                 evals += 1;
@@ -548,6 +586,17 @@ fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
         4.42 * sd
     );
     assert!((nis_mean - 3.0).abs() <= nis_bound, "mean NIS {nis_mean}");
+    // CUSUM: the mean time between false alarms is at least 1/α, so the count over n
+    // samples is at most about n α; the count of a renewal process with a near-geometric
+    // run length is near Poisson, so n α + 4.42 √(n α) bounds it (one-sided 5·10⁻⁶).
+    let expect = nis_n as f64 * ALPHA_CUSUM;
+    println!(
+        "  CUSUM (λ = 1.5, h = ln 1000 = {:.2}): {cusum_alarms} false alarms in {nis_n} samples = {:.2e} per sample (bound α = {ALPHA_CUSUM:e}: at most {:.0})",
+        cusum.threshold(),
+        cusum_alarms as f64 / nis_n as f64,
+        expect + 4.42 * expect.sqrt()
+    );
+    assert!(cusum_alarms as f64 <= expect + 4.42 * expect.sqrt());
     // The threshold's tail is the α it was set for, to the Wilson–Hilferty error.
     assert!((p_true / ALPHA - 1.0).abs() < 0.02);
 }
@@ -616,6 +665,9 @@ fn storey_1_damage_is_detected_and_located() {
         core::array::from_fn(|m| whs[m]),
     )
     .unwrap();
+    let cusum = Cusum::new(3, 2.0, ALPHA).unwrap();
+    let mut cs = CusumState::new();
+    let (mut cusum_first, mut cusum_before) = (None, 0);
     let mut win = Window::<W>::new();
     let mut e = obs[0].start_at_rest(&SVector::from([ag[0]])).unwrap();
     let mut st = bank
@@ -634,6 +686,12 @@ fn storey_1_damage_is_detected_and_located() {
         let w = SVector::from([ag[n]]);
         let nu = obs[0].step_innovation(&mut e, &w, &ys[n]);
         let alarm = det.update(&mut win, &nu);
+        let c_alarm = cusum.update(&mut cs, det.whitener.nis(&nu));
+        if n < k_change {
+            cusum_before += c_alarm as u32;
+        } else if c_alarm {
+            cusum_first.get_or_insert(n);
+        }
         bank.try_step(&mut st, &w, &ys[n]).unwrap();
         let top = bank.ranking(&st)[0];
         if n % 250 == 0 {
@@ -692,6 +750,13 @@ fn storey_1_damage_is_detected_and_located() {
             ll[m] - best
         );
     }
+    let cusum_delay = cusum_first.map(|n| (n - k_change) as f64 * H);
+    println!(
+        "  CUSUM (λ = 2, α = {ALPHA:e} per sample): first alarm {cusum_delay:?} s after, \
+         alarms before: {cusum_before}"
+    );
+    assert_eq!(cusum_before, 0);
+    assert!(cusum_delay.is_some_and(|d| d <= 2.0));
     assert_eq!(alarms_before, 0);
     assert!(delay.is_some_and(|d| d <= 2.0));
     assert_eq!(

@@ -20,6 +20,8 @@
 //!   samples in alarm); evaluated at disjoint windows, the false alarms are independent
 //!   Bernoulli(`α`) trials.
 //! - [`Detector`]: a [`Whitener`] and a [`ChiSquareTest`] together, one call a sample.
+//! - [`Cusum`]: Page's CUSUM on the same statistic, tuned to a covariance increase `λ`,
+//!   its threshold `ln(1/α)` bounding the false-alarm rate per sample by `α`.
 //! - [`ModelBank`]: `M` fixed-gain observers on the same measurements (e.g. the intact
 //!   building and one model per storey with reduced stiffness), each with its own
 //!   whitener; they are ranked by the Gaussian log-likelihood of their innovations over
@@ -54,9 +56,11 @@
 //! ```
 
 mod bank;
+mod cusum;
 mod quantile;
 
 pub use bank::{BankState, ModelBank};
+pub use cusum::{Cusum, CusumState};
 pub use quantile::{chi_square_quantile, normal_quantile};
 
 use nalgebra::SVector;
