@@ -13,7 +13,8 @@
 //! - [`Window`]: the sum of `q` over the last `W` samples, in a ring buffer, exact (the
 //!   terms are held in fixed point, so the running sum never drifts; see [`Window`]).
 //! - [`ChiSquareTest`]: the windowed test. Under the model the window's sum is `χ²` with
-//!   `W·O` degrees of freedom (innovations of disjoint samples are independent); the
+//!   `W·O` degrees of freedom (the innovations are white: independent from sample to
+//!   sample, for the steady-state Kalman gain of the true model); the
 //!   threshold is its upper quantile at a stated false-alarm probability `α`
 //!   ([`chi_square_quantile`], Wilson–Hilferty, `const fn`). Evaluated every sample, each
 //!   evaluation is a false alarm with probability `α` (so `α` is the expected fraction of
@@ -215,7 +216,8 @@ whitener_const!(f64);
 /// term's rounding, `≤ 2⁻²⁵` absolute, so the sum is within `W·2⁻²⁵` of the exact sum of
 /// the window's values whatever the run's length — a floating running sum instead
 /// accumulates the rounding of every add and subtract it ever did (a random walk growing
-/// as the square root of the run's length, in `f32` a visible one within hours at 50 Hz).
+/// without bound as the square root of the run's length), and recomputing it every `W`
+/// samples would make the cost of a step uneven.
 /// A capped term is at least `2⁴⁰/W` (above the largest threshold
 /// [`ChiSquareTest::new`] accepts), so capping never hides an alarm.
 ///
