@@ -611,11 +611,27 @@ fn hypothesis(m: usize) -> [f64; 5] {
     core::array::from_fn(|i| if m > 0 && i == m - 1 { 0.9 } else { 1.0 })
 }
 
-/// The bank's window: 5 s.
-const WB: usize = 250;
+/// The bank's window: 10 s. Storey 1 is named about a window after the damage (the
+/// window must first shed the samples from before it); with 5 s one noise seed in 8 lost
+/// it again for a while in the weakly excited part near t = 58 s (measured).
+const WB: usize = 500;
 
-#[test]
-fn storey_1_damage_is_detected_and_located() {
+/// What one run of the damage scene measured.
+struct DamageRun {
+    /// First χ² alarm after the damage (s after it).
+    delay: Option<f64>,
+    /// First CUSUM alarm after the damage (s after it).
+    cusum_delay: Option<f64>,
+    /// From when storey 1 stays on top of the bank's ranking until t = 60 s (s after it).
+    named: Option<f64>,
+    /// Alarms (χ² and CUSUM) before the damage.
+    alarms_before: u32,
+    /// The bank's top model just before the damage.
+    top_before: usize,
+}
+
+/// The damage scene with measurement-noise seed `seed`; prints its trace if `verbose`.
+fn damage_run(seed: u64, verbose: bool) -> DamageRun {
     let ag = &elcentro::AG_F64;
     let sigma = peaks().map(|p| NOISE_FRACTION * p);
     let r = r_rows(sigma);
@@ -630,7 +646,7 @@ fn storey_1_damage_is_detected_and_located() {
     let damaged = LinearInput::<f64, 5, 1>::from_rows(m1, c1, k1, b, H).unwrap();
     let z = SVector::<f64, 5>::zeros();
     let mut s = intact.start(&z, &z, &SVector::from([ag[0]])).unwrap();
-    let mut g = Gauss::new(20_261_126);
+    let mut g = Gauss::new(seed);
     let mut ys = Vec::with_capacity(ag.len());
     ys.push(SVector::<f64, 3>::from_element(f64::NAN)); // no sample at t = 0
     for n in 1..ag.len() {
@@ -694,7 +710,7 @@ fn storey_1_damage_is_detected_and_located() {
         }
         bank.try_step(&mut st, &w, &ys[n]).unwrap();
         let top = bank.ranking(&st)[0];
-        if n % 250 == 0 {
+        if verbose && n % 250 == 0 {
             let ll = bank.log_likelihoods(&st);
             let b = ll[top];
             println!(
@@ -725,46 +741,84 @@ fn storey_1_damage_is_detected_and_located() {
     let rank = bank.ranking(&st);
     let delay = first_alarm.map(|n| (n - k_change) as f64 * H);
     let named = named_from.map(|n| (n - k_change) as f64 * H);
-    println!(
-        "storey-1 damage at t = 20 s: first alarm {:?} s after (α = {ALPHA:e} per sample, \
-         1 s window); alarms before the damage: {alarms_before}",
-        delay
-    );
-    println!(
-        "  bank ranking at t = 19.98 s: {:?}",
-        ranking_before.unwrap()
-    );
-    println!(
-        "  bank ranking at the record's end: {rank:?} (0 = intact, i = storey i), storey 1 \
-         on top from {:?} s after the damage",
-        named
-    );
-    println!(
-        "  largest window sum after the damage {max_after:.1} (threshold {:.1})",
-        det.test.threshold()
-    );
-    let best = ll[rank[0]];
-    for m in 0..HYPOTHESES {
+    let cusum_delay = cusum_first.map(|n| (n - k_change) as f64 * H);
+    if verbose {
         println!(
-            "    hypothesis {m}: log-likelihood − best = {:.1}",
-            ll[m] - best
+            "storey-1 damage at t = 20 s: first alarm {:?} s after (α = {ALPHA:e} per sample, \
+             1 s window); alarms before the damage: {alarms_before}",
+            delay
+        );
+        println!(
+            "  bank ranking at t = 19.98 s: {:?}",
+            ranking_before.unwrap()
+        );
+        println!(
+            "  bank ranking at the record's end: {rank:?} (0 = intact, i = storey i), storey 1 \
+             on top from {:?} s after the damage",
+            named
+        );
+        println!(
+            "  largest window sum after the damage {max_after:.1} (threshold {:.1})",
+            det.test.threshold()
+        );
+        let best = ll[rank[0]];
+        for m in 0..HYPOTHESES {
+            println!(
+                "    hypothesis {m}: log-likelihood − best = {:.1}",
+                ll[m] - best
+            );
+        }
+        println!(
+            "  CUSUM (λ = 2, α = {ALPHA:e} per sample): first alarm {cusum_delay:?} s after, \
+             alarms before: {cusum_before}"
         );
     }
-    let cusum_delay = cusum_first.map(|n| (n - k_change) as f64 * H);
+    DamageRun {
+        delay,
+        cusum_delay,
+        named,
+        alarms_before: alarms_before + cusum_before,
+        top_before: ranking_before.unwrap()[0],
+    }
+}
+
+#[test]
+fn storey_1_damage_is_detected_and_located() {
+    // One run in full (its trace goes into the docs page), then more noise seeds.
+    let runs: Vec<DamageRun> = (0..8).map(|i| damage_run(20_261_126 + i, i == 0)).collect();
+    let worst = |f: fn(&DamageRun) -> Option<f64>| {
+        runs.iter()
+            .map(|r| f(r).unwrap_or(f64::INFINITY))
+            .fold(0.0f64, f64::max)
+    };
+    let (wd, wc, wn) = (
+        worst(|r| r.delay),
+        worst(|r| r.cusum_delay),
+        worst(|r| r.named),
+    );
     println!(
-        "  CUSUM (λ = 2, α = {ALPHA:e} per sample): first alarm {cusum_delay:?} s after, \
-         alarms before: {cusum_before}"
+        "over {} noise seeds: χ² delay ≤ {wd:.2} s, CUSUM delay ≤ {wc:.2} s, storey 1 named \
+         (and kept to t = 60 s) ≤ {wn:.2} s after the damage; alarms before the damage {}; \
+         intact on top before it in {} of {}",
+        runs.len(),
+        runs.iter().map(|r| r.alarms_before).sum::<u32>(),
+        runs.iter().filter(|r| r.top_before == 0).count(),
+        runs.len()
     );
-    assert_eq!(cusum_before, 0);
-    assert!(cusum_delay.is_some_and(|d| d <= 2.0));
-    assert_eq!(alarms_before, 0);
-    assert!(delay.is_some_and(|d| d <= 2.0));
-    assert_eq!(
-        ranking_before.unwrap()[0],
-        0,
-        "before the damage the bank names the intact model"
-    );
-    assert!(named.is_some_and(|d| d <= 8.0));
+    for r in &runs {
+        println!(
+            "  seed run: delay {:?}, CUSUM {:?}, named {:?}",
+            r.delay, r.cusum_delay, r.named
+        );
+        assert_eq!(r.alarms_before, 0);
+        assert_eq!(
+            r.top_before, 0,
+            "before the damage the bank names the intact model"
+        );
+    }
+    assert!(wd <= 2.0 && wc <= 2.0);
+    // Named within the bank's window (10 s) plus 2 s.
+    assert!(wn <= WB as f64 * H + 2.0);
 }
 
 #[test]
