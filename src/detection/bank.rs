@@ -49,6 +49,16 @@ impl<T: Real, const S: usize, const I: usize, const M: usize, const W: usize>
     pub fn window(&self, m: usize) -> &Window<W> {
         &self.windows[m]
     }
+
+    /// Empty every model's window (the estimates are kept): e.g. at a detector's alarm,
+    /// so that the ranking weighs only the samples after it. Cost: `O(M)`.
+    pub fn clear_windows(&mut self) {
+        for w in self.windows.iter_mut() {
+            let skipped = w.skipped();
+            *w = Window::new();
+            w.add_skipped(skipped);
+        }
+    }
 }
 
 impl<T: Real, const S: usize, const I: usize, const O: usize, const M: usize>

@@ -317,6 +317,11 @@ impl<const W: usize> Window<W> {
     pub fn skipped(&self) -> u64 {
         self.skipped
     }
+
+    /// Count `n` more skipped terms (a window emptied and restarted keeps its count).
+    pub(crate) fn add_skipped(&mut self, n: u64) {
+        self.skipped = self.skipped.wrapping_add(n);
+    }
 }
 
 /// The windowed χ² test: alarm when the sum of the normalized innovations squared over
