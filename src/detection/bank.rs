@@ -33,7 +33,7 @@ pub struct ModelBank<T, const S: usize, const I: usize, const O: usize, const M:
 /// The state of a [`ModelBank`]: each model's [`Estimate`] and [`Window`]. Plain data.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BankState<T, const S: usize, const I: usize, const M: usize, const W: usize> {
-    estimates: [Estimate<T, S, I>; M],
+    pub(super) estimates: [Estimate<T, S, I>; M],
     windows: [Window<W>; M],
 }
 

@@ -20,6 +20,7 @@ use crate::Error;
 /// rate per sample from above (the bound is conservative: the overshoot of `h` is
 /// ignored). Plain data, `const fn` construction; a step is two multiply-adds.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Cusum {
     slope: f64,
     offset: f64,
@@ -28,6 +29,7 @@ pub struct Cusum {
 
 /// The state of a [`Cusum`]: the statistic `g ≥ 0` and the skipped samples. Plain data.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct CusumState {
     g: f64,
     skipped: u64,

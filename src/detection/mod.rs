@@ -58,6 +58,8 @@
 
 mod bank;
 mod cusum;
+#[cfg(feature = "defmt")]
+mod defmt_impls;
 mod quantile;
 
 pub use bank::{BankState, ModelBank};
