@@ -77,9 +77,11 @@ mod schemes;
 // Nonlinear (Newton) and time-varying steppers.
 mod nonlinear;
 
+// Change detection on an observer's innovations, localization by a bank of models.
+pub mod detection;
+
 // Modal reduction, stability analysis, ready-made models.
 pub mod analysis;
-pub mod detection;
 pub mod hysteresis;
 pub mod modal;
 pub mod models;
