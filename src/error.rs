@@ -65,8 +65,9 @@ pub enum Error {
     /// lost its precision (e.g. `M⁻¹K ≈ 1e-324` from data whose scales are 1e300 apart).
     /// Rescale the units.
     OperatorUnderflow,
-    /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) is not finite or is
-    /// outside its documented range.
+    /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) or a change detector's
+    /// (window length, false-alarm probability, bank size) is not finite or is outside its
+    /// documented range.
     InvalidParameter,
     /// A response-spectrum period is not finite and at least `1e-150` s (shorter ones have
     /// an `ω²` that overflows), or the periods of a bank are not in non-decreasing order

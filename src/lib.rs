@@ -148,6 +148,9 @@ mod schemes;
 // Nonlinear (Newton) and time-varying steppers.
 mod nonlinear;
 
+// Change detection on an observer's innovations, localization by a bank of models.
+pub mod detection;
+
 // Modal reduction, stability analysis, ready-made models.
 pub mod analysis;
 pub mod estimation;

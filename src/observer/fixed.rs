@@ -221,6 +221,20 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
     /// that must not happen.
     #[inline]
     pub fn step(&self, e: &mut Estimate<T, S, I>, w: &SVector<T, I>, y: &SVector<T, O>) {
+        self.step_innovation(e, w, y);
+    }
+
+    /// [`Observer::step`], returning the innovation `ν = y_n − H x̂⁻ − D w_n` (output
+    /// units) that corrected it — what a change detector tests
+    /// ([`detection`](crate::detection)). Non-finite where `y` is (a missing sample).
+    /// Cost: as [`Observer::step`].
+    #[inline]
+    pub fn step_innovation(
+        &self,
+        e: &mut Estimate<T, S, I>,
+        w: &SVector<T, I>,
+        y: &SVector<T, O>,
+    ) -> SVector<T, O> {
         // Sums start from −0 (`−0 + x = x` exactly, so the compiler drops the add) and the
         // prediction is built in place (no zeroed temporary).
         let neg_zero = -T::zero();
@@ -262,6 +276,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
         }
         e.w = *w;
         e.n = e.n.wrapping_add(1);
+        innov.into()
     }
 
     /// [`Observer::step`], checked: the input must be finite and the new estimate
