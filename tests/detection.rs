@@ -297,7 +297,7 @@ fn const_threshold_is_the_run_time_one_and_bad_parameters_are_typed() {
     // The const twin is bit-identical.
     let s = [[2.0, 0.3], [0.3, 0.5]];
     assert_eq!(
-        Whitener::<f32, 2>::from_rows(&s).unwrap(),
+        Whitener::<f32, 2>::from_rows_f32(&s).unwrap(),
         Whitener::<f32, 2>::new(&s).unwrap()
     );
     // NIS against the inverse: νᵀ S⁻¹ ν for S = [[2, .3], [.3, .5]], ν = (1, −2):
@@ -396,9 +396,9 @@ struct Model {
 
 fn model(f: [f64; 5]) -> Model {
     let (m, c, k) = building(f);
-    let ss = StateSpace::aem_from_rows(m, c, k, base_excitation(&m), H).unwrap();
+    let ss = StateSpace::from_rows_aem(m, c, k, base_excitation(&m), H).unwrap();
     let eye: Rows<5> = core::array::from_fn(|i| core::array::from_fn(|j| (i == j) as u8 as f64));
-    let forces = StateSpace::<5, 10, 5>::aem_from_rows(m, c, k, eye, H).unwrap();
+    let forces = StateSpace::<5, 10, 5>::from_rows_aem(m, c, k, eye, H).unwrap();
     let qw: Rows<5> = core::array::from_fn(|i| {
         core::array::from_fn(|j| if i == j { SIGMA_F * SIGMA_F } else { 0.0 })
     });
@@ -643,8 +643,8 @@ fn damage_run(seed: u64, verbose: bool, restart: bool) -> DamageRun {
     let b = base_excitation(&building([1.0; 5]).0);
     let (m0, c0, k0) = building([1.0; 5]);
     let (m1, c1, k1) = building(hypothesis(1));
-    let intact = LinearInput::<f64, 5, 1>::from_rows(m0, c0, k0, b, H).unwrap();
-    let damaged = LinearInput::<f64, 5, 1>::from_rows(m1, c1, k1, b, H).unwrap();
+    let intact = LinearInput::<f64, 5, 1>::from_rows_f64(m0, c0, k0, b, H).unwrap();
+    let damaged = LinearInput::<f64, 5, 1>::from_rows_f64(m1, c1, k1, b, H).unwrap();
     let z = SVector::<f64, 5>::zeros();
     let mut s = intact.start(&z, &z, &SVector::from([ag[0]])).unwrap();
     let mut g = Gauss::new(seed);
@@ -931,14 +931,14 @@ const fn diag<const N: usize>(d: [f64; N]) -> Rows<N> {
 }
 
 const BUILDING: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();
-const SS: StateSpace<5, 10, 1> = ok(StateSpace::aem_from_rows(
+const SS: StateSpace<5, 10, 1> = ok(StateSpace::from_rows_aem(
     BUILDING.0,
     BUILDING.1,
     BUILDING.2,
     base_excitation(&BUILDING.0),
     H,
 ));
-const FORCES: StateSpace<5, 10, 5> = ok(StateSpace::aem_from_rows(
+const FORCES: StateSpace<5, 10, 5> = ok(StateSpace::from_rows_aem(
     BUILDING.0,
     BUILDING.1,
     BUILDING.2,
@@ -958,13 +958,14 @@ const R_FW: Rows<3> = diag([
     SIGMA_FW[2] * SIGMA_FW[2],
 ]);
 const Q_FW: Rows<10> = FORCES.input_noise(&diag([SIGMA_F * SIGMA_F; 5]));
-const KF: SteadyState<10, 3> = ok(SteadyState::solve(&SS, &MEAS, &Q_FW, &R_FW));
-static OBS32: Observer<f32, 10, 1, 3> =
-    ok(Observer::<f32, 10, 1, 3>::from_parts(&SS, &MEAS, &KF.gain));
+const KF: SteadyState<10, 3> = ok(SteadyState::from_parts(&SS, &MEAS, &Q_FW, &R_FW));
+static OBS32: Observer<f32, 10, 1, 3> = ok(Observer::<f32, 10, 1, 3>::from_parts_f32(
+    &SS, &MEAS, &KF.gain,
+));
 static DET32: Detector<f32, 3, W> = Detector::new(
-    ok(Whitener::<f32, 3>::from_rows(&ok(innovation_covariance(
-        &KF, &MEAS, &R_FW,
-    )))),
+    ok(Whitener::<f32, 3>::from_rows_f32(&ok(
+        innovation_covariance(&KF, &MEAS, &R_FW),
+    ))),
     ok(ChiSquareTest::<W>::new(3, 1e-3)),
 );
 

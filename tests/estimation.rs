@@ -57,7 +57,8 @@ fn sensor_noise() -> SMatrix<f64, 4, 4> {
 
 /// Small process noise on `ξ`: unmodelled forces of 100 N on every floor.
 fn process_noise(ss: &StateSpace<5, 10, 1>) -> SMatrix<f64, 10, 10> {
-    let f = StateSpace::<5, 10, 5>::from_rows_aem(BLD.0, BLD.1, BLD.2, eye5(), ss.time_step).unwrap();
+    let f =
+        StateSpace::<5, 10, 5>::from_rows_aem(BLD.0, BLD.1, BLD.2, eye5(), ss.time_step).unwrap();
     let qw: [[f64; 5]; 5] =
         core::array::from_fn(|i| core::array::from_fn(|j| if i == j { 1e4 } else { 0.0 }));
     SMatrix::from_fn(|i, j| f.input_noise(&qw)[i][j])

@@ -26,7 +26,12 @@ fn unwrap_const_builds_statics_and_panics_with_the_reason_at_run_time() {
     assert_eq!(SYS, direct);
     // At run time the macro panics with `Error::as_str`.
     let r = std::panic::catch_unwind(|| {
-        aemstep::unwrap_const!(Linear::<f64, 1>::from_rows_f64([[1.0]], [[0.0]], [[1.0]], 0.0))
+        aemstep::unwrap_const!(Linear::<f64, 1>::from_rows_f64(
+            [[1.0]],
+            [[0.0]],
+            [[1.0]],
+            0.0
+        ))
     });
     let msg = r
         .expect_err("h = 0 is refused")

@@ -39,7 +39,7 @@
 //! use aemstep::observer::{Observer, Outputs, StateSpace, SteadyState};
 //!
 //! let (m, c, k) = models::five_storey_building();
-//! let ss = StateSpace::<5, 10, 1>::aem_from_rows(m, c, k, base_excitation(&m), 0.02)?;
+//! let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02)?;
 //! let meas = ss.outputs(&Outputs::absolute_accelerations(Outputs::<5, 1, 2>::select([1, 4]), 0))?;
 //! let q = SMatrix::<f64, 10, 10>::identity() * 1e-10;
 //! let r = [[0.01, 0.0], [0.0, 0.01]];
@@ -153,7 +153,7 @@ pub struct Whitener<T, const O: usize> {
 impl<T: Real, const O: usize> Whitener<T, O> {
     /// From `S` (`f64`, symmetric positive definite, output units squared), e.g.
     /// [`innovation_covariance`]. Run time; bit-identical to the `const fn`
-    /// `Whitener::from_rows` of `f32`/`f64`.
+    /// `Whitener::from_rows_f32`/`from_rows_f64`.
     ///
     /// Errors: [`Error::InvalidParameter`] (`O = 0`), [`Error::InvalidCovariance`] (`S`
     /// not finite, not symmetric or not positive definite), [`Error::OperatorOverflow`]
@@ -188,11 +188,11 @@ impl<T: Real, const O: usize> Whitener<T, O> {
 }
 
 macro_rules! whitener_const {
-    ($t:ident) => {
+    ($t:ident, $from_rows:ident) => {
         impl<const O: usize> Whitener<$t, O> {
             /// `const fn` twin of [`Whitener::new`], bit-identical to it (in a `static`,
             /// the compiler factors `S`). Errors: as [`Whitener::new`].
-            pub const fn from_rows(s: &[[f64; O]; O]) -> Result<Self, Error> {
+            pub const fn $from_rows(s: &[[f64; O]; O]) -> Result<Self, Error> {
                 match whitener_parts(s, $t::MAX as f64) {
                     Ok((cinv, log_det)) => Ok(Self {
                         cinv: crate::linalg::const_round!($t, rows cinv),
@@ -204,8 +204,8 @@ macro_rules! whitener_const {
         }
     };
 }
-whitener_const!(f32);
-whitener_const!(f64);
+whitener_const!(f32, from_rows_f32);
+whitener_const!(f64, from_rows_f64);
 
 /// The sum of a statistic over the last `W` samples: a ring buffer of `W` fixed-point
 /// terms. Plain data, `8W + 32` bytes, `const`-constructible.
