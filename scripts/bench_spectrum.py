@@ -11,7 +11,7 @@ again (so a change of machine load between the two shows); the accuracy tables
 (`cargo run --release --features std --example spectrum -- --tables`); the CSV spectra and
 the plot (`... --example spectrum -- --out docs`); the measurements printed by
 `cargo test --release --features std --test spectrum`; the firmware under QEMU
-(`cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_spectrum`).
+(`cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_spectrum`).
 
 Timings are host wall-clock times on a shared machine: both sides are reported as the
 fastest and the median of their repetitions; the ratio uses the fastest (the least
@@ -123,7 +123,7 @@ def main():
     sd_sdof = sdof.spectrum(ag, DT, 0.05, periods=np.linspace(0.01, 10.0, 100), threads=1)[0][1]
     d_aem = np.abs(sd_sdof - lin[0]) / lin[0]
     d_exact = np.abs(sd_sdof - lin[1]) / lin[1]
-    fw = sh(["cargo", "run", "-q", "--release", "--target", "thumbv7em-none-eabihf", "--features", "qemu",
+    fw = sh(["cargo", "run", "-q", "-p", "aemstep-firmware", "--release", "--target", "thumbv7em-none-eabihf",
              "--example", "qemu_spectrum"])
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
     sdof_min = min(sdof_before[0], sdof_after[0])
@@ -181,7 +181,7 @@ def main():
         w(f"| {key.split('threads')[-1]} | {ms(mn)} | {32 / mn:.0f} |")
     w("")
     w("## Cortex-M4F: instructions per incoming sample\n")
-    w("`cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_spectrum` (QEMU")
+    w("`cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_spectrum` (QEMU")
     w("`mps2-an386`, `-icount shift=0`): `Bank<f32, P>`, 5 %, exact scheme, default rule, El Centro, averaged")
     w("over the record (sub-step walks included); multiply-adds: the whole-interval steps, 10P.\n")
     w("| bank | instructions / sample | multiply-adds / sample |")

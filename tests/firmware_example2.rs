@@ -1,4 +1,4 @@
-//! Host twin of the SysTick firmware example (`examples/qemu_timer.rs`): paper Example 2
+//! Host twin of the SysTick firmware example (`examples/firmware/qemu_timer.rs`): paper Example 2
 //! (ii), `u'' + 2ξω u' + ω² u = 10 H(t)`, ω = 2, ξ = 0.07, u0 = 1, v0 = 20, h = 1/500,
 //! 0 ≤ t ≤ 25 s (12 500 steps), stepped in `f32` with operators built by
 //! `Linear::<f32, 1>::from_rows_f32` in a `static`, exactly as the firmware builds them.

@@ -10,7 +10,7 @@
 //! `f64`) and exits with failure if the error exceeds `BOUND`, measured on the host first
 //! (`tests/firmware_example2.rs`, same data, same bound).
 //!
-//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_timer`
+//! Run: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_timer`
 //! (or `bash scripts/qemu.sh`). Broken variants that must fail: features
 //! `--cfg aemstep_broken="inject-nan"` (a NaN load sample at step 5000) and `--cfg aemstep_broken="tight-bound"`.
 #![no_std]

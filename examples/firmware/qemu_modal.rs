@@ -17,7 +17,7 @@
 //! and roof output), the full `LinearInput<f32, 5, 1>` and the full `Linear<f32, 5>` fed
 //! `p = B a_g`, and prints one `COST` line each.
 //!
-//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_modal`
+//! Run: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_modal`
 //! (or `bash scripts/qemu.sh`). Broken variant that must fail: feature
 //! `--cfg aemstep_broken="modal-tight-bound"` (bound 100× tighter than the measured truncation).
 #![no_std]
@@ -26,11 +26,11 @@
 #[macro_use]
 #[path = "fw/mod.rs"]
 mod fw;
-#[path = "../scenes/modal/elcentro.rs"]
+#[path = "../../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "fw/periodic.rs"]
 mod periodic;
-#[path = "../scenes/modal/reference.rs"]
+#[path = "../../scenes/modal/reference.rs"]
 mod reference;
 
 use core::cell::RefCell;

@@ -20,7 +20,7 @@
 //! (multiply-adds of the whole-interval steps, 10 P; the walks come on top). That run's
 //! spectra are checked as well.
 //!
-//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_spectrum`
+//! Run: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_spectrum`
 //! (or `bash scripts/qemu.sh`). Broken variant that must fail (bound 1000× tighter than
 //! measured): build with `RUSTFLAGS='--cfg aemstep_broken="spectrum-tight-bound" -C link-arg=-Tlink.x'`.
 #![no_std]
@@ -29,11 +29,11 @@
 #[macro_use]
 #[path = "fw/mod.rs"]
 mod fw;
-#[path = "../scenes/spectrum/config.rs"]
+#[path = "../../scenes/spectrum/config.rs"]
 mod config;
-#[path = "../scenes/modal/elcentro.rs"]
+#[path = "../../scenes/modal/elcentro.rs"]
 mod elcentro;
-#[path = "../scenes/spectrum/reference.rs"]
+#[path = "../../scenes/spectrum/reference.rs"]
 mod reference;
 
 use core::cell::RefCell;

@@ -8,7 +8,7 @@
 //! iterations) or if |u_n − u(t_n)| exceeds `BOUND`, measured and derived on the host
 //! first (`tests/firmware_duffing.rs`, same data, same bound).
 //!
-//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_nonlinear`
+//! Run: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_nonlinear`
 //! (or `bash scripts/qemu.sh`). Broken variant that must fail: `--cfg aemstep_broken="inject-nan"`
 //! (a NaN load sample at step 1000).
 #![no_std]

@@ -9,7 +9,8 @@
 //! mod fw;
 //! ```
 //!
-//! Runner and flags: `.cargo/config.toml` (`[target.thumbv7em-none-eabihf]`). The stack is
+//! Runner: `.cargo/config.toml` (`[target.thumbv7em-none-eabihf]`); memory layout and linker
+//! scripts: `examples/firmware/build.rs`. The stack is
 //! painted with `0xCCCC_CCCC` at reset by cortex-m-rt's `paint-stack` feature.
 #![allow(dead_code)] // each example uses a different subset
 

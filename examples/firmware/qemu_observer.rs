@@ -18,7 +18,7 @@
 //! `-icount shift=0`, as `examples/qemu_modal.rs`) for the full model (10 states,
 //! 2 outputs) and the modal observer (R = 2 modes, 4 states) and prints `COST` lines.
 //!
-//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_observer`
+//! Run: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_observer`
 //! (or `bash scripts/qemu.sh`). Broken variants that must fail, through
 //! `RUSTFLAGS='--cfg aemstep_broken="…"'` (not features): `observer-nan` (ten NaN
 //! accelerometer samples: skipped, counted, and the run fails) and `observer-tight-bound`
@@ -29,13 +29,13 @@
 #[macro_use]
 #[path = "fw/mod.rs"]
 mod fw;
-#[path = "../scenes/modal/elcentro.rs"]
+#[path = "../../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "fw/periodic.rs"]
 mod periodic;
-#[path = "../scenes/observer/reference.rs"]
+#[path = "../../scenes/observer/reference.rs"]
 mod reference;
-#[path = "../scenes/observer/scene.rs"]
+#[path = "../../scenes/observer/scene.rs"]
 mod scene;
 
 use core::cell::RefCell;

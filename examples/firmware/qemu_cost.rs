@@ -18,7 +18,7 @@
 //! so a figure is the step's own instructions, prologue and epilogue included. Counts are
 //! exactly repeatable; `f64` ones depend slightly on the data (soft-float shortcuts).
 //!
-//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_cost`
+//! Run: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_cost`
 #![no_std]
 #![no_main]
 

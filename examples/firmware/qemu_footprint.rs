@@ -10,7 +10,7 @@
 //! checks that the lean build links no symbol of the unused capabilities and the
 //! `static`-modal build no eigen-solver (the full build, which has both, is the control).
 //!
-//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_footprint`
+//! Run: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_footprint`
 #![no_std]
 #![no_main]
 

@@ -15,7 +15,7 @@
 //! `tests/firmware_hysteretic.rs`). Fails if a step is refused or not converged, if the
 //! roof leaves the bound, or if the two passes do not end on the same bits.
 //!
-//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_hysteretic`
+//! Run: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_hysteretic`
 //! (or `bash scripts/qemu.sh`). Broken variant that must fail:
 //! `RUSTFLAGS='--cfg aemstep_broken="hysteretic-tight-bound" -C link-arg=-Tlink.x'` (a bound 100 times tighter
 //! than the measured f32 rounding).
@@ -25,13 +25,13 @@
 #[macro_use]
 #[path = "fw/mod.rs"]
 mod fw;
-#[path = "../scenes/hysteretic/building.rs"]
+#[path = "../../scenes/hysteretic/building.rs"]
 mod building;
-#[path = "../scenes/modal/elcentro.rs"]
+#[path = "../../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "fw/periodic.rs"]
 mod periodic;
-#[path = "../scenes/hysteretic/reference.rs"]
+#[path = "../../scenes/hysteretic/reference.rs"]
 mod reference;
 
 use core::cell::RefCell;

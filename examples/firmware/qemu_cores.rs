@@ -18,7 +18,7 @@
 //! `--cfg aemstep_board="…"`, checked against 100 000 `nop`s first); a case times `reps`
 //! steps and subtracts the same loop around an empty out-of-line call.
 //!
-//! Run on the M4F: `cargo run --release --target thumbv7em-none-eabihf --features qemu
+//! Run on the M4F: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf
 //! --example qemu_cores`; on the other cores: `bash scripts/cores.sh`.
 #![no_std]
 #![no_main]

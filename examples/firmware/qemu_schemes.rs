@@ -17,7 +17,7 @@
 //!   whose f64 error is 2e-13, shows the rounding alone: 9.4e-5). A wrong operator or a
 //!   scheme bug shows as an error of 1e-2 or more.
 //!
-//! Run: `cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_schemes`
+//! Run: `cargo run -p aemstep-firmware --release --target thumbv7em-none-eabihf --example qemu_schemes`
 //! (or `bash scripts/qemu.sh`). Broken variant that must fail: `--cfg aemstep_broken="inject-nan"`
 //! (a NaN load sample at step 1000, refused by `try_step`).
 #![no_std]
