@@ -41,7 +41,7 @@ const BOUND: f64 = 1.2e-4;
 
 /// Example 2 (ii), operators computed by the compiler.
 static SYS: Linear<f32, 1> =
-    match Linear::<f32, 1>::from_rows([[1.0]], [[2.0 * XI * OMEGA]], [[OMEGA * OMEGA]], H) {
+    match Linear::<f32, 1>::from_rows_f32([[1.0]], [[2.0 * XI * OMEGA]], [[OMEGA * OMEGA]], H) {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };

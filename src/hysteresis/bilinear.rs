@@ -107,24 +107,25 @@ impl<T: Real> Law<T> for Bilinear<T> {
     #[inline]
     fn trial(&self, committed: &BilinearHistory<T>, d: T, _rate: T) -> LawTrial<T, Self::History> {
         let dp = committed.plastic;
-        // `d − d_p` may exceed `T::MAX` (both near it, opposite signs) while `k (d − d_p)`
-        // fits: distribute `k` then. A predictable branch; the usual path is unchanged.
-        let diff = d - dp;
-        let f_tr = if diff.is_finite() {
-            self.k * diff
-        } else {
-            self.k * d - self.k * dp
-        };
+        // `k d − k d_p`, not `k (d − d_p)`: with a tiny `k` and deformations near `T::MAX`,
+        // `d − d_p` (up to `2·T::MAX`) can overflow though the force fits.
+        let f_tr = self.k * d - self.k * dp;
         let xi = f_tr - self.hard * dp;
         let excess = xi.abs() - self.fy;
         if excess > T::zero() {
             let s = if xi > T::zero() { T::one() } else { -T::one() };
+            let two = T::one() + T::one();
+            let half = T::one() / two;
             return LawTrial {
                 force: f_tr - s * self.one_minus_alpha * excess,
                 stiffness: self.kt,
                 damping: T::zero(),
                 history: BilinearHistory {
-                    plastic: plastic_after(dp, s * self.compliance_p, excess),
+                    // `d_p + c·excess` at half scale: the new `d_p` lies between the
+                    // committed one and `d` (plastic flow moves it toward `d`, never past),
+                    // so it fits `T`, but the increment alone (up to `2·T::MAX`, tiny `k`)
+                    // may not. Halving and doubling are exact (but below the normal range).
+                    plastic: (dp * half + s * (self.compliance_p * half) * excess) * two,
                 },
                 inelastic: true,
             };
@@ -144,20 +145,4 @@ impl<T: Real> Law<T> for Bilinear<T> {
         let e = d - history.plastic;
         self.k * e * e / (T::one() + T::one())
     }
-}
-
-/// `d_p + c·excess`, the plastic deformation after a yielding trial. In exact arithmetic it
-/// lies between the committed `d_p` and the trial deformation `d` (plastic flow moves `d_p`
-/// toward `d`, never past it), so it fits `T` whenever they do; but with a tiny `k` the
-/// increment `c·excess` (`c = ±(1 − α)/k`) can overflow on its own (up to `|d − d_p| ≤
-/// 2·T::MAX`). Then the sum is formed at half scale: `2·(d_p/2 + (c/2)·excess)`, each part
-/// at most `T::MAX`.
-fn plastic_after<T: Real>(dp: T, c: T, excess: T) -> T {
-    let p = dp + c * excess;
-    if p.is_finite() {
-        return p;
-    }
-    let half = T::one() / (T::one() + T::one());
-    let two = T::one() + T::one();
-    (dp * half + (c * half) * excess) * two
 }

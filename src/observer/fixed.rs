@@ -228,7 +228,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
     /// units) that corrected it — what a change detector tests
     /// ([`detection`](crate::detection)). Non-finite where `y` is (a missing sample).
     /// Cost: as [`Observer::step`].
-    #[inline]
+    #[inline(always)]
     pub fn step_innovation(
         &self,
         e: &mut Estimate<T, S, I>,
