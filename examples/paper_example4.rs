@@ -11,16 +11,18 @@
 use aemstep::nalgebra::{Matrix3, Vector3};
 use aemstep::{Linear, Real, State, Stepper};
 
-/// Paper Example 4: `M`, `K`, the modal damping ratios (ascending frequency), `u0`, `v0` and
-/// the step load `p` (applied for t > 0).
-fn example4() -> (
+/// Paper Example 4: `(M, K, ξ, u0, v0, p)`: the modal damping ratios ξ in ascending
+/// frequency, and the step load `p` (applied for t > 0).
+type Example4 = (
     Matrix3<f64>,
     Matrix3<f64>,
     [f64; 3],
     Vector3<f64>,
     Vector3<f64>,
     Vector3<f64>,
-) {
+);
+
+fn example4() -> Example4 {
     let m = Matrix3::new(52.0, 10.0, 20.0, 10.0, 150.0, 30.0, 20.0, 30.0, 441.0);
     let k = Matrix3::new(
         1472.0, 407.0, 5553.0, 407.0, 1001.0, 4154.0, 5553.0, 4154.0, 43516.0,

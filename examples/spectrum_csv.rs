@@ -43,14 +43,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     bank.free_vibration(&mut r, bank.free_vibration_samples());
 
     println!("period_s,sd_m,sv_m_per_s,sa_g");
-    for i in 0..P {
-        println!(
-            "{:.4},{:.6e},{:.6e},{:.6e}",
-            periods[i],
-            r.sd()[i],
-            r.sv()[i],
-            r.sa()[i] / G
-        );
+    let (sd, sv, sa) = (r.sd(), r.sv(), r.sa());
+    for (i, t) in periods.iter().enumerate() {
+        println!("{t:.4},{:.6e},{:.6e},{:.6e}", sd[i], sv[i], sa[i] / G);
     }
     Ok(())
 }
