@@ -2,7 +2,7 @@
 # Fuzzing (issue 10): builds the fuzz targets of fuzz/ (libFuzzer through the crates.io
 # crate libfuzzer-sys) and runs each for a bounded time, starting from its kept corpus
 # fuzz/corpus/<target>/; fails on any crash (a panic, i.e. a broken property: the checks
-# in fuzz/src/checks.rs panic, and libfuzzer-sys aborts on a panic). Prints per-target
+# in fuzz/src/checks/ panic, and libfuzzer-sys aborts on a panic). Prints per-target
 # executions, time, crashes and the checks' counters, and writes them to
 # fuzz/target/fuzz-stats.txt.
 #
@@ -88,7 +88,8 @@ host=$(rustc -vV | sed -n 's/^host: //p')
 # path of the build enters the binaries (debug info of libFuzzer's C++, layout), and two
 # checkouts of one commit built binaries that differ, and fuzz differently from one seed.
 # From one path, every checkout builds the same binary and runs the same inputs.
-fixed=/tmp/aemstep-fuzz-build
+# FUZZ_BUILD_DIR moves it (one path for every run that is to be compared).
+fixed=${FUZZ_BUILD_DIR:-/tmp/aemstep-fuzz-build}
 export CARGO_TARGET_DIR="$fixed/target"
 work="$PWD/fuzz/target"
 mkdir -p "$work"

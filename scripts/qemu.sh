@@ -7,7 +7,12 @@
 # across Cortex-M cores (docs/cortex-m-cores.md), which fails if the M4F's f32 step
 # exceeds 3 instructions per multiply-add at N >= 6.
 #
-# Installs what it needs (thumb target, llvm-tools, qemu-system-arm). Called by
+# The examples are package `aemstep-firmware` (examples/firmware/, a workspace member; the
+# root crate has no firmware feature or dependency). One more, `qemu_defmt`, logs through
+# defmt: its output is decoded by `defmt-print` and compared line by line with
+# examples/firmware/qemu_defmt.out, and a broken variant must fail that comparison.
+#
+# Installs what it needs (thumb target, llvm-tools, qemu-system-arm, defmt-print). Called by
 # scripts/test.sh; runs alone too: `bash scripts/qemu.sh`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,6 +28,9 @@ BROKEN=("qemu_timer inject-nan" "qemu_timer tight-bound" "qemu_nonlinear inject-
     "qemu_hysteretic hysteretic-tight-bound"
     "qemu_observer observer-nan" "qemu_observer observer-tight-bound")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
+PKG=(-p aemstep-firmware)
+DEFMT_PRINT_VERSION=1.2.0 # the host decoder; its format must match the target's defmt 1.x
+DEFMT_EXPECTED=examples/firmware/qemu_defmt.out
 TARGET_DIR=${CARGO_TARGET_DIR:-target}
 OUT=$TARGET_DIR/qemu
 COST_DOC=docs/cortex-m4-cost.md
@@ -30,7 +38,7 @@ COST_DOC=docs/cortex-m4-cost.md
 step() { printf '\n==> %s\n' "$*"; }
 fail() { printf '\nFAILED: %s\n' "$*" >&2; exit 1; }
 
-step "qemu: tools (thumb target, llvm-tools, qemu-system-arm)"
+step "qemu: tools (thumb target, llvm-tools, qemu-system-arm, defmt-print)"
 rustup target add "$TARGET"
 rustup component add llvm-tools
 LLVM_BIN="$(rustc --print sysroot)/lib/rustlib/$(rustc -vV | sed -n 's/^host: //p')/bin"
@@ -45,6 +53,11 @@ if ! command -v qemu-system-arm >/dev/null; then
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q qemu-system-arm
 fi
 qemu-system-arm --version | sed -n 1p
+DEFMT_PRINT=$(command -v defmt-print || echo "${CARGO_HOME:-$HOME/.cargo}/bin/defmt-print")
+if [[ ! -x $DEFMT_PRINT ]]; then
+    cargo install defmt-print --locked --version "$DEFMT_PRINT_VERSION"
+fi
+"$DEFMT_PRINT" --version
 
 mkdir -p "$OUT" docs
 # The QEMU command of .cargo/config.toml for $TARGET (one place for it).
@@ -53,8 +66,8 @@ read -r -a RUNNER < <(sed -n "/^\[target.$TARGET\]/,/^\[/ s/^runner = \"\(.*\)\"
 # A variant is `qemu` (the example as shipped) or `<kind>:<value>`, built with
 # `--cfg aemstep_<kind>="<value>"` (kind: broken, control). The cfg goes to the example
 # crate only (`cargo rustc`), so the library and dependencies are not rebuilt.
-build() { # <example> <variant>: builds and keeps a copy of the ELF as $OUT/<example>-<variant>
-    local args=(-q --release --target "$TARGET" --features qemu --example "$1")
+build() { # <example> <variant> [cargo args]: builds and keeps a copy of the ELF as $OUT/<example>-<variant>
+    local args=(-q "${PKG[@]}" --release --target "$TARGET" --example "$1" "${@:3}")
     if [[ $2 == qemu ]]; then
         cargo build "${args[@]}" || fail "build $1"
     else
@@ -73,12 +86,10 @@ run() { # <example> <variant>: runs the ELF `build` kept under QEMU; sets RC
 }
 
 step "qemu: clippy of the firmware examples ($TARGET)"
-ex_flags=()
-for ex in "${EXAMPLES[@]}"; do ex_flags+=(--example "$ex"); done
-cargo clippy --release --target "$TARGET" --features qemu "${ex_flags[@]}" -- -D warnings ||
+cargo clippy "${PKG[@]}" --release --target "$TARGET" --features defmt --examples -- -D warnings ||
     fail "clippy (firmware examples)"
 for variant in footprint-modal footprint-all; do
-    cargo clippy --release --target "$TARGET" --features qemu --example qemu_footprint \
+    cargo clippy "${PKG[@]}" --release --target "$TARGET" --example qemu_footprint \
         -- -D warnings --cfg "aemstep_control=\"$variant\"" || fail "clippy (qemu_footprint, $variant)"
 done
 
@@ -99,6 +110,35 @@ for pair in "${BROKEN[@]}"; do
     grep -q '^FAIL: ' "$OUT/$ex-broken:$variant.log" || fail "$ex ($variant) failed without saying why"
     echo "ok: $ex with --cfg aemstep_broken=\"$variant\" failed as it must (exit 1)"
 done
+
+step "qemu: defmt: the decoded log of qemu_defmt, line by line against $DEFMT_EXPECTED"
+# The firmware writes defmt frames to semihosting stdout; defmt-print formats them on the
+# host. `--log-format '{L} {s}'`: level and message only (no timestamp is defined; source
+# locations would pin line numbers), so the comparison is exact and repeatable.
+defmt_check() { # <variant>: runs qemu_defmt; sets RC (QEMU) and DIFF (decoded vs expected)
+    local elf="$OUT/qemu_defmt-$1" decoded="$OUT/qemu_defmt-$1.decoded"
+    set +e
+    timeout "$RUN_TIMEOUT" "${RUNNER[@]}" "$elf" >"$OUT/qemu_defmt-$1.raw" 2>"$OUT/qemu_defmt-$1.err"
+    RC=$?
+    set -e
+    [[ $RC -ne 124 ]] || fail "qemu_defmt ($1) timed out after ${RUN_TIMEOUT}s"
+    "$DEFMT_PRINT" -e "$elf" --log-format '{L} {s}' <"$OUT/qemu_defmt-$1.raw" >"$decoded" ||
+        fail "defmt-print could not decode the output of qemu_defmt ($1)"
+    cat "$decoded"
+    DIFF=$(diff <(grep -v '^#' "$DEFMT_EXPECTED") "$decoded" || true)
+}
+build qemu_defmt qemu --features defmt
+defmt_check qemu
+[[ $RC -eq 0 ]] || fail "qemu_defmt exited with $RC: $(grep -a '^FAIL' "$OUT/qemu_defmt-qemu.raw" || true)"
+[[ -z $DIFF ]] || fail "the decoded defmt log differs from $DEFMT_EXPECTED (< expected, > decoded):
+$DIFF"
+echo "ok: qemu_defmt exited 0; its $(wc -l <"$OUT/qemu_defmt-qemu.decoded") decoded lines match $DEFMT_EXPECTED"
+build qemu_defmt broken:defmt-wrong --features defmt
+defmt_check broken:defmt-wrong
+[[ $RC -eq 0 && -n $DIFF ]] ||
+    fail "qemu_defmt with --cfg aemstep_broken=\"defmt-wrong\" (exit $RC) was not caught by the comparison"
+echo "ok: with --cfg aemstep_broken=\"defmt-wrong\" the comparison fails as it must:"
+echo "$DIFF"
 
 step "qemu: no operator inversion code in the compile-time-operator firmware"
 # The build with run-time operators (Linear::new) is the control: the same check must find
@@ -267,7 +307,7 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
         awk '{print $1, $2}'), \`--release\`, target \`$TARGET\`. Instruction counts do not depend on the host"
     echo "($(lscpu | sed -n 's/^Model name: *//p' | sed -n 1p)); they are instructions, not cycles."
     echo
-    echo "## Instructions per step (\`examples/qemu_cost.rs\`)"
+    echo "## Instructions per step (\`examples/firmware/qemu_cost.rs\`)"
     echo
     echo "Fast form: \`Linear<T, N>\` (3N² multiply-adds). A-form: \`AForm<T, N>\` (12N²). Building: N-storey"
     echo "uniform shear building (N = 5 is the benchmark building's size), dense operators. \`f64\` is software"
@@ -294,7 +334,7 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
         echo "| $name | $ty | $n | $instr | $madds | $ratio | $(sym_size "$OUT/qemu_cost-qemu" "$sym") | $stack |"
     done
     echo
-    echo "## Only what the scene needs (\`examples/qemu_modal.rs\`)"
+    echo "## Only what the scene needs (\`examples/firmware/qemu_modal.rs\`)"
     echo
     echo "The benchmark 5-storey building under El Centro, one step plus reading the roof drift, \`f32\`:"
     echo "\`Modal<f32, 5, R>\` (R of 5 modes), the full model with the input through \`B = −Mι\`"
@@ -306,7 +346,7 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
         echo "| \`$what\` | $instr | $madds |"
     done
     echo
-    echo "## Response spectrum (\`examples/qemu_spectrum.rs\`)"
+    echo "## Response spectrum (\`examples/firmware/qemu_spectrum.rs\`)"
     echo
     echo "\`Bank<f32, P>\` (5 %, exact scheme, default sub-steps) fed El Centro: instructions per incoming sample,"
     echo "averaged over the record (sub-step walks included); multiply-adds of the whole-interval steps (10P)."
@@ -315,7 +355,7 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "|---|---:|---:|"
     grep '^COST spectrum' "$OUT/qemu_spectrum-qemu.log" | while read -r _ what instr madds; do echo "| \`$what\` | $instr | $madds |"; done
     echo
-    echo "## A yielding building (\`examples/qemu_hysteretic.rs\`)"
+    echo "## A yielding building (\`examples/firmware/qemu_hysteretic.rs\`)"
     echo
     echo "The 3-storey building with bilinear storeys under El Centro, \`Nonlinear<f32, 3>\` with exactly 3"
     echo "Newton iterations a step, storey histories committed with each step; over the 3994 steps of the record."
@@ -326,7 +366,7 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
         echo "| \`$what\` | $mean | $max |"
     done
     echo
-    echo "## Observer loops (\`examples/qemu_observer.rs\`)"
+    echo "## Observer loops (\`examples/firmware/qemu_observer.rs\`)"
     echo
     echo "One step of the fixed-gain observer (predict, correct with 2 accelerometers), \`f32\`: the full building"
     echo "(\`Observer<f32, 10, 1, 2>\`, 10 states) and 2 of its 5 modes (\`Observer<f32, 4, 1, 2>\`)."
@@ -337,7 +377,7 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
         echo "| \`$what\` | $instr | $madds | $(awk -v a="$instr" -v b="$madds" 'BEGIN { printf "%.2f", a / b }') |"
     done
     echo
-    echo "## Footprint (\`examples/qemu_footprint.rs\`)"
+    echo "## Footprint (\`examples/firmware/qemu_footprint.rs\`)"
     echo
     echo "Flash (\`.text\` + \`.rodata\` + vector table + \`.data\`) of the same firmware using only"
     echo "\`Linear<f32, 5>\`; also a \`Modal<f32, 5, 2>\` solved by the compiler ("
@@ -348,7 +388,7 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "| firmware | flash (bytes) |"
     echo "|---|---:|"
     echo "| \`Linear<f32, 5>\` only | $FP_LEAN |"
-    echo "| + \`Modal<f32, 5, 2>\` (\`static\`, \`from_rows\`) | $FP_MODAL |"
+    echo "| + \`Modal<f32, 5, 2>\` (\`static\`, \`from_rows_f32\`) | $FP_MODAL |"
     echo "| + \`Nonlinear<f32, 5>\` + \`Modal<f32, 5, 2>\` (\`Modal::new\` on target) | $FP_ALL |"
     echo
     echo "## Memory of each example"

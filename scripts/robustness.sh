@@ -30,11 +30,11 @@ def fuzz_section(path):
         elif f and f[0] == "COUNT":
             counts[f[1]][" ".join(f[2:-1])] = int(f[-1])
     covers = dict(
-        linear_family="`Linear` (new, from_rows), `AForm`, `CompensatedLinear`, `LinearInput`, `Newmark` (β, γ; three presets), `GeneralizedAlpha` (ρ∞, HHT), `Exact`; N = 1, 2, 3",
-        modal="`Modal` (new, with_modes, from_rows, from_rows_with_modes; every `Damping`); N = 2, 3",
+        linear_family="`Linear` (new, from_rows_f32/_f64), `AForm`, `CompensatedLinear`, `LinearInput`, `Newmark` (β, γ; three presets), `GeneralizedAlpha` (ρ∞, HHT), `Exact`; N = 1, 2, 3",
+        modal="`Modal` (new, with_modes, from_rows_f32/_f64, from_rows_with_modes_f32/_f64; every `Damping`); N = 2, 3",
         nonlinear="`Nonlinear` (cubic springs, analytic or finite-difference tangent; Newton settings), `Varying`; N = 1, 2",
         hysteresis="`Bilinear`, `BoucWen`, `Friction`, `Parallel` (trials along a path), `ShearBuilding`, its `Nonlinear` steps with history",
-        observer="`StateSpace` (aem, aem_from_rows, exact, modal; wrong S), outputs, `SteadyState`, `Observer` (new, from_parts), `Kalman`, `Readout`",
+        observer="`StateSpace` (aem, from_rows_aem, exact, modal; wrong S), outputs, `SteadyState`, `Observer` (new, from_parts_f32/_f64), `Kalman`, `Readout`",
         spectrum="`Bank` (new, with: both schemes, every sub-step rule), `RotD`, `batch::spectra`",
     )
     order = ["linear_family", "modal", "nonlinear", "hysteresis", "observer", "spectrum"]
@@ -53,7 +53,7 @@ bit patterns; `h` from 1e-324 to 1e300 and invalid ones (0, −0, < 0, NaN, ∞,
 overflowing); structured matrices (SPD at any scale, singular and near-singular
 `v vᵀ + δ I`, non-symmetric, effective matrices cancelled to rounding `K = −4M/h²`,
 `C = −2M/h` and near them); scheme parameters in and out of range — and run the checks
-of `fuzz/src/checks.rs` on them: every constructor of the group in `f32` and `f64`, every
+of `fuzz/src/checks/` on them: every constructor of the group in `f32` and `f64`, every
 built stepper started and stepped with checked steps (a NaN load among them), each `Ok`
 compared with the unchecked step, each failed step's state compared bit by bit, the same
 data given to every constructor that takes it (the same error expected where the data
@@ -105,12 +105,12 @@ Library fixes (each `Ok` with garbage, or a wrong error, before):
 - `f32` steppers accepted a time step that is valid in `f64` but not in `f32`
   (`h = 1e58` overflows, `h = 1e-30` makes `h²/4` zero): infinite or vanishing
   kinematics. Now `InvalidTimeStep` from every constructor (and from `Observer` for its
-  model's `dt`); Newmark coefficients `β h²` that overflow are `OperatorOverflow`.
+  model's `time_step`); Newmark coefficients `β h²` that overflow are `OperatorOverflow`.
 - `Linear::a_form`'s blocks overflow where the stepper's operators do not
   (`(h/2) G` with `G = 1e251`, `h = 1e147`): `Linear::try_a_form` checks them.
-- Response-spectrum banks with NaN operators (a period of 1e-109 s at `dt = 1e-4`: the
-  exact map over `ω dt ≈ 6e105` overflows), or finite but unbounded ones (`uu = 6e134` at
-  `ω dt ≈ 3e18`, where a damped oscillator's map is bounded by 1): `OperatorOverflow`,
+- Response-spectrum banks with NaN operators (a period of 1e-109 s at `h = 1e-4`: the
+  exact map over `ω h ≈ 6e105` overflows), or finite but unbounded ones (`uu = 6e134` at
+  `ω h ≈ 3e18`, where a damped oscillator's map is bounded by 1): `OperatorOverflow`,
   reported after the periods and damping ratios are checked. The AEM's sub-step map, formed by stepping unit
   inputs, cancelled terms of size `(ωh)²/4` (at `ωh ≈ 5e14` a bank stepped 10 m/s² to a
   displacement of 1e98): now in closed form.

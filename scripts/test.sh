@@ -83,6 +83,12 @@ rustup toolchain install nightly --profile minimal || fail "installing the night
 RUSTDOCFLAGS="--cfg docsrs -D warnings" cargo +nightly doc --no-deps --all-features ||
     fail "rustdoc as docs.rs builds it (nightly, --all-features, --cfg docsrs)"
 
+step "every code block of README, docs and rustdoc builds and runs in a crate that depends on aemstep alone (scripts/downstream.py)"
+# Its self-test first: a README block that names `nalgebra` and a rustdoc block that fails
+# when run, in a copy of the repository, must both fail the check.
+python3 scripts/downstream.py --self-test || fail "scripts/downstream.py --self-test"
+python3 scripts/downstream.py || fail "a code block fails downstream (python3 scripts/downstream.py lists them)"
+
 step "the published package: cargo publish --dry-run clean, its size as docs/package.md states"
 bash scripts/package.sh || fail "package (bash scripts/package.sh; --write regenerates docs/package.md)"
 

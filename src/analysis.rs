@@ -53,7 +53,7 @@ where
     let mut raw = [[0.0; 3]; 3];
     for j in 0..3 {
         let e = |k: usize| SVector::<T, 1>::new(if k == j { T::one() } else { T::zero() });
-        let mut s = State::from_parts(e(0), e(1), e(2), 0);
+        let mut s = State::unchecked(e(0), e(1), e(2), 0);
         stepper.step(&mut s, &SVector::<T, 1>::zeros());
         raw[0][j] = s.u()[0].as_f64();
         raw[1][j] = s.v()[0].as_f64();
@@ -173,6 +173,7 @@ pub fn spectral_radius(a: &Matrix3) -> f64 {
 }
 
 /// What the analysis of one scheme at one `(s, ξ)` gives.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SdofProperties {
     /// `s = ωh`.
@@ -234,6 +235,7 @@ impl SdofProperties {
 }
 
 /// The schemes of the crate, for [`sdof`].
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Scheme {
     /// The AEM, eliminated form ([`Linear`]).

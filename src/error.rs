@@ -65,8 +65,9 @@ pub enum Error {
     /// lost its precision (e.g. `M⁻¹K ≈ 1e-324` from data whose scales are 1e300 apart).
     /// Rescale the units.
     OperatorUnderflow,
-    /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) is not finite or is
-    /// outside its documented range.
+    /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) or a change detector's
+    /// (window length, false-alarm probability, bank size) is not finite or is outside its
+    /// documented range.
     InvalidParameter,
     /// A response-spectrum period is not finite and at least `1e-150` s (shorter ones have
     /// an `ω²` that overflows), or the periods of a bank are not in non-decreasing order
@@ -89,6 +90,13 @@ pub enum Error {
     /// A state-space size parameter does not match the model: `S = 2N` for the full state
     /// `x = [u; v]`, `S = 3N` for generalized-α's `x = [u; v; a]`, `S = 2R` for `R` modes.
     StateSizeMismatch,
+    /// The unknown input cannot be estimated from the chosen sensors
+    /// ([`estimation`](crate::estimation)): fewer measurements than unknown inputs, a
+    /// feedthrough `D̃ = HΓ₁ + D` without full column rank, or an invariant zero of the
+    /// model on or outside the unit circle (acceleration-only sensing: the static
+    /// force–displacement pair at `z = 1`, the drift), so the estimator has no stable
+    /// steady state.
+    InputNotIdentifiable,
 }
 
 impl Error {
@@ -144,6 +152,9 @@ impl Error {
                 "the Riccati equation of the steady-state gain did not converge"
             }
             Error::StateSizeMismatch => "state size must be S = 2N (or 3N gen-alpha, 2R modal)",
+            Error::InputNotIdentifiable => {
+                "the unknown input is not identifiable from these sensors (count, rank or zeros)"
+            }
         }
     }
 }

@@ -61,7 +61,7 @@ impl<const N: usize> KernelOps<N> {
 }
 
 impl<T: Real, const N: usize> Kernel<T, N, AemKinematics<T>> {
-    /// The AEM kernel of `M, C, K, h` (run time; bit-identical to `aem_from_rows`): the
+    /// The AEM kernel of `M, C, K, h` (run time; bit-identical to `from_rows_aem`): the
     /// one build behind `Linear::new` and `CompensatedLinear::new`.
     pub(crate) fn aem(
         m: &nalgebra::SMatrix<f64, N, N>,
@@ -88,8 +88,8 @@ macro_rules! const_kernel {
         impl<const N: usize> Kernel<$t, N, AemKinematics<$t>> {
             /// The AEM kernel of `M, C, K, h` (`const`): the checks and operators of
             /// [`newmark_operators`] with β = 1/4, γ = 1/2, rounded once (the one build
-            /// behind `Linear::from_rows` and `CompensatedLinear::from_rows`).
-            pub(crate) const fn aem_from_rows(
+            /// behind `Linear::from_rows_f32`/`_f64` and `CompensatedLinear::from_rows_f32`/`_f64`).
+            pub(crate) const fn from_rows_aem(
                 m: &Mat<N, N>,
                 c: &Mat<N, N>,
                 k: &Mat<N, N>,

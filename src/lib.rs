@@ -13,7 +13,7 @@
 //! Newmark's average-acceleration rule).
 //!
 //! - [`Linear`]: constant `M, C, K`; operators built once (at run time, or by the compiler
-//!   into flash with [`Linear::from_rows`]); `3N²` multiply-adds a step.
+//!   into flash with [`Linear::from_rows_f32`]); `3N²` multiply-adds a step.
 //! - [`AForm`]: the paper's literal `U_n = A U_{n−1} + b p_n` (`12N²`), for reference and
 //!   inspection.
 //! - [`CompensatedLinear`]: the same step with the state update compensated (two-sum), for
@@ -38,8 +38,74 @@
 //!   Kalman filter, modal observers.
 //! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
+//! - [`matrix!`], [`vector!`]: nalgebra's literal syntax for the crate's matrix and vector
+//!   types, also in `const` and `static` items, with no `nalgebra` dependency of your own.
 //!
 //! Scalars are `f32` or `f64` ([`Real`]); sizes are const generics; nothing allocates.
+//!
+//! # Naming
+//!
+//! One rule for constructors and one name for the time step, across the crate:
+//!
+//! - **Run-time constructors** are `new` (variants `with`, `with_modes`, `aem`, …), generic
+//!   over the scalar `T: Real`: [`Linear::new`], [`Modal::new`], [`spectrum::Bank::new`],
+//!   [`observer::Observer::new`], [`observer::SteadyState::new`].
+//! - **Compile-time constructors** (`const fn`: in a `static`, the compiler computes the
+//!   operators into flash) are `from_rows` when they take row-major `f64` arrays (`m[i][j]`
+//!   is row `i`, column `j`) and `from_parts` when they take other `const`-built values (a
+//!   model, a measurement, a gain). Where a type has one impl per scalar, the name ends in
+//!   the scalar — [`Linear::from_rows_f32`] / [`Linear::from_rows_f64`],
+//!   [`Modal::from_rows_with_modes_f32`], [`observer::Observer::from_parts_f32`],
+//!   [`spectrum::Bank::new_f32`], [`spectrum::RotD::new_f64`], … — so a typed `static`
+//!   infers the sizes with no turbofish and never meets `E0034 multiple applicable items`.
+//!   On a type with one scalar (`f64`), a variant ends in its kind:
+//!   [`observer::StateSpace::from_rows_aem`], `from_rows_newmark`,
+//!   `from_rows_generalized_alpha`, `from_rows_modal`; [`observer::SteadyState::from_parts`].
+//! - [`State::restore`] rebuilds a saved state (checked finite); it is not a `const`
+//!   constructor.
+//! - **The time step** is `time_step` everywhere: [`Stepper::time_step`], an inherent
+//!   `const fn time_step` on the per-scalar steppers (usable in a `const`; generic code
+//!   still calls the trait's), [`observer::Observer::time_step`],
+//!   [`spectrum::Bank::time_step`], the field [`observer::StateSpace::time_step`]. In
+//!   arguments it is `h` (s), the paper's symbol.
+//!
+//! ```
+//! use aemstep::Linear;
+//!
+//! // u'' + 0.28 u' + 4 u = p, h = 2 ms: operators computed by the compiler.
+//! static SYS: Linear<f32, 1> = match Linear::from_rows_f32([[1.0]], [[0.28]], [[4.0]], 0.002) {
+//!     Ok(s) => s,
+//!     Err(e) => panic!("{}", e.as_str()),
+//! };
+//! const H: f32 = SYS.time_step(); // s
+//! const STEPS_PER_SECOND: u32 = (1.0 / H + 0.5) as u32;
+//! assert_eq!(H, 0.002);
+//! assert_eq!(STEPS_PER_SECOND, 500);
+//! ```
+//!
+//! ```
+//! use aemstep::models::{self, base_excitation};
+//! use aemstep::observer::{Observer, Outputs, StateSpace};
+//!
+//! // The 5-storey building under ground acceleration, h = 0.02 s; the open-loop
+//! // observer (gain 0) of the roof displacement, in f32, built by the compiler.
+//! const B: ([[f64; 5]; 5], [[f64; 5]; 5], [[f64; 5]; 5]) = models::five_storey_building();
+//! const SS: StateSpace<5, 10, 1> =
+//!     match StateSpace::from_rows_aem(B.0, B.1, B.2, base_excitation(&B.0), 0.02) {
+//!         Ok(s) => s,
+//!         Err(e) => panic!("{}", e.as_str()),
+//!     };
+//! static OPEN_LOOP: Observer<f32, 10, 1, 1> =
+//!     match SS.outputs(&Outputs::displacements(Outputs::<5, 1, 1>::select([4]))) {
+//!         Ok(meas) => match Observer::from_parts_f32(&SS, &meas, &[[0.0]; 10]) {
+//!             Ok(o) => o,
+//!             Err(e) => panic!("{}", e.as_str()),
+//!         },
+//!         Err(e) => panic!("{}", e.as_str()),
+//!     };
+//! assert_eq!(SS.time_step, 0.02);
+//! assert_eq!(OPEN_LOOP.time_step(), 0.02);
+//! ```
 #![no_std]
 // docs.rs builds with `--cfg docsrs`: feature-gated items say which feature they need.
 #![cfg_attr(docsrs, feature(doc_cfg))]
@@ -56,6 +122,11 @@ extern crate std;
 /// The `nalgebra` this crate's API is written in (version 0.35): use `aemstep::nalgebra`
 /// so your matrices and vectors are the same types as the crate's.
 pub use nalgebra;
+
+// `matrix!` and `vector!` (exported at the crate root) and the helper they expand to.
+mod macros;
+#[doc(hidden)]
+pub use macros::rows_to_columns as __rows_to_columns;
 
 // The state and the interface every scheme shares.
 mod error;
@@ -77,12 +148,20 @@ mod schemes;
 // Nonlinear (Newton) and time-varying steppers.
 mod nonlinear;
 
+// Change detection on an observer's innovations, localization by a bank of models.
+pub mod detection;
+
 // Modal reduction, stability analysis, ready-made models.
 pub mod analysis;
+pub mod estimation;
 pub mod hysteresis;
 pub mod modal;
 pub mod models;
 pub mod observer;
+
+// `defmt::Format` for the types that hold nalgebra data (feature `defmt`).
+#[cfg(feature = "defmt")]
+mod defmt_impls;
 
 pub use error::Error;
 pub use modal::{Damping, Modal, ModalState};
@@ -115,3 +194,18 @@ pub struct NonlinearDocDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/schemes.md")]
 pub struct SchemesDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/hysteresis.md")]
+pub struct HysteresisDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/spectrum.md")]
+pub struct SpectrumDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/observer.md")]
+pub struct ObserverDocDoctests;

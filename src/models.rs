@@ -8,6 +8,109 @@
 
 pub use crate::linalg::Rows;
 
+use nalgebra::{SMatrix, SVector};
+
+use crate::Real;
+
+/// Unwrap a `Result<_, aemstep::Error>` in a `const` or `static` initializer: the value, or
+/// a build error naming the reason ([`Error::as_str`](crate::Error::as_str)). The same in
+/// run-time code, where it panics with that text (prefer `?` there).
+///
+/// A macro, not a `const fn`: a generic `const fn` cannot drop a `Result<T, _>` whose `T`
+/// may have drop glue, so it would need one function per type. Expands to
+/// `match expr { Ok(v) => v, Err(e) => panic!("{}", e.as_str()) }`. Cost: none at run
+/// time in a `static`.
+///
+/// ```
+/// use aemstep::Linear;
+/// static SYS: Linear<f32, 1> =
+///     aemstep::unwrap_const!(Linear::<f32, 1>::from_rows_f32([[1.0]], [[0.28]], [[4.0]], 0.002));
+/// const M: aemstep::models::Rows<2> = aemstep::models::diagonal([1.0e5, 2.0e5]);
+/// assert_eq!(M[1][1], 2.0e5);
+/// # let _ = &SYS;
+/// ```
+///
+/// A constructor that fails stops the build:
+///
+/// ```compile_fail
+/// use aemstep::Linear;
+/// // h = 0 is not a time step: error[E0080] ... "invalid time step"
+/// static SYS: Linear<f32, 1> =
+///     aemstep::unwrap_const!(Linear::<f32, 1>::from_rows_f32([[1.0]], [[0.0]], [[4.0]], 0.0));
+/// ```
+#[macro_export]
+macro_rules! unwrap_const {
+    ($result:expr) => {
+        match $result {
+            ::core::result::Result::Ok(value) => value,
+            ::core::result::Result::Err(e) => ::core::panic!("{}", $crate::Error::as_str(&e)),
+        }
+    };
+}
+
+/// `diag(d)`: the row-major `N×N` matrix with `d` on its diagonal (e.g. lumped masses, kg,
+/// or a diagonal covariance). `const`; cost `N²` stores.
+pub const fn diagonal<const N: usize>(d: [f64; N]) -> Rows<N> {
+    let mut a = [[0.0; N]; N];
+    let mut i = 0;
+    while i < N {
+        a[i][i] = d[i];
+        i += 1;
+    }
+    a
+}
+
+/// The floor masses of a lumped mass matrix: its diagonal (kg when `m` is), the argument
+/// [`ShearBuilding::new`] takes, e.g. from [`shear_building`] or
+/// [`five_storey_building`]'s `M`. Off-diagonal entries are ignored (a lumped `M` has
+/// none). `const`; cost `N`.
+pub const fn floor_masses<const N: usize>(m: &Rows<N>) -> [f64; N] {
+    let mut d = [0.0; N];
+    let mut i = 0;
+    while i < N {
+        d[i] = m[i][i];
+        i += 1;
+    }
+    d
+}
+
+/// Storey drifts `δ_i = u_i − u_{i−1}` (`u_{−1} = 0`, the ground) of a floor vector `u`
+/// (displacements, m, or velocities, m/s; DOFs ground storey first), in any scalar type,
+/// without naming the building's type. The run-time form of [`storey_drifts`]; what
+/// [`ShearBuilding::drifts`] computes. Cost: `N − 1` subtractions.
+pub fn drifts<T: Real, const N: usize>(u: &SVector<T, N>) -> SVector<T, N> {
+    let mut d = *u;
+    for i in 1..N {
+        d[i] -= u[i - 1];
+    }
+    d
+}
+
+/// The nalgebra matrix of a row-major array: `a[i][j]` becomes entry `(i, j)`, rounded
+/// once to `T`. Use it (not `SMatrix::from(a)`, which reads the arrays as **columns** and
+/// gives the transpose) to pass [`Rows`] data to the run-time constructors
+/// (`Linear::new(&models::matrix_of(&k), …)` builds what `Linear::from_rows(…, k, …)`
+/// builds). Cost: `N²` conversions.
+///
+/// ```
+/// use aemstep::models;
+/// use aemstep::nalgebra::SMatrix;
+/// let k = [[2.0, -1.0], [0.0, 3.0]]; // row-major: k[0][1] = −1 is row 0, column 1
+/// let a: SMatrix<f64, 2, 2> = models::matrix_of(&k);
+/// assert_eq!(a[(0, 1)], -1.0);
+/// assert_eq!(SMatrix::<f64, 2, 2>::from(k)[(1, 0)], -1.0); // nalgebra's reading: transposed
+/// assert_eq!(models::rows_of(&a), k);
+/// ```
+pub fn matrix_of<T: Real, const N: usize>(rows: &Rows<N>) -> SMatrix<T, N, N> {
+    SMatrix::from_fn(|i, j| T::from_f64_rounded(rows[i][j]))
+}
+
+/// The row-major array of a matrix (`a[i][j]` = entry `(i, j)`, as `f64`), the inverse of
+/// [`matrix_of`]: for the `const` constructors' [`Rows`] arguments. Cost: `N²`.
+pub fn rows_of<T: Real, const N: usize>(a: &SMatrix<T, N, N>) -> Rows<N> {
+    core::array::from_fn(|i| core::array::from_fn(|j| a[(i, j)].as_f64()))
+}
+
 /// The hysteretic shear building (storeys from any [`hysteresis`](crate::hysteresis) law
 /// plus linear damping, for the nonlinear stepper at any `N`), here beside the linear
 /// builders; defined in [`hysteresis`](crate::hysteresis).
@@ -18,7 +121,7 @@ pub use crate::hysteresis::ShearBuilding;
 /// `K_ii = k_i + k_{i+1}` (`k_{N+1} = 0`), `K_{i,i+1} = K_{i+1,i} = −k_{i+1}`.
 ///
 /// Units: kg and N/m (or any consistent set). DOF `i` is the displacement of floor `i+1`
-/// relative to the ground. No checks here: `Linear::new`/`from_rows` check the result.
+/// relative to the ground. No checks here: `Linear::new`/`from_rows_f32`/`from_rows_f64` check the result.
 pub const fn shear_building<const N: usize>(m: [f64; N], k: [f64; N]) -> (Rows<N>, Rows<N>) {
     let mut mm = [[0.0; N]; N];
     let mut kk = [[0.0; N]; N];
@@ -167,6 +270,7 @@ mod tests {
 /// With `u0 = 0`, `v0 = 1` and `p(t) = −0.01 e^{−0.1t} sin t + e^{−0.3t} sin³ t` the exact
 /// solution is `u = e^{−0.1t} sin t`. Units: any consistent set (the paper's are
 /// dimensionless). Cost: `force` 4 multiplies and 2 adds, `tangent` 3 and 1.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Duffing;
 

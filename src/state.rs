@@ -19,9 +19,45 @@ pub struct State<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> State<T, N> {
-    /// A state from its parts (no check; used by steppers and by callers restoring a
-    /// saved state).
-    pub fn from_parts(u: SVector<T, N>, v: SVector<T, N>, a: SVector<T, N>, steps: u64) -> Self {
+    /// A state restored from saved parts: displacement `u`, velocity `v`, acceleration `a`
+    /// (model units, as [`State::u`], [`State::v`], [`State::a`]) and the step count
+    /// `steps` (time `steps·h`). Give it to the stepper the parts came from.
+    ///
+    /// Errors: [`Error::NonFiniteInput`] if any entry of `u`, `v`, `a` is not finite.
+    /// Cost: a scan of the `3N` entries.
+    ///
+    /// ```
+    /// use aemstep::{Error, State};
+    /// use aemstep::nalgebra::vector;
+    /// let s = State::restore(vector![0.1], vector![0.0], vector![-2.5], 40)?;
+    /// assert_eq!((s.u()[0], s.steps()), (0.1, 40));
+    /// assert_eq!(
+    ///     State::restore(vector![f64::NAN], vector![0.0], vector![0.0], 0),
+    ///     Err(Error::NonFiniteInput)
+    /// );
+    /// # Ok::<(), aemstep::Error>(())
+    /// ```
+    pub fn restore(
+        u: SVector<T, N>,
+        v: SVector<T, N>,
+        a: SVector<T, N>,
+        steps: u64,
+    ) -> Result<Self, Error> {
+        let s = Self::unchecked(u, v, a, steps);
+        if s.is_finite() {
+            Ok(s)
+        } else {
+            Err(Error::NonFiniteInput)
+        }
+    }
+
+    /// A state from its parts, unchecked (the steppers' own results).
+    pub(crate) fn unchecked(
+        u: SVector<T, N>,
+        v: SVector<T, N>,
+        a: SVector<T, N>,
+        steps: u64,
+    ) -> Self {
         Self { u, v, a, n: steps }
     }
     /// Displacement `u_n` (model units, e.g. m).
@@ -61,7 +97,7 @@ impl<T: Real, const N: usize> State<T, N> {
         v0: &SVector<T, N>,
         a0: SVector<T, N>,
     ) -> Result<Self, Error> {
-        let s = Self::from_parts(*u0, *v0, a0, 0);
+        let s = Self::unchecked(*u0, *v0, a0, 0);
         if s.is_finite() {
             Ok(s)
         } else {

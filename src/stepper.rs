@@ -35,7 +35,8 @@ impl<T: Real, const I: usize> StepInput for SVector<T, I> {
 ///
 /// ```
 /// use aemstep::{Error, Linear, Modal, StepState, Stepper};
-/// use aemstep::nalgebra::{SVector, matrix, vector};
+/// use aemstep::{matrix, vector};
+/// use aemstep::nalgebra::SVector;
 ///
 /// /// Step any scheme through a load history; the displacement of DOF 0 at the end.
 /// fn run<S: Stepper<f64, 2>>(sys: &S, loads: &[S::Input]) -> Result<f64, Error> {

@@ -36,7 +36,7 @@ fn effective_matrix_cancelled_to_rounding_is_singular() {
     );
     let rows = |a: M2| [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]];
     assert_eq!(
-        Linear::<f64, 2>::from_rows(rows(m), rows(c), rows(k), h).err(),
+        Linear::<f64, 2>::from_rows_f64(rows(m), rows(c), rows(k), h).err(),
         want.err()
     );
 }
@@ -98,7 +98,7 @@ fn f32_operators_that_overflow_are_rejected() {
     let want = Some(Error::OperatorOverflow);
     assert_eq!(Linear::<f32, 1>::new(&m, &z, &z, 0.01).err(), want);
     assert_eq!(
-        Linear::<f32, 1>::from_rows([[1e-39]], [[0.0]], [[0.0]], 0.01).err(),
+        Linear::<f32, 1>::from_rows_f32([[1e-39]], [[0.0]], [[0.0]], 0.01).err(),
         want
     );
     assert_eq!(
@@ -308,7 +308,7 @@ fn f32_time_step_that_does_not_fit_is_invalid() {
             "h = {h:e}"
         );
         assert_eq!(
-            Linear::<f32, 1>::from_rows([[1.0]], [[0.0]], [[1.0]], h).err(),
+            Linear::<f32, 1>::from_rows_f32([[1.0]], [[0.0]], [[1.0]], h).err(),
             want
         );
         assert_eq!(CompensatedLinear::<f32, 1>::new(&m, &z, &k, h).err(), want);

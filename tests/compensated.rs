@@ -16,7 +16,7 @@ fn operators_and_errors_are_linear_s() {
     let a = Linear::<f32, 2>::new(&m, &c, &k, 0.011).unwrap();
     let b = CompensatedLinear::<f32, 2>::new(&m, &c, &k, 0.011).unwrap();
     let rows = |a: SMatrix<f64, 2, 2>| [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]];
-    let d = CompensatedLinear::<f32, 2>::from_rows(rows(m), rows(c), rows(k), 0.011).unwrap();
+    let d = CompensatedLinear::<f32, 2>::from_rows_f32(rows(m), rows(c), rows(k), 0.011).unwrap();
     assert_eq!(a.effective_inverse(), b.effective_inverse());
     assert_eq!(b, d);
     assert_eq!(a.condition(), b.condition());

@@ -1,5 +1,5 @@
 //! Every constructor gives bit-identical operators for the same data, in `f32` and `f64`:
-//! the run-time `new` (nalgebra `f64` matrices) and the `const fn` `from_rows` (row
+//! the run-time `new` (nalgebra `f64` matrices) and the `const fn` `from_rows_f32`/`_f64` (row
 //! arrays) both compute in `f64` and round once. The data are chosen not `f32`-exact
 //! (ξ = 0.07, h = 0.01), so a constructor that rounded its inputs before building would
 //! fail here.
@@ -7,7 +7,7 @@
 
 use aemstep::models::{Rows, base_excitation, rayleigh, rayleigh_coefficients, shear_building};
 use aemstep::nalgebra::SMatrix;
-use aemstep::{Damping, Linear, LinearInput, Modal, Stepper};
+use aemstep::{Damping, Linear, LinearInput, Modal};
 
 /// A 4-storey building, storeys not uniform, Rayleigh damping ξ = 0.07 in modes 1 and 2.
 fn building() -> (Rows<4>, Rows<4>, Rows<4>) {
@@ -39,10 +39,10 @@ fn data_are_not_f32_exact() {
 fn linear_new_equals_from_rows_bit_for_bit() {
     let (m, c, k) = building();
     let a64 = Linear::<f64, 4>::new(&sm(&m), &sm(&c), &sm(&k), H).unwrap();
-    let b64 = Linear::<f64, 4>::from_rows(m, c, k, H).unwrap();
+    let b64 = Linear::<f64, 4>::from_rows_f64(m, c, k, H).unwrap();
     assert_eq!(bits(&a64), bits(&b64));
     let a32 = Linear::<f32, 4>::new(&sm(&m), &sm(&c), &sm(&k), H).unwrap();
-    let b32 = Linear::<f32, 4>::from_rows(m, c, k, H).unwrap();
+    let b32 = Linear::<f32, 4>::from_rows_f32(m, c, k, H).unwrap();
     assert_eq!(bits(&a32), bits(&b32));
     // And the f32 operators are the f64 ones rounded once.
     let g64 = a64.effective_inverse();
@@ -55,10 +55,10 @@ fn linear_input_new_equals_from_rows_bit_for_bit() {
     let (m, c, k) = building();
     let b = base_excitation(&m);
     let a64 = LinearInput::<f64, 4, 1>::new(&sm(&m), &sm(&c), &sm(&k), &sm(&b), H).unwrap();
-    let b64 = LinearInput::<f64, 4, 1>::from_rows(m, c, k, b, H).unwrap();
+    let b64 = LinearInput::<f64, 4, 1>::from_rows_f64(m, c, k, b, H).unwrap();
     assert_eq!(bits(&a64), bits(&b64));
     let a32 = LinearInput::<f32, 4, 1>::new(&sm(&m), &sm(&c), &sm(&k), &sm(&b), H).unwrap();
-    let b32 = LinearInput::<f32, 4, 1>::from_rows(m, c, k, b, H).unwrap();
+    let b32 = LinearInput::<f32, 4, 1>::from_rows_f32(m, c, k, b, H).unwrap();
     assert_eq!(bits(&a32), bits(&b32));
     assert_eq!(a64.input_operator().map(|x| x as f32), a32.input_operator());
 }
@@ -70,10 +70,10 @@ fn modal_new_equals_from_rows_bit_for_bit() {
     let y = [[0.0, 0.0, 0.0, 1.0], [1.0, 0.0, 0.0, 0.0]];
     let d = Damping::Matrix(c);
     let a64 = Modal::<f64, 4, 2, 1, 2>::new(&sm(&m), &sm(&k), &d, &sm(&b), &sm(&y), H).unwrap();
-    let b64 = Modal::<f64, 4, 2, 1, 2>::from_rows(m, k, d, b, y, H).unwrap();
+    let b64 = Modal::<f64, 4, 2, 1, 2>::from_rows_f64(m, k, d, b, y, H).unwrap();
     assert_eq!(bits(&a64), bits(&b64));
     let a32 = Modal::<f32, 4, 2, 1, 2>::new(&sm(&m), &sm(&k), &d, &sm(&b), &sm(&y), H).unwrap();
-    let b32 = Modal::<f32, 4, 2, 1, 2>::from_rows(m, k, d, b, y, H).unwrap();
+    let b32 = Modal::<f32, 4, 2, 1, 2>::from_rows_f32(m, k, d, b, y, H).unwrap();
     assert_eq!(bits(&a32), bits(&b32));
     let ratios = Damping::Ratios([0.07; 4]);
     let a = Modal::<f32, 4, 2, 1, 2>::with_modes(
@@ -86,14 +86,15 @@ fn modal_new_equals_from_rows_bit_for_bit() {
         H,
     )
     .unwrap();
-    let b = Modal::<f32, 4, 2, 1, 2>::from_rows_with_modes(m, k, ratios, b, y, [3, 1], H).unwrap();
+    let b =
+        Modal::<f32, 4, 2, 1, 2>::from_rows_with_modes_f32(m, k, ratios, b, y, [3, 1], H).unwrap();
     assert_eq!(bits(&a), bits(&b));
 }
 
 /// The largest sizes the `const fn` constructors are documented to compile in a `static`
 /// with the default `long_running_const_eval` lint (rustc 1.95): `Linear<f32, 63>` and
 /// `Modal<f32, 49, 2>`. One size more stops the build (measured: `Linear` at 64, `Modal`
-/// at 50); the rustdoc of `from_rows` says so and names the lint to allow.
+/// at 50); the rustdoc of `from_rows_f32`/`_f64` says so and names the lint to allow.
 mod largest_const_sizes {
     use super::*;
 
@@ -112,12 +113,12 @@ mod largest_const_sizes {
     }
 
     static LINEAR_63: Linear<f32, 63> =
-        match Linear::<f32, 63>::from_rows(chain(1.0, 0.0), chain(0.0, 0.0), chain(2.0, -1.0), H) {
+        match Linear::from_rows_f32(chain(1.0, 0.0), chain(0.0, 0.0), chain(2.0, -1.0), H) {
             Ok(s) => s,
             Err(e) => panic!("{}", e.as_str()),
         };
 
-    static MODAL_49: Modal<f32, 49, 2> = match Modal::<f32, 49, 2>::from_rows(
+    static MODAL_49: Modal<f32, 49, 2> = match Modal::from_rows_f32(
         chain(1.0, 0.0),
         chain(2.0, -1.0),
         Damping::None,

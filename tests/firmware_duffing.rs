@@ -1,4 +1,4 @@
-//! Host twin of the nonlinear firmware example (`examples/qemu_nonlinear.rs`): paper
+//! Host twin of the nonlinear firmware example (`examples/firmware/qemu_nonlinear.rs`): paper
 //! Example 5, the Duffing oscillator `u'' + 0.2 u' + u + u³ = p(t)`, u0 = 0, v0 = 1, with
 //! `p(t)` chosen so that the exact solution is `u = e^{−0.1t} sin t`; h = 0.01 s,
 //! 0 < t ≤ 20 s (2000 steps), `f32`, exactly 2 Newton iterations a step.

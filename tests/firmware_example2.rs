@@ -1,7 +1,7 @@
-//! Host twin of the SysTick firmware example (`examples/qemu_timer.rs`): paper Example 2
+//! Host twin of the SysTick firmware example (`examples/firmware/qemu_timer.rs`): paper Example 2
 //! (ii), `u'' + 2ξω u' + ω² u = 10 H(t)`, ω = 2, ξ = 0.07, u0 = 1, v0 = 20, h = 1/500,
 //! 0 ≤ t ≤ 25 s (12 500 steps), stepped in `f32` with operators built by
-//! `Linear::<f32, 1>::from_rows` in a `static`, exactly as the firmware builds them.
+//! `Linear::<f32, 1>::from_rows_f32` in a `static`, exactly as the firmware builds them.
 //!
 //! This test is where the firmware's error bound comes from: it measures the same `f32`
 //! error against the same closed form and asserts the same bound (`FIRMWARE_BOUND`, copied
@@ -53,13 +53,13 @@ fn method_error_estimate() -> f64 {
 }
 
 static SYS32: Linear<f32, 1> =
-    match Linear::<f32, 1>::from_rows([[1.0]], [[2.0 * XI * OMEGA]], [[OMEGA * OMEGA]], H) {
+    match Linear::<f32, 1>::from_rows_f32([[1.0]], [[2.0 * XI * OMEGA]], [[OMEGA * OMEGA]], H) {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };
 
 static SYS64: Linear<f64, 1> =
-    match Linear::<f64, 1>::from_rows([[1.0]], [[2.0 * XI * OMEGA]], [[OMEGA * OMEGA]], H) {
+    match Linear::<f64, 1>::from_rows_f64([[1.0]], [[2.0 * XI * OMEGA]], [[OMEGA * OMEGA]], H) {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };

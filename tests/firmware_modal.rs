@@ -41,7 +41,7 @@ const TRUNCATION_MEASURED: f64 = 4.825e-4;
 fn modal() -> Modal<f32, 5, 2> {
     let (m, c, k) = models::five_storey_building();
     let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    Modal::<f32, 5, 2>::from_rows(
+    Modal::<f32, 5, 2>::from_rows_f32(
         m,
         k,
         Damping::Matrix(c),
@@ -120,7 +120,7 @@ fn reference_is_current_and_host_f32_run_is_within_bound() {
     // Truncation of 2 modes, f64, every step.
     let (m, c, k) = models::five_storey_building();
     let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    let m64 = Modal::<f64, 5, 2>::from_rows(
+    let m64 = Modal::<f64, 5, 2>::from_rows_f64(
         m,
         k,
         Damping::Matrix(c),
@@ -158,7 +158,7 @@ fn reference_is_current_and_host_f32_run_is_within_bound() {
     assert!(err <= BOUND, "{err:e} > {BOUND:e}");
     // The check has teeth: one mode (3.6 mm at worst, see the README table) fails it.
     let (m, c, k) = models::five_storey_building();
-    let one = Modal::<f32, 5, 1>::from_rows(
+    let one = Modal::<f32, 5, 1>::from_rows_f32(
         m,
         k,
         Damping::Matrix(c),

@@ -2,12 +2,12 @@
 //! input of `fuzz/corpus/<target>/` (the minimized corpus of `scripts/fuzz.sh`) and of
 //! `fuzz/regressions/<target>/` (each input a fuzz run found a property broken by, named
 //! after the fix) is replayed through the same checks the fuzz targets run
-//! (`fuzz/src/checks.rs`, included here), and the test fails if any property breaks.
+//! (`fuzz/src/checks/`, included here), and the test fails if any property breaks.
 //!
 //! `AEMSTEP_FUZZ_REPLAY=path/to/input` replays one file (its target from its directory's
 //! name), e.g. a crash artifact of a fuzz run, with the broken property printed.
 
-#[path = "../fuzz/src/checks.rs"]
+#[path = "../fuzz/src/checks/mod.rs"]
 mod checks;
 
 use std::path::{Path, PathBuf};

@@ -106,6 +106,69 @@ fn bad_parameters_are_typed_errors() {
     );
 }
 
+/// The fuzz stage's input (saved as `fuzz/regressions/hysteresis/
+/// bouc-wen-fy-max-hysteretic-force-beyond-f64`): `f_y = f64::MAX`, `α = 1.8e-3`, `β = 1`,
+/// `γ = 1/2`, `n = 1` was `Ok`, but `z` saturates at `z_max = (β + γ)^{−1/n} = 2/3` and can
+/// reach `2^{1/n} z_max = 4/3` on reloading, so the hysteretic force `(1 − α) f_y z` is
+/// `≈ 1.33 f_y`, beyond `f64`: the first step that nears saturation had an infinite force.
+/// Now `OperatorOverflow` whenever `(1 − α) f_y 2^{1/n} z_max` does not fit `T`, in `f64`
+/// and `f32`; the same law with that bound just inside `T` is built and drives to
+/// saturation with a finite force. Bilinear (force within `f_y` for `α = 0`) and friction
+/// (within `f_s`) need no more than their coefficients fitting.
+#[test]
+fn bouc_wen_whose_largest_hysteretic_force_overflows_t_is_rejected() {
+    let over = Some(Error::OperatorOverflow);
+    assert_eq!(
+        BoucWen::<f64>::new(1e3, f64::MAX, 1.8e-3, 1.0, 0.5, 1.0).err(),
+        over
+    );
+    // The bound (1 − α) f_y (2/(β + γ))^{1/n}, written here, against T::MAX either side.
+    let bound = |a: f64, fy: f64, bg: f64, n: f64| (1.0 - a) * fy * (2.0 / bg).powf(1.0 / n);
+    for (bg, n) in [(1.5, 1.0), (1.5, 2.0), (1.0, 1.0), (0.25, 3.0)] {
+        let (b, g) = (0.75 * bg, 0.25 * bg);
+        let a = 1.8e-3;
+        // f64: f_y such that the bound is 1.01 MAX (rejected) and 0.99 MAX (built).
+        let unit = bound(a, 1.0, bg, n);
+        for (t_max, is_f32) in [(f64::MAX, false), (f64::from(f32::MAX), true)] {
+            let fy_over = 1.01 * (t_max / unit);
+            let fy_in = 0.99 * (t_max / unit);
+            assert!(bound(a, fy_over, bg, n) > t_max && bound(a, fy_in, bg, n) < t_max);
+            let (e_over, e_in) = if is_f32 {
+                (
+                    BoucWen::<f32>::new(1e3, fy_over, a, b, g, n).err(),
+                    BoucWen::<f32>::new(1e3, fy_in, a, b, g, n).err(),
+                )
+            } else {
+                (
+                    BoucWen::<f64>::new(1e3, fy_over, a, b, g, n).err(),
+                    BoucWen::<f64>::new(1e3, fy_in, a, b, g, n).err(),
+                )
+            };
+            assert_eq!(e_over, over, "β + γ = {bg}, n = {n}, f32: {is_f32}");
+            assert_eq!(e_in, None, "β + γ = {bg}, n = {n}, f32: {is_f32}");
+        }
+        // Built with the bound at 0.99 MAX (α = 0, so the force is the hysteretic part
+        // alone): loading to saturation and reversing (where γ < β lets |z| pass z_max)
+        // keeps the force finite and within the bound.
+        let fy = 0.99 * (f64::MAX / bound(0.0, 1.0, bg, n));
+        let law = BoucWen::<f64>::new(1e3, fy, 0.0, b, g, n).expect("bound fits");
+        let uy = fy / 1e3;
+        let mut h = law.initial_history();
+        for x in [0.5, 2.0, 20.0, -20.0, 20.0, -3.0, 0.1, -20.0] {
+            let tr = law.trial(&h, x * uy, 0.0);
+            assert!(
+                tr.force.is_finite() && tr.force.abs() <= 0.99 * f64::MAX,
+                "x = {x}: {tr:?}"
+            );
+            h = tr.history;
+        }
+    }
+    // Bilinear and friction at f_y = f_s = f64::MAX are built (their hysteretic force
+    // stays within the yield/slip force, for bilinear with α = 0).
+    assert!(Bilinear::<f64>::new(1.0, f64::MAX, 0.0).is_ok());
+    assert!(Friction::<f64>::new(f64::MAX, 1.0).is_ok());
+}
+
 // ------------------------------------------------------------------------ bilinear
 
 #[test]

@@ -111,8 +111,8 @@ fn base_excitation_f32_matches_linear() {
     let (m, c, k) = models::five_storey_building();
     let b = base_excitation(&m);
     let h = 0.02;
-    let lin = Linear::<f32, 5>::from_rows(m, c, k, h).unwrap();
-    let inp = LinearInput::<f32, 5, 1>::from_rows(m, c, k, b, h).unwrap();
+    let lin = Linear::<f32, 5>::from_rows_f32(m, c, k, h).unwrap();
+    let inp = LinearInput::<f32, 5, 1>::from_rows_f32(m, c, k, b, h).unwrap();
     let bv = SVector::<f32, 5>::from_fn(|i, _| b[i][0] as f32);
     let ag = elcentro::AG_F32;
     let z = SVector::<f32, 5>::zeros();
@@ -142,7 +142,7 @@ fn base_excitation_f32_matches_linear() {
 fn const_and_runtime_constructors_agree_bit_for_bit() {
     let (m, c, k) = models::five_storey_building();
     let b = base_excitation(&m);
-    static SYS: LinearInput<f32, 5, 1> = match LinearInput::<f32, 5, 1>::from_rows(
+    static SYS: LinearInput<f32, 5, 1> = match LinearInput::from_rows_f32(
         models::five_storey_building().0,
         models::five_storey_building().1,
         models::five_storey_building().2,
@@ -163,19 +163,19 @@ fn const_and_runtime_constructors_agree_bit_for_bit() {
         0.02,
     )
     .unwrap();
-    let ct = LinearInput::<f32, 5, 1>::from_rows(m, c32, k, b, 0.02).unwrap();
+    let ct = LinearInput::<f32, 5, 1>::from_rows_f32(m, c32, k, b, 0.02).unwrap();
     assert_eq!(rt, ct);
     // The static one used the exact C; it differs from the rounded-C one, and equals a
     // fresh const evaluation.
     assert_eq!(
         SYS,
-        LinearInput::<f32, 5, 1>::from_rows(m, c, k, b, 0.02).unwrap()
+        LinearInput::<f32, 5, 1>::from_rows_f32(m, c, k, b, 0.02).unwrap()
     );
     // G·B really is G times B.
-    let g = Linear::<f64, 5>::from_rows(m, c, k, 0.02)
+    let g = Linear::<f64, 5>::from_rows_f64(m, c, k, 0.02)
         .unwrap()
         .effective_inverse();
-    let gb = LinearInput::<f64, 5, 1>::from_rows(m, c, k, b, 0.02)
+    let gb = LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, b, 0.02)
         .unwrap()
         .input_operator();
     let bm = SMatrix::<f64, 5, 1>::from_fn(|i, _| b[i][0]);
@@ -189,24 +189,29 @@ fn errors_and_failed_step_leaves_state_unchanged() {
     let mut bad = b;
     bad[2][0] = f64::NAN;
     assert_eq!(
-        LinearInput::<f64, 5, 1>::from_rows(m, c, k, bad, 0.02),
+        LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, bad, 0.02),
         Err(Error::NonFiniteInput)
     );
     assert_eq!(
-        LinearInput::<f64, 5, 1>::from_rows(m, c, k, b, 0.0),
+        LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, b, 0.0),
         Err(Error::InvalidTimeStep)
     );
     // Singular M with nonsingular M_eff: steps fine, start needs the acceleration.
     let z = [[0.0; 2]; 2];
-    let sys =
-        LinearInput::<f64, 2, 1>::from_rows(z, z, [[2.0, -1.0], [-1.0, 1.0]], [[1.0], [0.0]], 0.1)
-            .unwrap();
+    let sys = LinearInput::<f64, 2, 1>::from_rows_f64(
+        z,
+        z,
+        [[2.0, -1.0], [-1.0, 1.0]],
+        [[1.0], [0.0]],
+        0.1,
+    )
+    .unwrap();
     let zero = SVector::<f64, 2>::zeros();
     assert_eq!(
         sys.start(&zero, &zero, &SVector::from([1.0])),
         Err(Error::SingularMass)
     );
-    let sys = LinearInput::<f64, 5, 1>::from_rows(m, c, k, b, 0.02).unwrap();
+    let sys = LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, b, 0.02).unwrap();
     let z5 = SVector::<f64, 5>::zeros();
     assert_eq!(
         sys.start(&z5, &z5, &SVector::from([f64::INFINITY])),

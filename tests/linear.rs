@@ -323,7 +323,7 @@ fn checked_step_keeps_state_bit_identical_on_bad_load() {
             }
             // A finite load whose step overflows: the result is refused as state.
             let m = SVector::repeat(f64::MAX);
-            let mut huge = State::from_parts(m, m, m, s.steps());
+            let mut huge = State::restore(m, m, m, s.steps()).unwrap();
             let kept = huge;
             assert_eq!(
                 st.try_step(&mut huge, &vector![f64::MAX, f64::MAX, f64::MAX]),
@@ -378,18 +378,18 @@ fn errors_display_and_const_path_errors() {
     let e: &dyn std::error::Error = &Error::NonFiniteState;
     assert!(!e.to_string().is_empty());
     assert_eq!(
-        Linear::<f64, 1>::from_rows([[1.0]], [[0.0]], [[1.0]], 0.0),
+        Linear::<f64, 1>::from_rows_f64([[1.0]], [[0.0]], [[1.0]], 0.0),
         Err(Error::InvalidTimeStep)
     );
     assert_eq!(
-        Linear::<f32, 1>::from_rows([[f64::NAN]], [[0.0]], [[1.0]], 0.1),
+        Linear::<f32, 1>::from_rows_f32([[f64::NAN]], [[0.0]], [[1.0]], 0.1),
         Err(Error::NonFiniteInput)
     );
     assert_eq!(
-        Linear::<f32, 2>::from_rows([[0.0; 2]; 2], [[0.0; 2]; 2], [[0.0; 2]; 2], 0.1),
+        Linear::<f32, 2>::from_rows_f32([[0.0; 2]; 2], [[0.0; 2]; 2], [[0.0; 2]; 2], 0.1),
         Err(Error::SingularEffectiveMatrix)
     );
-    let s = Linear::<f64, 2>::from_rows(
+    let s = Linear::<f64, 2>::from_rows_f64(
         [[1.0, 0.0], [0.0, 0.0]],
         [[0.0; 2]; 2],
         [[1.0, 0.0], [0.0, 1.0]],
@@ -417,11 +417,11 @@ const EX4_K: [[f64; 3]; 3] = [
 ];
 
 /// Evaluated by the compiler (a `static` initializer must be a constant).
-static EX4_F64: Linear<f64, 3> = match Linear::<f64, 3>::from_rows(EX4_M, EX4_C, EX4_K, 0.01) {
+static EX4_F64: Linear<f64, 3> = match Linear::from_rows_f64(EX4_M, EX4_C, EX4_K, 0.01) {
     Ok(s) => s,
     Err(e) => panic!("{}", e.as_str()),
 };
-static EX4_F32: Linear<f32, 3> = match Linear::<f32, 3>::from_rows(EX4_M, EX4_C, EX4_K, 0.01) {
+static EX4_F32: Linear<f32, 3> = match Linear::from_rows_f32(EX4_M, EX4_C, EX4_K, 0.01) {
     Ok(s) => s,
     Err(e) => panic!("{}", e.as_str()),
 };
@@ -436,7 +436,7 @@ fn const_built_operators_equal_runtime_built_bit_for_bit() {
         EX4_F64.effective_inverse().map(f64::to_bits)
     );
     // f32: computed in f64 from the same (f64) data and rounded once, in both paths.
-    let from_rows = Linear::<f32, 3>::from_rows(EX4_M, EX4_C, EX4_K, 0.01).unwrap();
+    let from_rows = Linear::<f32, 3>::from_rows_f32(EX4_M, EX4_C, EX4_K, 0.01).unwrap();
     let rt32 = Linear::<f32, 3>::new(&sm(EX4_M), &sm(EX4_C), &sm(EX4_K), 0.01).unwrap();
     assert_eq!(rt32, from_rows);
     // The compile-time f32 static: `step` and `try_step` give the same bits.

@@ -102,7 +102,7 @@ fn modal_vs_linear<const N: usize>(seed: u64, kind: Kind, steps: usize) -> f64 {
     let bm = SMatrix::<f64, N, 2>::from_fn(|i, j| b[i][j]);
     let ym = SMatrix::<f64, 3, N>::from_fn(|i, j| y[i][j]);
     let lin = Linear::<f64, _>::new(&sm(&m), &sm(&c), &sm(&k), h).unwrap();
-    let modal = Modal::<f64, N, N, 2, 3>::from_rows(m, k, damping, b, y, h).unwrap();
+    let modal = Modal::<f64, N, N, 2, 3>::from_rows_f64(m, k, damping, b, y, h).unwrap();
 
     let w_at = |n: usize| {
         let t = n as f64 * h;
@@ -205,7 +205,7 @@ fn paper_example4_exact_modal_solution_second_order() {
     let mut errs = vec![];
     let mut bound_at = vec![];
     for &h in &[0.01, 0.005, 0.0025] {
-        let sys = Modal::<f64, 3, 3, 1, 3>::from_rows(
+        let sys = Modal::<f64, 3, 3, 1, 3>::from_rows_f64(
             m,
             k,
             Damping::Ratios(xi),
@@ -266,7 +266,7 @@ fn building_frequencies_damping_and_mode_selection() {
     let (m, c, k) = models::five_storey_building();
     let b = base_excitation(&m);
     let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    let all = Modal::<f64, 5, 5>::from_rows(m, k, Damping::Matrix(c), b, roof, 0.02).unwrap();
+    let all = Modal::<f64, 5, 5>::from_rows_f64(m, k, Damping::Matrix(c), b, roof, 0.02).unwrap();
     let root = (models::FIVE_STOREY_STIFFNESS / models::FIVE_STOREY_MASS).sqrt();
     let w_exact: Vec<f64> = (1..=5)
         .map(|r| 2.0 * root * ((2 * r - 1) as f64 * core::f64::consts::PI / 22.0).sin())
@@ -284,7 +284,7 @@ fn building_frequencies_damping_and_mode_selection() {
     let mm = SMatrix::<f64, 5, 5>::from_fn(|i, j| m[i][j]);
     assert!((phi.transpose() * mm * phi - SMatrix::<f64, 5, 5>::identity()).amax() < 1e-13);
 
-    let sel = Modal::<f64, 5, 2>::from_rows_with_modes(
+    let sel = Modal::<f64, 5, 2>::from_rows_with_modes_f64(
         m,
         k,
         Damping::Rayleigh { a0, a1 },
@@ -309,9 +309,9 @@ fn building_frequencies_damping_and_mode_selection() {
 fn truncation<const R: usize>(ag: &[f64]) -> (f64, f64) {
     let (m, c, k) = models::five_storey_building();
     let b = base_excitation(&m);
-    let full = LinearInput::<f64, 5, 1>::from_rows(m, c, k, b, 0.02).unwrap();
+    let full = LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, b, 0.02).unwrap();
     let drifts = storey_drifts::<5>();
-    let modal = Modal::<f64, 5, R, 1, 5>::from_rows_with_modes(
+    let modal = Modal::<f64, 5, R, 1, 5>::from_rows_with_modes_f64(
         m,
         k,
         Damping::Matrix(c),
@@ -382,8 +382,8 @@ fn f32_modal_tracks_f64_modal() {
     let (m, c, k) = models::five_storey_building();
     let b = base_excitation(&m);
     let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    let m64 = Modal::<f64, 5, 2>::from_rows(m, k, Damping::Matrix(c), b, roof, 0.02).unwrap();
-    let m32 = Modal::<f32, 5, 2>::from_rows(m, k, Damping::Matrix(c), b, roof, 0.02).unwrap();
+    let m64 = Modal::<f64, 5, 2>::from_rows_f64(m, k, Damping::Matrix(c), b, roof, 0.02).unwrap();
+    let m32 = Modal::<f32, 5, 2>::from_rows_f32(m, k, Damping::Matrix(c), b, roof, 0.02).unwrap();
     let mut s64 = m64.start_at_rest(&SVector::from([ag[0]])).unwrap();
     let mut s32 = m32.start_at_rest(&SVector::from([ag[0] as f32])).unwrap();
     let (mut d, mut p) = (0.0f64, 0.0f64);
@@ -403,13 +403,13 @@ fn f32_modal_tracks_f64_modal() {
     assert!(d / p <= bound, "{} > {bound}", d / p);
 }
 
-/// `Modal::from_rows` in a `static` (evaluated by the compiler) is bit-identical to
+/// `Modal::from_rows_f32`/`_f64` in a `static` (evaluated by the compiler) is bit-identical to
 /// `Modal::new` at run time, in f32 and f64, and for a chosen mode set.
 #[test]
 fn const_and_runtime_constructors_agree_bit_for_bit() {
     const B: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();
     const ROOF: [[f64; 5]; 1] = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-    static S32: Modal<f32, 5, 2> = match Modal::<f32, 5, 2>::from_rows(
+    static S32: Modal<f32, 5, 2> = match Modal::from_rows_f32(
         B.0,
         B.2,
         Damping::Matrix(B.1),
@@ -420,7 +420,7 @@ fn const_and_runtime_constructors_agree_bit_for_bit() {
         Ok(s) => s,
         Err(e) => panic!("{}", e.as_str()),
     };
-    static S64: Modal<f64, 5, 3, 1, 5> = match Modal::<f64, 5, 3, 1, 5>::from_rows_with_modes(
+    static S64: Modal<f64, 5, 3, 1, 5> = match Modal::from_rows_with_modes_f64(
         B.0,
         B.2,
         Damping::Matrix(B.1),
@@ -437,11 +437,11 @@ fn const_and_runtime_constructors_agree_bit_for_bit() {
     let d = Damping::Matrix(c);
     assert_eq!(
         S32,
-        Modal::<f32, 5, 2>::from_rows(m, k, d, b, ROOF, 0.02).unwrap()
+        Modal::<f32, 5, 2>::from_rows_f32(m, k, d, b, ROOF, 0.02).unwrap()
     );
     assert_eq!(
         S64,
-        Modal::<f64, 5, 3, 1, 5>::from_rows_with_modes(
+        Modal::<f64, 5, 3, 1, 5>::from_rows_with_modes_f64(
             m,
             k,
             d,
@@ -453,7 +453,7 @@ fn const_and_runtime_constructors_agree_bit_for_bit() {
         .unwrap()
     );
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(m, k, d, b, [[1.0; 5]], -1.0).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(m, k, d, b, [[1.0; 5]], -1.0).err(),
         Some(Error::InvalidTimeStep)
     );
 }
@@ -467,45 +467,45 @@ fn typed_errors() {
     let h = 0.02;
     // R > N, R = 0, bad selections.
     assert_eq!(
-        Modal::<f64, 5, 6>::from_rows(m, k, d, b, y, h).err(),
+        Modal::<f64, 5, 6>::from_rows_f64(m, k, d, b, y, h).err(),
         Some(Error::InvalidModeSelection)
     );
     assert_eq!(
-        Modal::<f64, 5, 0>::from_rows(m, k, d, b, y, h).err(),
+        Modal::<f64, 5, 0>::from_rows_f64(m, k, d, b, y, h).err(),
         Some(Error::InvalidModeSelection)
     );
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows_with_modes(m, k, d, b, y, [1, 1], h).err(),
+        Modal::<f64, 5, 2>::from_rows_with_modes_f64(m, k, d, b, y, [1, 1], h).err(),
         Some(Error::InvalidModeSelection)
     );
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows_with_modes(m, k, d, b, y, [0, 5], h).err(),
+        Modal::<f64, 5, 2>::from_rows_with_modes_f64(m, k, d, b, y, [0, 5], h).err(),
         Some(Error::InvalidModeSelection)
     );
     // M not SPD: indefinite, singular, not symmetric.
     let mut mi = m;
     mi[2][2] = -1e5;
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(mi, k, d, b, y, h).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(mi, k, d, b, y, h).err(),
         Some(Error::MassNotSpd)
     );
     let mut ms = m;
     ms[4][4] = 0.0;
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(ms, k, d, b, y, h).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(ms, k, d, b, y, h).err(),
         Some(Error::MassNotSpd)
     );
     let mut mn = m;
     mn[0][1] = 1.0e3;
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(mn, k, d, b, y, h).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(mn, k, d, b, y, h).err(),
         Some(Error::MassNotSpd)
     );
     // K not symmetric.
     let mut kn = k;
     kn[1][3] = 1.0e6;
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(m, kn, d, b, y, h).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(m, kn, d, b, y, h).err(),
         Some(Error::StiffnessNotSymmetric)
     );
     // Non-classical damping: a dashpot on one storey only (a classic non-proportional
@@ -513,14 +513,14 @@ fn typed_errors() {
     let mut cd = [[0.0; 5]; 5];
     cd[0][0] = 2.0e6;
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(m, k, Damping::Matrix(cd), b, y, h).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(m, k, Damping::Matrix(cd), b, y, h).err(),
         Some(Error::NonClassicalDamping)
     );
     let mut cp = c;
     cp[1][2] *= 1.01;
     cp[2][1] *= 1.01;
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(m, k, Damping::Matrix(cp), b, y, h).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(m, k, Damping::Matrix(cp), b, y, h).err(),
         Some(Error::NonClassicalDamping)
     );
     // Non-finite data and bad h (NaN in every input).
@@ -532,7 +532,7 @@ fn typed_errors() {
             _ => cc[0][4] = f64::NAN,
         }
         assert_eq!(
-            Modal::<f64, 5, 2>::from_rows(mm, kk, Damping::Matrix(cc), b, y, h).err(),
+            Modal::<f64, 5, 2>::from_rows_f64(mm, kk, Damping::Matrix(cc), b, y, h).err(),
             Some(Error::NonFiniteInput),
             "NaN in input #{which}"
         );
@@ -540,23 +540,23 @@ fn typed_errors() {
     let mut yn = y;
     yn[0][2] = f64::NAN;
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(m, k, d, b, yn, h).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(m, k, d, b, yn, h).err(),
         Some(Error::NonFiniteInput)
     );
     let mut xi = [0.05; 5];
     xi[3] = f64::NAN;
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(m, k, Damping::Ratios(xi), b, y, h).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(m, k, Damping::Ratios(xi), b, y, h).err(),
         Some(Error::NonFiniteInput)
     );
     let mut bn = b;
     bn[0][0] = f64::NAN;
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(m, k, d, bn, y, h).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(m, k, d, bn, y, h).err(),
         Some(Error::NonFiniteInput)
     );
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(
+        Modal::<f64, 5, 2>::from_rows_f64(
             m,
             k,
             Damping::Rayleigh {
@@ -571,11 +571,11 @@ fn typed_errors() {
         Some(Error::NonFiniteInput)
     );
     assert_eq!(
-        Modal::<f64, 5, 2>::from_rows(m, k, d, b, y, -0.02).err(),
+        Modal::<f64, 5, 2>::from_rows_f64(m, k, d, b, y, -0.02).err(),
         Some(Error::InvalidTimeStep)
     );
     // A failed step leaves the state bit-identical.
-    let sys = Modal::<f64, 5, 2>::from_rows(m, k, d, b, y, h).unwrap();
+    let sys = Modal::<f64, 5, 2>::from_rows_f64(m, k, d, b, y, h).unwrap();
     assert_eq!(
         sys.start_at_rest(&SVector::from([f64::NAN])).err(),
         Some(Error::NonFiniteInput)
@@ -591,7 +591,7 @@ fn typed_errors() {
 #[test]
 fn undamped_single_mode_is_the_sdof_recurrence() {
     let sys =
-        Modal::<f64, 1, 1>::from_rows([[2.0]], [[50.0]], Damping::None, [[2.0]], [[1.0]], 0.01)
+        Modal::<f64, 1, 1>::from_rows_f64([[2.0]], [[50.0]], Damping::None, [[2.0]], [[1.0]], 0.01)
             .unwrap();
     let lin = Linear::<f64, _>::new(
         &SMatrix::<f64, 1, 1>::new(2.0),

@@ -27,7 +27,7 @@ const B: Building = models::five_storey_building();
 
 /// The building's full model, ground acceleration in.
 fn building() -> StateSpace<5, 10, 1> {
-    StateSpace::aem_from_rows(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap()
+    StateSpace::from_rows_aem(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap()
 }
 
 /// Absolute accelerations of floors 2 and 5 (DOFs 1 and 4).
@@ -37,7 +37,7 @@ fn accelerometers() -> Outputs<5, 1, 2> {
 
 /// Unmodelled forces on every floor, white, `σ_f` (N): `Q = G σ_f² Gᵀ`.
 fn force_noise(sigma_f: f64) -> SMatrix<f64, 10, 10> {
-    let f = StateSpace::<5, 10, 5>::aem_from_rows(B.0, B.1, B.2, identity5(), H).unwrap();
+    let f = StateSpace::<5, 10, 5>::from_rows_aem(B.0, B.1, B.2, identity5(), H).unwrap();
     let qw: [[f64; 5]; 5] = core::array::from_fn(|i| {
         core::array::from_fn(|j| if i == j { sigma_f * sigma_f } else { 0.0 })
     });
@@ -60,7 +60,8 @@ fn recurrence_bound(n: usize, terms: usize, scale: f64) -> f64 {
 #[test]
 fn aem_state_space_reproduces_linear_input() {
     let ss = building();
-    let sys = LinearInput::<f64, 5, 1>::from_rows(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap();
     let ag = &elcentro::AG_F64;
     let z = SVector::<f64, 5>::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();
@@ -149,7 +150,7 @@ fn exact_state_space_reproduces_exact() {
 #[test]
 fn modal_state_space_reproduces_modal() {
     fn check<const R: usize, const S: usize>() {
-        let ss = StateSpace::<5, S, 1>::modal_from_rows::<R>(
+        let ss = StateSpace::<5, S, 1>::from_rows_modal::<R>(
             B.0,
             B.2,
             Damping::Matrix(B.1),
@@ -158,7 +159,7 @@ fn modal_state_space_reproduces_modal() {
             H,
         )
         .unwrap();
-        let sys = Modal::<f64, 5, R>::from_rows(
+        let sys = Modal::<f64, 5, R>::from_rows_f64(
             B.0,
             B.2,
             Damping::Matrix(B.1),
@@ -210,9 +211,9 @@ fn modal_state_space_reproduces_modal() {
 
 #[test]
 fn state_size_must_match() {
-    let e = StateSpace::<5, 9, 1>::aem_from_rows(B.0, B.1, B.2, base_excitation(&B.0), H);
+    let e = StateSpace::<5, 9, 1>::from_rows_aem(B.0, B.1, B.2, base_excitation(&B.0), H);
     assert_eq!(e, Err(Error::StateSizeMismatch));
-    let e = StateSpace::<5, 5, 1>::modal_from_rows::<2>(
+    let e = StateSpace::<5, 5, 1>::from_rows_modal::<2>(
         B.0,
         B.2,
         Damping::None,
@@ -231,15 +232,15 @@ fn state_size_must_match() {
     let mut bad = B.0;
     bad[0][0] = f64::NAN;
     assert_eq!(
-        StateSpace::<5, 10, 1>::aem_from_rows(bad, B.1, B.2, base_excitation(&B.0), H),
+        StateSpace::<5, 10, 1>::from_rows_aem(bad, B.1, B.2, base_excitation(&B.0), H),
         Err(Error::NonFiniteInput)
     );
     assert_eq!(
-        StateSpace::<5, 10, 1>::aem_from_rows(B.0, B.1, B.2, base_excitation(&B.0), -1.0),
+        StateSpace::<5, 10, 1>::from_rows_aem(B.0, B.1, B.2, base_excitation(&B.0), -1.0),
         Err(Error::InvalidTimeStep)
     );
     assert_eq!(
-        StateSpace::<5, 10, 1>::aem_from_rows([[0.0; 5]; 5], B.1, B.2, base_excitation(&B.0), H),
+        StateSpace::<5, 10, 1>::from_rows_aem([[0.0; 5]; 5], B.1, B.2, base_excitation(&B.0), H),
         Err(Error::SingularMass)
     );
 }
@@ -250,11 +251,11 @@ const SIGMA_Y: f64 = 0.1;
 
 static CONST_GAIN: SteadyState<10, 2> = {
     const SS: StateSpace<5, 10, 1> =
-        match StateSpace::aem_from_rows(B.0, B.1, B.2, base_excitation(&B.0), H) {
+        match StateSpace::from_rows_aem(B.0, B.1, B.2, base_excitation(&B.0), H) {
             Ok(s) => s,
             Err(e) => panic!("{}", e.as_str()),
         };
-    const F: StateSpace<5, 10, 5> = match StateSpace::aem_from_rows(
+    const F: StateSpace<5, 10, 5> = match StateSpace::from_rows_aem(
         B.0,
         B.1,
         B.2,
@@ -285,7 +286,7 @@ static CONST_GAIN: SteadyState<10, 2> = {
         Outputs::<5, 1, 2>::select([1, 4]),
         0,
     )) {
-        Ok(meas) => match SteadyState::solve(
+        Ok(meas) => match SteadyState::from_parts(
             &SS,
             &meas,
             &F.input_noise(&QW),
@@ -433,7 +434,7 @@ fn covariance_and_gain_errors_are_typed() {
     // A model with an unmeasured, undriven, undamped mode: no stabilizing solution.
     let (m, k) = models::shear_building([1.0, 1.0], [100.0, 100.0]);
     let und =
-        StateSpace::<2, 4, 1>::aem_from_rows(m, [[0.0; 2]; 2], k, [[1.0], [0.0]], 0.01).unwrap();
+        StateSpace::<2, 4, 1>::from_rows_aem(m, [[0.0; 2]; 2], k, [[1.0], [0.0]], 0.01).unwrap();
     let meas1 = und.outputs(&Outputs::displacements([[0.0, 0.0]])).unwrap();
     assert_eq!(
         SteadyState::new(
@@ -452,7 +453,8 @@ fn zero_gain_observer_is_the_open_loop_stepper() {
     let ss = building();
     let meas = ss.outputs(&accelerometers()).unwrap();
     let obs = Observer::<f64, 10, 1, 2>::new(&ss, &meas, &SMatrix::zeros()).unwrap();
-    let sys = LinearInput::<f64, 5, 1>::from_rows(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(B.0, B.1, B.2, base_excitation(&B.0), H).unwrap();
     let ag = &elcentro::AG_F64;
     let z = SVector::<f64, 5>::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();
@@ -567,7 +569,7 @@ fn missing_samples_are_skipped_and_failed_steps_change_nothing() {
 fn f32_observer_from_the_compiler_is_bit_identical_to_run_time() {
     static OBS: Observer<f32, 10, 1, 2> = {
         const SS: StateSpace<5, 10, 1> =
-            match StateSpace::aem_from_rows(B.0, B.1, B.2, base_excitation(&B.0), H) {
+            match StateSpace::from_rows_aem(B.0, B.1, B.2, base_excitation(&B.0), H) {
                 Ok(s) => s,
                 Err(e) => panic!("{}", e.as_str()),
             };
@@ -575,10 +577,12 @@ fn f32_observer_from_the_compiler_is_bit_identical_to_run_time() {
             Outputs::<5, 1, 2>::select([1, 4]),
             0,
         )) {
-            Ok(meas) => match Observer::<f32, 10, 1, 2>::from_parts(&SS, &meas, &CONST_GAIN.gain) {
-                Ok(o) => o,
-                Err(e) => panic!("{}", e.as_str()),
-            },
+            Ok(meas) => {
+                match Observer::<f32, 10, 1, 2>::from_parts_f32(&SS, &meas, &CONST_GAIN.gain) {
+                    Ok(o) => o,
+                    Err(e) => panic!("{}", e.as_str()),
+                }
+            }
             Err(e) => panic!("{}", e.as_str()),
         }
     };
@@ -628,7 +632,7 @@ fn kalman_filter_is_consistent_nees_in_its_95_percent_band() {
     let q = force_noise(SIGMA_F);
     let r = r_matrix();
     let kal = Kalman::<f64, 10, 1, 2>::new(&ss, &meas, &q, &r).unwrap();
-    let f = StateSpace::<5, 10, 5>::aem_from_rows(B.0, B.1, B.2, identity5(), H).unwrap();
+    let f = StateSpace::<5, 10, 5>::from_rows_aem(B.0, B.1, B.2, identity5(), H).unwrap();
     let gf = f.gamma0_matrix() + f.gamma1_matrix();
     let kf = SteadyState::new(&ss, &meas, &q, &r).unwrap();
     // Truth starts at x0 ~ N(0, P0) and the filter at x̂0 = 0 with P0: P0 = the Riccati P.
@@ -682,7 +686,7 @@ fn kalman_filter_is_consistent_nees_in_its_95_percent_band() {
 }
 
 // ---------------------------------------------------------------------------------------
-// The scene (xtask/src/bin/observer_building.rs) and the firmware (examples/qemu_observer.rs).
+// The scene (xtask/src/bin/observer_building.rs) and the firmware (examples/firmware/qemu_observer.rs).
 
 #[path = "../scenes/observer/reference.rs"]
 mod reference;
@@ -696,7 +700,8 @@ const EVERY: usize = 10;
 /// `LinearInput<f64, 5, 1>` in soft-float f64 (IEEE: bit-identical).
 fn truth_measurements() -> (Vec<[f64; 2]>, [f64; 2]) {
     let (m, c, k) = scene::TRUTH;
-    let sys = LinearInput::<f64, 5, 1>::from_rows(m, c, k, base_excitation(&m), scene::H).unwrap();
+    let sys =
+        LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, base_excitation(&m), scene::H).unwrap();
     let ag = &elcentro::AG_F64;
     let z = SVector::zeros();
     let mut s = sys.start(&z, &z, &SVector::from([ag[0]])).unwrap();

@@ -325,7 +325,7 @@ proptest! {
             check("aform", Ok(sys.a_form()), &p, &d)?;
         }
         let rows = |a: M2| [[a[(0, 0)], a[(0, 1)]], [a[(1, 0)], a[(1, 1)]]];
-        let from_rows = Linear::<f64, 2>::from_rows(rows(m), rows(c), rows(k), h);
+        let from_rows = Linear::<f64, 2>::from_rows_f64(rows(m), rows(c), rows(k), h);
         prop_assert_eq!(bits(&from_rows), bits(&built));
         if let Ok(sys) = &built {
             eom_holds("linear", sys, &m, &c, &k, h, &p)?;

@@ -393,7 +393,7 @@ const RHO: AlphaParameters = match AlphaParameters::chung_hulbert(0.8) {
 };
 
 /// The generalized-α model of the building in a `static`: computed by the compiler.
-static ALPHA_BUILDING: StateSpace<5, 15, 1> = match StateSpace::generalized_alpha_from_rows(
+static ALPHA_BUILDING: StateSpace<5, 15, 1> = match StateSpace::from_rows_generalized_alpha(
     B.0,
     B.1,
     B.2,
@@ -405,7 +405,7 @@ static ALPHA_BUILDING: StateSpace<5, 15, 1> = match StateSpace::generalized_alph
     Err(e) => panic!("{}", e.as_str()),
 };
 
-static LINEAR_ACCELERATION_BUILDING: StateSpace<5, 10, 1> = match StateSpace::newmark_from_rows(
+static LINEAR_ACCELERATION_BUILDING: StateSpace<5, 10, 1> = match StateSpace::from_rows_newmark(
     B.0,
     B.1,
     B.2,
@@ -511,7 +511,7 @@ fn errors_are_the_steppers_for_the_same_bad_input() {
         let st = Newmark::<f64, 3>::new(&m, &c, &k, h, beta, gamma).err();
         assert_eq!(ss, Some(want), "Newmark state space, {what}");
         assert_eq!(st, Some(want), "Newmark stepper, {what}");
-        let fr = StateSpace::<3, 6, 3>::newmark_from_rows(
+        let fr = StateSpace::<3, 6, 3>::from_rows_newmark(
             m.transpose().into(),
             c.transpose().into(),
             k.transpose().into(),
@@ -520,7 +520,7 @@ fn errors_are_the_steppers_for_the_same_bad_input() {
             beta,
             gamma,
         );
-        assert_eq!(fr.err(), Some(want), "newmark_from_rows, {what}");
+        assert_eq!(fr.err(), Some(want), "from_rows_newmark, {what}");
     }
     let p = AlphaParameters::chung_hulbert(0.8).unwrap();
     let bad = |f: fn(&mut AlphaParameters)| {
@@ -692,7 +692,7 @@ fn steady_state_gain_and_kalman_filter_on_the_generalized_alpha_model() {
     let ss = ALPHA_BUILDING;
     let meas = ss.outputs(&accelerometers()).unwrap();
     // Unmodelled forces on every floor (σ_f = 2·10⁴ N), accelerometer noise 0.1 m/s².
-    let forces = StateSpace::<5, 15, 5>::generalized_alpha_from_rows(
+    let forces = StateSpace::<5, 15, 5>::from_rows_generalized_alpha(
         B.0,
         B.1,
         B.2,

@@ -71,7 +71,7 @@ fn check<const N: usize>() -> f64 {
     let dyn_load = |n: usize| DVector::from_column_slice(load(n).as_slice());
     let dv = |x: &SVector<f64, N>| DVector::from_column_slice(x.as_slice());
     let reference = newmark(&m, &c, &k, dv(&u0), dv(&v0), dyn_load);
-    let lin = Linear::<f64, N>::from_rows(mr, cr, kr, H).expect("operators");
+    let lin = Linear::<f64, N>::from_rows_f64(mr, cr, kr, H).expect("operators");
     let afm: AForm<f64, N> = lin.a_form();
     // Differences relative to the largest |u|, |v|, |a| of the run (a vector's own size
     // passes through zero as it oscillates).
@@ -111,7 +111,7 @@ fn linear_and_aform_match_an_independent_newmark_for_every_table_size() {
 #[test]
 fn aform_blocks_out_of_range_are_none() {
     let (m, c, k) = building::<2>();
-    let a = Linear::<f64, 2>::from_rows(m, c, k, H)
+    let a = Linear::<f64, 2>::from_rows_f64(m, c, k, H)
         .expect("operators")
         .a_form();
     assert!(a.a_block(2, 2).is_some() && a.b_block(2).is_some());

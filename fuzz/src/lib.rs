@@ -1,7 +1,7 @@
-//! The fuzz targets' library: the checks (`checks.rs`, shared with the replay test
-//! `tests/fuzz_corpus.rs` of the main crate) and the harness glue of the fuzz binaries.
+//! The fuzz targets' library: the checks (`checks/`, one module per target, shared with
+//! the replay test `tests/fuzz_corpus.rs` of the main crate) and the harness glue of the
+//! fuzz binaries.
 
-#[path = "checks.rs"]
 mod checks;
 
 pub use checks::*;

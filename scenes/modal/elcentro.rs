@@ -1,7 +1,7 @@
 //! The El Centro 1940 NS record (`data/elcentro-ns-1940.txt`, dt = 0.02 s, in g), parsed
 //! by the compiler: `static` ground accelerations in m/s², no parsing code in flash.
 //!
-//! Shared by `examples/qemu_modal.rs` (firmware) and `tests/firmware_modal.rs` (host),
+//! Shared by `examples/firmware/qemu_modal.rs` (firmware) and `tests/firmware_modal.rs` (host),
 //! which checks the `const` parser against `str::parse` bit for bit.
 #![allow(dead_code)] // each includer uses a different subset
 

@@ -1,5 +1,5 @@
 //! The observer scene, shared by the host example (`xtask/src/bin/observer_building.rs`), the
-//! firmware (`examples/qemu_observer.rs`) and the tests (`tests/observer.rs`): the 5-storey
+//! firmware (`examples/firmware/qemu_observer.rs`) and the tests (`tests/observer.rs`): the 5-storey
 //! building under El Centro; the "true" structure has a storey-1 stiffness 10 % below the
 //! model's; the absolute accelerations of floors 2 and 5 are measured with noise; the
 //! ground acceleration (the input) is measured exactly.
@@ -48,7 +48,7 @@ pub const SIGMA_F: f64 = 5.0e4;
 pub const SEED: u64 = 20_260_519;
 
 /// The model's state-space form (input: ground acceleration, m/s²).
-pub const MODEL_SS: StateSpace<5, 10, 1> = ok(StateSpace::aem_from_rows(
+pub const MODEL_SS: StateSpace<5, 10, 1> = ok(StateSpace::from_rows_aem(
     MODEL.0,
     MODEL.1,
     MODEL.2,
@@ -56,7 +56,7 @@ pub const MODEL_SS: StateSpace<5, 10, 1> = ok(StateSpace::aem_from_rows(
     H,
 ));
 /// The model with unit forces on every floor as inputs (for the process noise).
-const FORCES_SS: StateSpace<5, 10, 5> = ok(StateSpace::aem_from_rows(
+const FORCES_SS: StateSpace<5, 10, 5> = ok(StateSpace::from_rows_aem(
     MODEL.0,
     MODEL.1,
     MODEL.2,
@@ -72,10 +72,10 @@ pub const Q: [[f64; 10]; 10] = FORCES_SS.input_noise(&diag([SIGMA_F * SIGMA_F; 5
 /// Measurement noise covariance `R`.
 pub const R: [[f64; 2]; 2] = diag([SIGMA_Y[0] * SIGMA_Y[0], SIGMA_Y[1] * SIGMA_Y[1]]);
 /// The steady-state Kalman gain, solved by the compiler.
-pub const GAIN: SteadyState<10, 2> = ok(SteadyState::solve(&MODEL_SS, &MEAS, &Q, &R));
+pub const GAIN: SteadyState<10, 2> = ok(SteadyState::from_parts(&MODEL_SS, &MEAS, &Q, &R));
 
 /// The modal observer's model: R = 2 modes, `x = [η; η']`.
-pub const MODAL_SS: StateSpace<5, 4, 1> = ok(StateSpace::modal_from_rows::<2>(
+pub const MODAL_SS: StateSpace<5, 4, 1> = ok(StateSpace::from_rows_modal::<2>(
     MODEL.0,
     MODEL.2,
     aemstep::Damping::Matrix(MODEL.1),
@@ -83,7 +83,7 @@ pub const MODAL_SS: StateSpace<5, 4, 1> = ok(StateSpace::modal_from_rows::<2>(
     [0, 1],
     H,
 ));
-const MODAL_FORCES: StateSpace<5, 4, 5> = ok(StateSpace::modal_from_rows::<2>(
+const MODAL_FORCES: StateSpace<5, 4, 5> = ok(StateSpace::from_rows_modal::<2>(
     MODEL.0,
     MODEL.2,
     aemstep::Damping::Matrix(MODEL.1),
@@ -99,8 +99,12 @@ pub const MODAL_DRIFT_OUT: Measurement<4, 1, 5> = ok(MODAL_SS.outputs(&DRIFTS));
 pub const MODAL_Q: [[f64; 4]; 4] = MODAL_FORCES.input_noise(&diag([SIGMA_F * SIGMA_F; 5]));
 /// The modal observer's steady-state gain. The dropped modes' response is measurement
 /// error to it; it is in the accelerometers' noise budget here.
-pub const MODAL_GAIN: SteadyState<4, 2> =
-    ok(SteadyState::solve(&MODAL_SS, &MODAL_MEAS, &MODAL_Q, &R));
+pub const MODAL_GAIN: SteadyState<4, 2> = ok(SteadyState::from_parts(
+    &MODAL_SS,
+    &MODAL_MEAS,
+    &MODAL_Q,
+    &R,
+));
 
 /// `diag(d)`.
 pub const fn diag<const N: usize>(d: [f64; N]) -> [[f64; N]; N] {

@@ -1,4 +1,4 @@
-//! The banks of `examples/qemu_spectrum.rs`, shared with its host side
+//! The banks of `examples/firmware/qemu_spectrum.rs`, shared with its host side
 //! (`tests/firmware_spectrum.rs`): periods, damping, sample interval.
 #![allow(dead_code)] // each includer uses a different subset
 

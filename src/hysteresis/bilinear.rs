@@ -21,6 +21,7 @@ use crate::{Error, Real};
 /// parallelogram of area `4 f_y (1 − α)(U − u_y)`.
 ///
 /// Cost per trial: 8 flops and 2 comparisons; no panic.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bilinear<T> {
     k: T,
@@ -34,6 +35,7 @@ pub struct Bilinear<T> {
 
 /// The history of a [`Bilinear`] law: the plastic deformation `d_p` (deformation units;
 /// the back force is `H d_p`).
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BilinearHistory<T> {
     /// Plastic deformation `d_p`.
@@ -105,7 +107,14 @@ impl<T: Real> Law<T> for Bilinear<T> {
     #[inline]
     fn trial(&self, committed: &BilinearHistory<T>, d: T, _rate: T) -> LawTrial<T, Self::History> {
         let dp = committed.plastic;
-        let f_tr = self.k * (d - dp);
+        // `d − d_p` may exceed `T::MAX` (both near it, opposite signs) while `k (d − d_p)`
+        // fits: distribute `k` then. A predictable branch; the usual path is unchanged.
+        let diff = d - dp;
+        let f_tr = if diff.is_finite() {
+            self.k * diff
+        } else {
+            self.k * d - self.k * dp
+        };
         let xi = f_tr - self.hard * dp;
         let excess = xi.abs() - self.fy;
         if excess > T::zero() {
@@ -115,7 +124,7 @@ impl<T: Real> Law<T> for Bilinear<T> {
                 stiffness: self.kt,
                 damping: T::zero(),
                 history: BilinearHistory {
-                    plastic: dp + s * self.compliance_p * excess,
+                    plastic: plastic_after(dp, s * self.compliance_p, excess),
                 },
                 inelastic: true,
             };
@@ -135,4 +144,20 @@ impl<T: Real> Law<T> for Bilinear<T> {
         let e = d - history.plastic;
         self.k * e * e / (T::one() + T::one())
     }
+}
+
+/// `d_p + c·excess`, the plastic deformation after a yielding trial. In exact arithmetic it
+/// lies between the committed `d_p` and the trial deformation `d` (plastic flow moves `d_p`
+/// toward `d`, never past it), so it fits `T` whenever they do; but with a tiny `k` the
+/// increment `c·excess` (`c = ±(1 − α)/k`) can overflow on its own (up to `|d − d_p| ≤
+/// 2·T::MAX`). Then the sum is formed at half scale: `2·(d_p/2 + (c/2)·excess)`, each part
+/// at most `T::MAX`.
+fn plastic_after<T: Real>(dp: T, c: T, excess: T) -> T {
+    let p = dp + c * excess;
+    if p.is_finite() {
+        return p;
+    }
+    let half = T::one() / (T::one() + T::one());
+    let two = T::one() + T::one();
+    (dp * half + (c * half) * excess) * two
 }

@@ -64,6 +64,7 @@ const FREE_NEWTON: u32 = 8;
 /// bracket is bisected to two neighbouring numbers); no panic. A trial whose
 /// data is not finite, or whose `z` is beyond `T`, returns a non-finite force, which the
 /// stepper reports as [`Error::NonFiniteForce`] without taking the step.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWen<T> {
     ak: T,
@@ -91,6 +92,7 @@ pub struct BoucWen<T> {
 }
 
 /// The history of a [`BoucWen`] law: the committed deformation and hysteretic variable.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWenHistory<T> {
     /// Deformation `d` at the end of the last accepted step.
@@ -107,7 +109,9 @@ impl<T: Real> BoucWen<T> {
     /// (unloading is then linear with stiffness `k`).
     ///
     /// Errors: [`Error::InvalidMaterial`] for any parameter out of its range or not finite;
-    /// [`Error::OperatorOverflow`] if a coefficient does not fit `T`. Cost: O(1).
+    /// [`Error::OperatorOverflow`] if a coefficient does not fit `T`, or if the largest
+    /// hysteretic force the law can produce, `(1 − α) f_y 2^{1/n} z_max` (for `β + γ > 0`),
+    /// does not (e.g. `f_y = f64::MAX`, `β = 1`, `γ = 1/2`, `n = 1`: `1.33 f_y`). Cost: O(1).
     pub fn new(k: f64, fy: f64, alpha: f64, beta: f64, gamma: f64, n: f64) -> Result<Self, Error> {
         if !(positive(k)
             && positive(fy)
@@ -147,6 +151,14 @@ impl<T: Real> BoucWen<T> {
             n,
         ];
         fits::<T>(&c)?;
+        // The largest hysteretic force the law can produce, `(1 − α) f_y |z|` with `|z|`
+        // within `2^{1/n} z_max` (β + γ > 0; for γ = −β, `z` does not saturate and the
+        // stepper reports the force that leaves `T`): it must fit `T` too, else a step
+        // whose `z` nears saturation has an infinite force (found by fuzzing: f_y =
+        // f64::MAX, α = 1.8e-3, β = 1, γ = 0.5, n = 1, force ≈ 1.33 f64::MAX).
+        if beta + gamma > 0.0 {
+            fits::<T>(&[hysteretic_force_bound(alpha, fy, beta + gamma, n)])?;
+        }
         // z lives on the scale of z_max (tiny for a huge β + γ: a tolerance of 4ε in
         // absolute terms stopped at z = 3e-16 where z_max = 6e-48; found by fuzzing). Kept
         // a normal number of `T` (at least its `MIN_POSITIVE`), so `4ε z_scale` is not zero;
@@ -377,6 +389,20 @@ impl<T: Real> BoucWen<T> {
         let half = T::from_f64_rounded(0.5);
         let slope = if num == zero { zero } else { num * half / den };
         (z, slope)
+    }
+}
+
+/// `(1 − α) f_y 2^{1/n} z_max`, `z_max = (β + γ)^{−1/n}` (`bg = β + γ > 0`): the largest
+/// `|(1 − α) f_y z|` along any path from the virgin history. `(2/bg)^{1/n}` directly where
+/// `2/bg` is finite (exact to rounding); else (`bg < 1.1e-308`) through logarithms, `∞`
+/// where it overflows `f64`.
+fn hysteretic_force_bound(alpha: f64, fy: f64, bg: f64, n: f64) -> f64 {
+    let ratio = 2.0 / bg;
+    if ratio.is_finite() {
+        (1.0 - alpha) * fy * <f64 as ComplexField>::powf(ratio, 1.0 / n)
+    } else {
+        let ln = <f64 as ComplexField>::ln;
+        <f64 as ComplexField>::exp(ln((1.0 - alpha) * fy) + (ln(2.0) - ln(bg)) / n)
     }
 }
 

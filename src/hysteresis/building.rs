@@ -109,12 +109,15 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
     }
 
     /// Storey drifts `δ_i = u_i − u_{i−1}` (`u_{−1} = 0`) of a floor vector. Cost: `N`.
+    /// [`models::drifts`](crate::models::drifts) is the same without naming the type.
     pub fn drifts(x: &SVector<T, N>) -> SVector<T, N> {
-        let mut d = *x;
-        for i in 1..N {
-            d[i] -= x[i - 1];
-        }
-        d
+        crate::models::drifts(x)
+    }
+
+    /// The floor masses (kg), ground storey first: the diagonal of
+    /// [`HistoryModel::mass`]. Cost: O(1).
+    pub fn masses(&self) -> &SVector<T, N> {
+        &self.masses
     }
 
     /// The `N` storey law trials at floor displacements `u`, velocities `v` from the

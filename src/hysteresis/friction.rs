@@ -19,6 +19,7 @@ use crate::{Error, Real};
 /// storey mass; at a third of that Newton converges in under three iterations a step).
 ///
 /// Cost per trial: one `tanh` and 4 flops; no panic.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Friction<T> {
     fs: T,

@@ -21,7 +21,9 @@
 //!
 //! [`Parallel`] puts two laws side by side in one storey (a frame and a friction damper).
 //! [`ShearBuilding`] assembles `N` storeys of one law type with linear damping into a
-//! [`HistoryModel`] for the [`Nonlinear`](crate::Nonlinear) stepper.
+//! [`HistoryModel`] for the [`Nonlinear`](crate::Nonlinear) stepper; [`EnergyAccount`]
+//! keeps its energy balance (input = kinetic + recoverable + viscous + hysteretic) beside
+//! a run.
 //!
 //! Equations, measured accuracy and the commands that produce each figure:
 //! `docs/hysteresis.md`.
@@ -29,12 +31,14 @@
 mod bilinear;
 mod bouc_wen;
 mod building;
+mod energy;
 mod friction;
 mod parallel;
 
 pub use bilinear::{Bilinear, BilinearHistory};
 pub use bouc_wen::{BoucWen, BoucWenHistory};
 pub use building::ShearBuilding;
+pub use energy::EnergyAccount;
 pub use friction::Friction;
 pub use parallel::Parallel;
 
@@ -105,6 +109,7 @@ pub trait HistoryModel<T: Real, const N: usize> {
 }
 
 /// One uniaxial law's response at a trial deformation.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LawTrial<T, H> {
     /// The force `f` (force units).

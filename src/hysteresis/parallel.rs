@@ -8,7 +8,13 @@ use crate::Real;
 /// both histories kept, inelastic when either is. E.g. a storey whose frame is
 /// [`Bilinear`](super::Bilinear) with a [`Friction`](super::Friction) damper across it.
 ///
+/// Each law's constructor checks that its own coefficients and largest hysteretic force fit
+/// `T`; their sum may not (`f_y + f_s` beyond `T::MAX`): such a trial's force is `±∞`, and
+/// the stepper reports [`Error::NonFiniteForce`](crate::Error::NonFiniteForce) without
+/// taking the step.
+///
 /// Cost per trial: one trial of each law and 3 additions; no panic.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Parallel<A, B>(pub A, pub B);
 

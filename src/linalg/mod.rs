@@ -29,6 +29,10 @@ use crate::Real;
 
 /// A row-major `N×N` matrix of `f64` (`a[i][j]`: row `i`, column `j`), the form the
 /// `const fn` constructors (`from_rows`) take.
+///
+/// **Row-major**; use [`models::matrix_of`](crate::models::matrix_of) to convert, not
+/// `SMatrix::from`, which reads columns (a non-symmetric matrix would be silently
+/// transposed). [`models::rows_of`](crate::models::rows_of) converts back.
 pub type Rows<const N: usize> = [[f64; N]; N];
 
 /// A row-major `R×C` matrix of `f64`.

@@ -19,7 +19,7 @@
 //! The eigenproblem `K φ = ω² M φ` is solved once, in `f64`, by `const fn` code: Cholesky
 //! `M = L Lᵀ`, symmetric eigen-decomposition `L⁻¹ K L⁻ᵀ = Q Λ Qᵀ` (cyclic Jacobi),
 //! `Φ = L⁻ᵀ Q`. At run time ([`Modal::new`]) or by the compiler into flash
-//! (`Modal::from_rows` in a `static`), with bit-identical results.
+//! (`Modal::from_rows_f32`/`_f64` in a `static`), with bit-identical results.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -43,6 +43,7 @@ const SYMMETRY_TOL: f64 = 64.0 * f64::EPSILON;
 pub const CLASSICAL_COUPLING_TOL: f64 = 1e-6;
 
 /// How the structure is damped; every form here is classical (diagonal in the modes).
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Damping<const N: usize> {
     /// No damping (`C = 0`).
@@ -65,6 +66,7 @@ pub enum Damping<const N: usize> {
 /// The state of a [`Modal`] stepper at step `n`: modal displacements `η`, velocities `η'`
 /// and accelerations `η''` of the `R` kept modes. Plain data, `3R + 1` words;
 /// [`Modal::full_state`] rebuilds the `N`-DOF state from it.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModalState<T, const R: usize> {
     eta: [T; R],
@@ -121,20 +123,20 @@ pub const fn lowest_modes<const R: usize>() -> [usize; R] {
 ///
 /// Size: `R·(2I + O + 2N + 4) + 3` values of `T` and `R` indices. Build with
 /// [`Modal::new`] (the `R` lowest modes) or [`Modal::with_modes`] at run time, or with
-/// `Modal::from_rows` / `Modal::from_rows_with_modes` (`const fn`: in a `static`, computed
+/// `Modal::from_rows_f32` / `Modal::from_rows_with_modes_f32` (and `_f64`; `const fn`: in a `static`, computed
 /// by the compiler into flash); in `f64`, rounded once to `T`.
 ///
 /// ```
 /// use aemstep::{models, Damping, Modal, Stepper};
 /// use aemstep::models::{base_excitation, storey_drifts};
-/// use aemstep::nalgebra::vector;
+/// use aemstep::vector;
 ///
 /// // The benchmark 5-storey building: 2 modes, base excitation, roof drift out.
 /// let (m, _c, k) = models::five_storey_building();
 /// let (w1, w2) = (9.0, 26.3); // rad/s, see `five_storey_building`
 /// let (a0, a1) = models::rayleigh_coefficients(w1, w2, 0.05);
 /// let roof = [[0.0, 0.0, 0.0, 0.0, 1.0]];
-/// let sys = Modal::<f32, 5, 2>::from_rows(
+/// let sys = Modal::<f32, 5, 2>::from_rows_f32(
 ///     m, k, Damping::Rayleigh { a0, a1 }, base_excitation(&m), roof, 0.02,
 /// )?;
 /// let mut s = sys.start_at_rest(&vector![0.0])?;
@@ -169,7 +171,7 @@ pub struct Modal<T, const N: usize, const R: usize, const I: usize = 1, const O:
 
 // ---------------------------------------------------------------------------------------
 // Construction, all in `const fn` `f64`: the same code serves `Modal::new` at run time and
-// `Modal::from_rows` evaluated by the compiler, so both give bit-identical operators.
+// `Modal::from_rows_f32`/`_f64` evaluated by the compiler, so both give bit-identical operators.
 
 /// `(ω², Φ)` of `K φ = ω² M φ`, ascending, `Φᵀ M Φ = I` (`Φ` row-major, column `r` is
 /// mode `r`): Cholesky `M = L Lᵀ`, Jacobi on `L⁻¹ K L⁻ᵀ = Q Λ Qᵀ`, `Φ = L⁻ᵀ Q`.
@@ -533,7 +535,7 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
     ///   [`storey_drifts`](crate::models::storey_drifts)).
     /// - `h`: time step (s).
     ///
-    /// Computed in `f64` by the same `const` code as `Modal::from_rows` (bit-identical
+    /// Computed in `f64` by the same `const` code as `Modal::from_rows_f64` (bit-identical
     /// results), rounded once to `T`.
     ///
     /// Errors: [`Error::InvalidModeSelection`] (`R = 0` or `R > N`),
@@ -599,11 +601,16 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
 
 /// Const-fn construction, for modal operators computed at compile time into flash.
 macro_rules! const_ctor {
-    ($t:ident) => {
+    ($t:ident, $from_rows:ident, $from_rows_with_modes:ident) => {
         impl<const N: usize, const R: usize, const I: usize, const O: usize> Modal<$t, N, R, I, O> {
             /// `const fn` twin of [`Modal::new`] (the `R` lowest modes), bit-identical to
             /// it. In a `static`, the compiler solves the eigenproblem and no eigen-solver
             /// code is linked into the firmware.
+            ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+            /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+            /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+            /// which reads columns.
             ///
             /// **Size limit at compile time.** The Jacobi sweeps cost about `4N³` flops
             /// each; measured with rustc 1.95, `Modal<f32, N, 2>` compiles in a `static` up
@@ -613,7 +620,7 @@ macro_rules! const_ctor {
             /// with [`Modal::new`].
             ///
             /// Errors: as [`Modal::new`].
-            pub const fn from_rows(
+            pub const fn $from_rows(
                 m: Rows<N>,
                 k: Rows<N>,
                 damping: Damping<N>,
@@ -621,13 +628,18 @@ macro_rules! const_ctor {
                 y: [[f64; N]; O],
                 h: f64,
             ) -> Result<Self, Error> {
-                Self::from_rows_with_modes(m, k, damping, b, y, lowest_modes(), h)
+                Self::$from_rows_with_modes(m, k, damping, b, y, lowest_modes(), h)
             }
 
             /// `const fn` twin of [`Modal::with_modes`], bit-identical to it.
             ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+            /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+            /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+            /// which reads columns.
+            ///
             /// Errors: as [`Modal::with_modes`].
-            pub const fn from_rows_with_modes(
+            pub const fn $from_rows_with_modes(
                 m: Rows<N>,
                 k: Rows<N>,
                 damping: Damping<N>,
@@ -654,11 +666,18 @@ macro_rules! const_ctor {
                     modes,
                 })
             }
+
+            /// The time step `h` (s), usable in `const` contexts: the same value as
+            /// [`Stepper::time_step`](crate::Stepper::time_step), which generic code still
+            /// calls. Cost: none.
+            pub const fn time_step(&self) -> $t {
+                self.kin.h
+            }
         }
     };
 }
-const_ctor!(f32);
-const_ctor!(f64);
+const_ctor!(f32, from_rows_f32, from_rows_with_modes_f32);
+const_ctor!(f64, from_rows_f64, from_rows_with_modes_f64);
 
 impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Modal<T, N, R, I, O> {
     /// The kept modes (indices in ascending frequency, `0` the fundamental).
@@ -847,6 +866,6 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> St
                 y
             })
         };
-        State::from_parts(map(&s.eta), map(&s.deta), map(&s.ddeta), s.n)
+        State::unchecked(map(&s.eta), map(&s.deta), map(&s.ddeta), s.n)
     }
 }

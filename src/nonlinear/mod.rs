@@ -186,7 +186,8 @@ pub struct NewtonReport<T> {
 ///
 /// ```
 /// use aemstep::{Model, NewtonSettings, Nonlinear, Tangent};
-/// use aemstep::nalgebra::{matrix, vector, SMatrix, SVector};
+/// use aemstep::{matrix, vector};
+/// use aemstep::nalgebra::{SMatrix, SVector};
 ///
 /// struct Duffing;
 /// impl Model<f32, 1> for Duffing {
@@ -450,7 +451,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
             let converged = residual <= tol || (iterations > 0 && correction <= tol);
             let done = iterations >= budget || (!fixed && converged);
             if done {
-                let next = State::from_parts(u, v, q, state.n.wrapping_add(1));
+                let next = State::unchecked(u, v, q, state.n.wrapping_add(1));
                 if !next.is_finite() {
                     return Err(Error::NonFiniteState);
                 }

@@ -64,7 +64,7 @@ impl<T: Real, const N: usize, F: Fn(T) -> Coefficients<T, N>> TimeVarying<T, N> 
 ///
 /// ```
 /// use aemstep::{Coefficients, Varying};
-/// use aemstep::nalgebra::{matrix, vector};
+/// use aemstep::{matrix, vector};
 ///
 /// // u'' + (1 + t/10) u = 0: a stiffening oscillator.
 /// let coeffs = |t: f64| Coefficients {
@@ -183,7 +183,7 @@ impl<T: Real, const N: usize> Varying<T, N> {
             return Err(Error::SingularEffectiveMatrixAtStep { step: n });
         }
         let (v, u) = self.kin.correct_all(&vh, &uh, &q);
-        let next = State::from_parts(u, v, q, n);
+        let next = State::unchecked(u, v, q, n);
         if !next.is_finite() {
             return Err(Error::NonFiniteState);
         }

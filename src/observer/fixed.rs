@@ -77,11 +77,11 @@ pub(crate) fn initial_estimate<T: Real, const S: usize, const I: usize>(
 ///
 /// The gain `L` (`S×O`) is the steady-state Kalman gain ([`SteadyState`](super::SteadyState))
 /// or any the user gives (`L = 0` is the open-loop model). With a modal model
-/// ([`StateSpace::modal_from_rows`], `S = 2R`) it is a modal observer that pays only for
+/// ([`StateSpace::from_rows_modal`], `S = 2R`) it is a modal observer that pays only for
 /// the kept modes.
 ///
 /// Every operator is computed in `f64` and rounded once to `T`; [`Observer::new`] (run
-/// time) and `Observer::from_parts` (`const fn`: in a `static` the compiler computes the
+/// time) and `Observer::from_parts_f32`/`_f64` (`const fn`: in a `static` the compiler computes the
 /// model and the gain, and no factorization or Riccati code is linked) are bit-identical.
 ///
 /// Cost of a step: `S² + 2S·I + 2S·O + O·I` multiply-adds, fixed (a missing measurement
@@ -90,12 +90,13 @@ pub(crate) fn initial_estimate<T: Real, const S: usize, const I: usize>(
 /// ```
 /// use aemstep::models::{self, base_excitation};
 /// use aemstep::observer::{Observer, Outputs, StateSpace, SteadyState};
-/// use aemstep::nalgebra::{SMatrix, vector};
+/// use aemstep::vector;
+/// use aemstep::nalgebra::SMatrix;
 ///
 /// // The 5-storey building, ground acceleration in, absolute accelerations of floors 2
 /// // and 5 measured.
 /// let (m, c, k) = models::five_storey_building();
-/// let ss = StateSpace::<5, 10, 1>::aem_from_rows(m, c, k, base_excitation(&m), 0.02)?;
+/// let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02)?;
 /// let meas = ss.outputs(&Outputs::absolute_accelerations(Outputs::<5, 1, 2>::select([1, 4]), 0))?;
 /// let q = SMatrix::<f64, 10, 10>::identity() * 1e-10;
 /// let r = SMatrix::<f64, 2, 2>::identity() * 0.01;
@@ -115,7 +116,7 @@ pub struct Observer<T, const S: usize, const I: usize, const O: usize> {
     h: [[T; S]; O],
     d: [[T; I]; O],
     gain: [[T; O]; S],
-    dt: T,
+    time_step: T,
 }
 
 /// Check a gain (finite, fits `T`) and the model's operators fit `T`.
@@ -130,7 +131,7 @@ const fn check_parts<const N: usize, const S: usize, const I: usize, const O: us
     }
     // The time step too must fit `T` (an f32 observer of a model with h = 1e147 had an
     // infinite time step; found by fuzzing).
-    if let Err(e) = check_time_step_as(model.dt, max) {
+    if let Err(e) = check_time_step_as(model.time_step, max) {
         return Err(e);
     }
     if !(finite_as(&model.phi, max)
@@ -151,7 +152,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
     /// loop). Rounded once to `T`.
     ///
     /// Errors: [`Error::NonFiniteInput`] (a non-finite gain or output matrix),
-    /// [`Error::InvalidTimeStep`] (the model's `dt` is not a valid time step in `T`),
+    /// [`Error::InvalidTimeStep`] (the model's time step is not a valid time step in `T`),
     /// [`Error::OperatorOverflow`] (an operator does not fit `T`). Cost: `O(S²)`.
     pub fn new<const N: usize>(
         model: &StateSpace<N, S, I>,
@@ -167,13 +168,13 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
             h: round_rows(&meas.h),
             d: round_rows(&meas.d),
             gain: round_rows(&gain),
-            dt: T::from_f64_rounded(model.dt),
+            time_step: T::from_f64_rounded(model.time_step),
         })
     }
 
     /// The time step `h` (s).
     pub fn time_step(&self) -> T {
-        self.dt
+        self.time_step
     }
 
     /// The gain `L` (`S×O`) as stepped.
@@ -220,6 +221,20 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
     /// that must not happen.
     #[inline]
     pub fn step(&self, e: &mut Estimate<T, S, I>, w: &SVector<T, I>, y: &SVector<T, O>) {
+        self.step_innovation(e, w, y);
+    }
+
+    /// [`Observer::step`], returning the innovation `ν = y_n − H x̂⁻ − D w_n` (output
+    /// units) that corrected it — what a change detector tests
+    /// ([`detection`](crate::detection)). Non-finite where `y` is (a missing sample).
+    /// Cost: as [`Observer::step`].
+    #[inline]
+    pub fn step_innovation(
+        &self,
+        e: &mut Estimate<T, S, I>,
+        w: &SVector<T, I>,
+        y: &SVector<T, O>,
+    ) -> SVector<T, O> {
         // Sums start from −0 (`−0 + x = x` exactly, so the compiler drops the add) and the
         // prediction is built in place (no zeroed temporary).
         let neg_zero = -T::zero();
@@ -261,6 +276,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
         }
         e.w = *w;
         e.n = e.n.wrapping_add(1);
+        innov.into()
     }
 
     /// [`Observer::step`], checked: the input must be finite and the new estimate
@@ -284,7 +300,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
 
 /// Const-fn construction: model and gain computed by the compiler into flash.
 macro_rules! const_ctor {
-    ($t:ident) => {
+    ($t:ident, $from_parts:ident) => {
         impl<const S: usize, const I: usize, const O: usize> Observer<$t, S, I, O> {
             /// `const fn` twin of [`Observer::new`] with the gain as row-major `f64`
             /// (`S×O`, e.g. [`SteadyState::gain`](super::SteadyState::gain));
@@ -294,14 +310,14 @@ macro_rules! const_ctor {
             /// use aemstep::models::{self, base_excitation};
             /// use aemstep::observer::{Observer, Outputs, StateSpace};
             /// const B: ([[f64; 5]; 5], [[f64; 5]; 5], [[f64; 5]; 5]) = models::five_storey_building();
-            /// const SS: StateSpace<5, 10, 1> = match StateSpace::aem_from_rows(
+            /// const SS: StateSpace<5, 10, 1> = match StateSpace::from_rows_aem(
             ///     B.0, B.1, B.2, base_excitation(&B.0), 0.02) {
             ///     Ok(s) => s,
             ///     Err(e) => panic!("{}", e.as_str()),
             /// };
             /// static OPEN_LOOP: Observer<f32, 10, 1, 1> = match SS.outputs(
             ///     &Outputs::displacements(Outputs::<5, 1, 1>::select([4]))) {
-            ///     Ok(meas) => match Observer::<f32, 10, 1, 1>::from_parts(&SS, &meas, &[[0.0]; 10]) {
+            ///     Ok(meas) => match Observer::<f32, 10, 1, 1>::from_parts_f32(&SS, &meas, &[[0.0]; 10]) {
             ///         Ok(o) => o,
             ///         Err(e) => panic!("{}", e.as_str()),
             ///     },
@@ -311,7 +327,7 @@ macro_rules! const_ctor {
             /// ```
             ///
             /// Errors: as [`Observer::new`].
-            pub const fn from_parts<const N: usize>(
+            pub const fn $from_parts<const N: usize>(
                 model: &StateSpace<N, S, I>,
                 meas: &Measurement<S, I, O>,
                 gain: &[[f64; O]; S],
@@ -326,14 +342,14 @@ macro_rules! const_ctor {
                     h: linalg::const_round!($t, rows meas.h),
                     d: linalg::const_round!($t, rows meas.d),
                     gain: linalg::const_round!($t, rows * gain),
-                    dt: model.dt as $t,
+                    time_step: model.time_step as $t,
                 })
             }
         }
     };
 }
-const_ctor!(f32);
-const_ctor!(f64);
+const_ctor!(f32, from_parts_f32);
+const_ctor!(f64, from_parts_f64);
 
 /// Estimated quantities read from a state, `z = H x + D w` (e.g. every inter-storey drift
 /// from `[u; v]`): the output matrices of [`StateSpace::outputs`] rounded once to `T`.
@@ -376,12 +392,12 @@ impl<T: Real, const S: usize, const I: usize, const P: usize> Readout<T, S, I, P
 }
 
 macro_rules! readout_const {
-    ($t:ident) => {
+    ($t:ident, $from_parts:ident) => {
         impl<const S: usize, const I: usize, const P: usize> Readout<$t, S, I, P> {
             /// `const fn` twin of [`Readout::new`], bit-identical to it.
             ///
             /// Errors: as [`Readout::new`].
-            pub const fn from_parts(m: &Measurement<S, I, P>) -> Result<Self, Error> {
+            pub const fn $from_parts(m: &Measurement<S, I, P>) -> Result<Self, Error> {
                 if !(all_finite(&m.h) && all_finite(&m.d)) {
                     return Err(Error::NonFiniteInput);
                 }
@@ -396,5 +412,5 @@ macro_rules! readout_const {
         }
     };
 }
-readout_const!(f32);
-readout_const!(f64);
+readout_const!(f32, from_parts_f32);
+readout_const!(f64, from_parts_f64);

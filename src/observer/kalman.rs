@@ -142,6 +142,20 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         w: &SVector<T, I>,
         y: &SVector<T, O>,
     ) -> Result<(), Error> {
+        self.try_step_innovation(s, w, y).map(|_| ())
+    }
+
+    /// [`Kalman::try_step`], returning this step's innovation `ν = y − H x̂⁻ − D w`
+    /// (output units; non-finite where `y` is missing) and its covariance
+    /// `H P⁻ Hᵀ + R` (`ν ~ N(0, ·)` under the model) — what a change detector tests
+    /// ([`detection`](crate::detection)). Errors and cost: as [`Kalman::try_step`]
+    /// (plus `S²·O` for the covariance of a missing sample).
+    pub fn try_step_innovation(
+        &self,
+        s: &mut KalmanState<T, S, I>,
+        w: &SVector<T, I>,
+        y: &SVector<T, O>,
+    ) -> Result<(SVector<T, O>, SMatrix<T, O, O>), Error> {
         if !w.iter().all(|v| v.is_finite()) {
             return Err(Error::NonFiniteInput);
         }
@@ -149,14 +163,14 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         let xp = self.phi * e.x + self.gamma0 * e.w + self.gamma1 * w;
         let pm = self.predicted_covariance(s);
         let mut next = *s;
+        let hp = self.h * pm;
+        let si = hp * self.h.transpose() + self.r;
+        let si = (si + si.transpose()) * T::from_f64_rounded(0.5);
+        let innov = y - self.h * xp - self.d * w;
         if y.iter().all(|v| v.is_finite()) {
-            let hp = self.h * pm;
-            let si = hp * self.h.transpose() + self.r;
-            let si = (si + si.transpose()) * T::from_f64_rounded(0.5);
             let chol = si.cholesky().ok_or(Error::InvalidCovariance)?;
             // Kᵀ = (H P⁻ Hᵀ + R)⁻¹ H P⁻.
             let k = chol.solve(&hp).transpose();
-            let innov = y - self.h * xp - self.d * w;
             let ikh = SMatrix::<T, S, S>::identity() - k * self.h;
             next.estimate.x = xp + k * innov;
             next.p = sym(&(ikh * pm * ikh.transpose() + k * self.r * k.transpose()));
@@ -177,6 +191,6 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
             return Err(Error::NonFiniteState);
         }
         *s = next;
-        Ok(())
+        Ok((innov, si))
     }
 }

@@ -27,6 +27,7 @@ use nalgebra::SMatrix;
 use super::state_space::{Measurement, StateSpace, lu_of};
 use crate::Error;
 use crate::linalg::cholesky::cholesky;
+use crate::linalg::lu::Lu;
 use crate::linalg::{
     Mat, add_scaled, all_finite, identity, is_symmetric, max_abs, mul, rows_f64, sqrt, transpose,
 };
@@ -84,20 +85,28 @@ pub(crate) const fn symmetrize<const N: usize>(a: &Mat<N, N>) -> Mat<N, N> {
     s
 }
 
+/// The LU (with row scales) of `a` if `a` is a positive definite covariance: finite,
+/// symmetric, with a Cholesky factorization and that LU, which [`SteadyState`] solves
+/// with. Both: at the edge of singularity the two judge rounding differently (an `R` with
+/// relative determinant `−3e-21` passed the Cholesky and failed the LU, so `Kalman` took
+/// what `SteadyState` refused; found by fuzzing). Cost: `N³/6 + N³/3` multiply-adds.
+pub(crate) const fn definite_lu<const N: usize>(a: &Mat<N, N>) -> Option<Lu<N>> {
+    if !symmetric(a) || cholesky(a).is_none() {
+        return None;
+    }
+    lu_of(a)
+}
+
 /// `a` is a valid covariance: finite, symmetric and positive semidefinite (`definite`:
-/// positive definite). Semidefiniteness is tested by a Cholesky factorization of
-/// `a + δI`, `δ = 16 N ε max|a|`: a rank-deficient `a` passes, an eigenvalue below `−δ`
-/// fails. Definiteness needs a Cholesky factorization of `a` and the LU with row scales
-/// that [`SteadyState`] solves with: at the edge of singularity the two tests judge
-/// rounding differently (an `R` with relative determinant `−3e-21` passed the Cholesky
-/// and failed the LU, so `Kalman` took what `SteadyState` refused; found by fuzzing).
-/// Cost: `N³/6` flops (`N³/2` more for `definite`).
+/// positive definite, as [`definite_lu`] judges it). Semidefiniteness is tested by a
+/// Cholesky factorization of `a + δI`, `δ = 16 N ε max|a|`: a rank-deficient `a` passes,
+/// an eigenvalue below `−δ` fails. Cost: `N³/6` flops (`N³/3` more for `definite`).
 pub(crate) const fn is_covariance<const N: usize>(a: &Mat<N, N>, definite: bool) -> bool {
+    if definite {
+        return definite_lu(a).is_some();
+    }
     if !symmetric(a) {
         return false;
-    }
-    if definite {
-        return cholesky(a).is_some() && lu_of(a).is_some();
     }
     let delta = 16.0 * N as f64 * f64::EPSILON * max_abs(a) + f64::MIN_POSITIVE;
     let mut b = *a;
@@ -126,7 +135,7 @@ pub(crate) const fn gain_of<const S: usize, const O: usize>(
     Some(transpose(&lu.solve(&hp)))
 }
 
-/// Newton refinements of the doubling's solution at most ([`SteadyState::solve`]).
+/// Newton refinements of the doubling's solution at most ([`SteadyState::from_parts`]).
 const RICCATI_REFINEMENTS: u32 = 3;
 
 /// A residual at or below this many units (of [`RICCATI_RESIDUAL_UNITS`]'s `(2S + 5) ε`)
@@ -135,7 +144,7 @@ const RICCATI_RESIDUAL_REFINE: f64 = 4.0;
 
 /// The doubling has converged once `‖A_k‖∞ ≤ 2^-26` (`√ε`): the updates of `X` still to
 /// come are quadratic in it.
-const A_SMALL: f64 = 1.4901161193847656e-8;
+pub(crate) const A_SMALL: f64 = 1.4901161193847656e-8;
 
 /// `|a|` entry by entry.
 const fn abs_of<const R: usize, const C: usize>(a: &Mat<R, C>) -> Mat<R, C> {
@@ -230,7 +239,7 @@ const fn residual_units<const S: usize>(res: &Mat<S, S>, bound: &Mat<S, S>) -> f
 }
 
 /// `max_i Σ_j |a_ij|` (NaN if an entry is NaN).
-const fn inf_norm<const N: usize>(a: &Mat<N, N>) -> f64 {
+pub(crate) const fn inf_norm<const N: usize>(a: &Mat<N, N>) -> f64 {
     let mut m = 0.0f64;
     let mut i = 0;
     while i < N {
@@ -253,7 +262,7 @@ const fn inf_norm<const N: usize>(a: &Mat<N, N>) -> f64 {
 /// off-diagonal sums. A badly scaled closed loop (`H ≈ 7e41` of a modal form with
 /// `M = 2e-84`) has a norm far above its spectral radius, and its squares would be all
 /// rounding. Cost: `O(S²)` a sweep, a few sweeps.
-const fn balance<const N: usize>(a: &Mat<N, N>) -> (Mat<N, N>, [f64; N]) {
+pub(crate) const fn balance<const N: usize>(a: &Mat<N, N>) -> (Mat<N, N>, [f64; N]) {
     let mut b = *a;
     let mut d = [1.0f64; N];
     let mut sweep = 0;
@@ -380,25 +389,25 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
     /// each refinement; a few `S×S` `f64` temporaries on the stack. In a `static` the
     /// compiler evaluates it; `S = 10` (the 5-storey building, 10 iterations) is pinned by
     /// `tests/observer.rs` (`CONST_GAIN`). Much larger `S` may stop rustc with the
-    /// `long_running_const_eval` lint, as for the steppers' `from_rows`: allow it at the
+    /// `long_running_const_eval` lint, as for the steppers' `from_rows_f32`/`_f64`: allow it at the
     /// firmware's crate root, or solve at run time with [`SteadyState::new`].
-    pub const fn solve<const N: usize, const I: usize>(
+    pub const fn from_parts<const N: usize, const I: usize>(
         model: &StateSpace<N, S, I>,
         meas: &Measurement<S, I, O>,
         q: &[[f64; S]; S],
         r: &[[f64; O]; O],
     ) -> Result<Self, Error> {
-        if !(is_covariance(q, false) && is_covariance(r, true)) {
+        if !is_covariance(q, false) {
             return Err(Error::InvalidCovariance);
         }
+        let lu_r = match definite_lu(r) {
+            Some(lu) => lu,
+            None => return Err(Error::InvalidCovariance),
+        };
         let h = &meas.h;
         if !all_finite(h) {
             return Err(Error::NonFiniteInput);
         }
-        let lu_r = match lu_of(r) {
-            Some(lu) => lu,
-            None => return Err(Error::InvalidCovariance),
-        };
         let id: Mat<S, S> = identity();
         let mut a = transpose(&model.phi);
         let mut g = symmetrize(&mul(&transpose(h), &lu_r.solve(h)));
@@ -493,16 +502,16 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         }
     }
 
-    /// [`SteadyState::solve`] with `nalgebra` covariances (run time; same numbers).
+    /// [`SteadyState::from_parts`] with `nalgebra` covariances (run time; same numbers).
     ///
-    /// Errors and cost: as [`SteadyState::solve`].
+    /// Errors and cost: as [`SteadyState::from_parts`].
     pub fn new<const N: usize, const I: usize>(
         model: &StateSpace<N, S, I>,
         meas: &Measurement<S, I, O>,
         q: &SMatrix<f64, S, S>,
         r: &SMatrix<f64, O, O>,
     ) -> Result<Self, Error> {
-        Self::solve(model, meas, &rows_f64(q), &rows_f64(r))
+        Self::from_parts(model, meas, &rows_f64(q), &rows_f64(r))
     }
 
     /// `P` as a `nalgebra` matrix.

@@ -61,9 +61,9 @@ use crate::{AlphaParameters, Error, Exact};
 /// modal, `[η; η']`. Plain matrices a user can check; [`StateSpace::outputs`] makes the
 /// output matrices of any [`Outputs`]. Built by [`StateSpace::aem`],
 /// [`StateSpace::newmark`], [`StateSpace::generalized_alpha`], [`StateSpace::exact`],
-/// [`StateSpace::modal`] (run time) or the `const fn` [`StateSpace::aem_from_rows`],
-/// [`StateSpace::newmark_from_rows`], [`StateSpace::generalized_alpha_from_rows`],
-/// [`StateSpace::modal_from_rows`] (in a `static`: computed by the compiler). Each
+/// [`StateSpace::modal`] (run time) or the `const fn` [`StateSpace::from_rows_aem`],
+/// [`StateSpace::from_rows_newmark`], [`StateSpace::from_rows_generalized_alpha`],
+/// [`StateSpace::from_rows_modal`] (in a `static`: computed by the compiler). Each
 /// reproduces its stepper to rounding (`tests/state_space.rs`).
 ///
 /// Size: `S² + 2S·I + N·(3S + I) + 1` values of `f64` (a build-time object: the
@@ -87,7 +87,7 @@ pub struct StateSpace<const N: usize, const S: usize, const I: usize> {
     /// `A_w` (`N×I`): the accelerations' direct dependence on the input.
     pub dof_a_input: [[f64; I]; N],
     /// The time step `h` (s).
-    pub dt: f64,
+    pub time_step: f64,
 }
 
 /// What is measured or estimated: `y = Y_u u + Y_v v + Y_a a + Y_w w`, `O` outputs of a
@@ -310,7 +310,7 @@ const fn put<const R1: usize, const C1: usize, const R2: usize, const C2: usize>
 
 impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// A model with every matrix zero (filled by the builders).
-    const fn zero(dt: f64) -> Self {
+    const fn zero(h: f64) -> Self {
         Self {
             phi: [[0.0; S]; S],
             gamma0: [[0.0; I]; S],
@@ -319,15 +319,20 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
             dof_v: [[0.0; S]; N],
             dof_a: [[0.0; S]; N],
             dof_a_input: [[0.0; I]; N],
-            dt,
+            time_step: h,
         }
     }
 
     /// The full-state form of [`Linear`](crate::Linear) / [`LinearInput`](crate::LinearInput)
     /// (the AEM) for `M u'' + C u' + K u = B w(t)`, `x = [u; v]`, `S = 2N` (`const fn`; see
     /// the module docs for the derivation). `M, C, K` are `N×N`, `B` is `N×I`, row-major
-    /// `f64`; `h` in s. The same data as the steppers' `from_rows`. The same numbers, bit
-    /// for bit, as [`StateSpace::newmark_from_rows`] with β = 1/4, γ = 1/2.
+    /// `f64`; `h` in s. The same data as the steppers' `from_rows_f32`/`_f64`. The same numbers, bit
+    /// for bit, as [`StateSpace::from_rows_newmark`] with β = 1/4, γ = 1/2.
+    ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+    /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+    /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+    /// which reads columns.
     ///
     /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`],
     /// [`Error::InvalidTimeStep`], [`Error::SingularEffectiveMatrix`],
@@ -335,19 +340,19 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// [`Error::OperatorOverflow`].
     ///
     /// Cost: about `12N³ + 4N²·I` `f64` flops and a few `N×N` temporaries on the stack.
-    pub const fn aem_from_rows(
+    pub const fn from_rows_aem(
         m: Rows<N>,
         c: Rows<N>,
         k: Rows<N>,
         b: [[f64; I]; N],
         h: f64,
     ) -> Result<Self, Error> {
-        Self::newmark_from_rows(m, c, k, b, h, 0.25, 0.5)
+        Self::from_rows_newmark(m, c, k, b, h, 0.25, 0.5)
     }
 
-    /// [`StateSpace::aem_from_rows`] from `nalgebra` matrices (run time; same numbers).
+    /// [`StateSpace::from_rows_aem`] from `nalgebra` matrices (run time; same numbers).
     ///
-    /// Errors and cost: as [`StateSpace::aem_from_rows`].
+    /// Errors and cost: as [`StateSpace::from_rows_aem`].
     pub fn aem(
         m: &SMatrix<f64, N, N>,
         c: &SMatrix<f64, N, N>,
@@ -355,7 +360,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         b: &SMatrix<f64, N, I>,
         h: f64,
     ) -> Result<Self, Error> {
-        Self::aem_from_rows(rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(b), h)
+        Self::from_rows_aem(rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(b), h)
     }
 
     /// The full-state form of [`Newmark`](crate::Newmark) with parameters `beta` (β ≥ 0) and
@@ -365,6 +370,11 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// any state whose acceleration satisfies the equation of motion — its start
     /// (`Stepper::start`) and every state after a step.
     ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+    /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+    /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+    /// which reads columns.
+    ///
     /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`] (also for
     /// `B`), then those of [`Newmark::new`](crate::Newmark::new) for the same data, in its
     /// order ([`Error::InvalidTimeStep`], [`Error::InvalidParameter`],
@@ -372,7 +382,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// [`Error::SingularMass`] (the state-space form needs `a = M⁻¹(…)`).
     ///
     /// Cost: about `12N³ + 4N²·I` `f64` flops and a few `N×N` temporaries on the stack.
-    pub const fn newmark_from_rows(
+    pub const fn from_rows_newmark(
         m: Rows<N>,
         c: Rows<N>,
         k: Rows<N>,
@@ -400,9 +410,9 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         ss.full_outputs(&bl.au, &bl.av, bl.aw)
     }
 
-    /// [`StateSpace::newmark_from_rows`] from `nalgebra` matrices (run time; same numbers).
+    /// [`StateSpace::from_rows_newmark`] from `nalgebra` matrices (run time; same numbers).
     ///
-    /// Errors and cost: as [`StateSpace::newmark_from_rows`].
+    /// Errors and cost: as [`StateSpace::from_rows_newmark`].
     #[allow(clippy::too_many_arguments)] // the stepper's arguments, plus B
     pub fn newmark(
         m: &SMatrix<f64, N, N>,
@@ -413,7 +423,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         beta: f64,
         gamma: f64,
     ) -> Result<Self, Error> {
-        Self::newmark_from_rows(
+        Self::from_rows_newmark(
             rows_f64(m),
             rows_f64(c),
             rows_f64(k),
@@ -435,6 +445,11 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// has `Γ₀ + Γ₁` in place of `Γ₁` and no `Γ₀`. Start from
     /// [`StateSpace::initial_state`], what the stepper's `start` computes.
     ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+    /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+    /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+    /// which reads columns.
+    ///
     /// Outputs: the acceleration map `a = A_x x + A_w w` ([`StateSpace::outputs`]) is the
     /// *physical* acceleration `M⁻¹ (B w − C v − K u)`, what an accelerometer measures (the
     /// columns of the `a` block of `A_x` are zero). The scheme's acceleration variable is
@@ -449,7 +464,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// and the start need `M⁻¹`).
     ///
     /// Cost: about `14N³ + 4N²·I` `f64` flops and a few `N×N` temporaries on the stack.
-    pub const fn generalized_alpha_from_rows(
+    pub const fn from_rows_generalized_alpha(
         m: Rows<N>,
         c: Rows<N>,
         k: Rows<N>,
@@ -506,14 +521,14 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         ss.full_outputs(&au, &av, lu_m.solve(&b))
     }
 
-    /// [`StateSpace::generalized_alpha_from_rows`] from `nalgebra` matrices (run time; same
+    /// [`StateSpace::from_rows_generalized_alpha`] from `nalgebra` matrices (run time; same
     /// numbers). `params` from [`AlphaParameters::chung_hulbert`] (the
     /// [`GeneralizedAlpha::new`](crate::GeneralizedAlpha::new) of `ρ∞`),
     /// [`AlphaParameters::hht`] or written out.
     ///
     /// ```
     /// use aemstep::observer::StateSpace;
-    /// use aemstep::nalgebra::{matrix, vector};
+    /// use aemstep::{matrix, vector};
     /// use aemstep::{AlphaParameters, GeneralizedAlpha, Stepper};
     /// let (m, c, k, b, h) = (matrix![2.0], matrix![0.3], matrix![50.0], matrix![1.0], 0.01);
     /// let p = AlphaParameters::chung_hulbert(0.8)?;
@@ -530,7 +545,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// # Ok::<(), aemstep::Error>(())
     /// ```
     ///
-    /// Errors and cost: as [`StateSpace::generalized_alpha_from_rows`].
+    /// Errors and cost: as [`StateSpace::from_rows_generalized_alpha`].
     pub fn generalized_alpha(
         m: &SMatrix<f64, N, N>,
         c: &SMatrix<f64, N, N>,
@@ -539,7 +554,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         h: f64,
         params: AlphaParameters,
     ) -> Result<Self, Error> {
-        Self::generalized_alpha_from_rows(
+        Self::from_rows_generalized_alpha(
             rows_f64(m),
             rows_f64(c),
             rows_f64(k),
@@ -644,14 +659,19 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// The form of [`Modal`](crate::Modal) keeping the modes `modes` (indices in ascending
     /// frequency, `R` of them, `S = 2R`): `x = [η; η']`, each mode the scalar AEM of
     /// `η'' + 2ξω η' + ω² η = Γ w`, so each of the four `R×R` blocks of `Φ` is diagonal
-    /// (`const fn`). Same data and checks as `Modal::from_rows_with_modes`; `U = [Φ_R 0]`,
+    /// (`const fn`). Same data and checks as `Modal::from_rows_with_modes_f64`; `U = [Φ_R 0]`,
     /// `V = [0 Φ_R]`, `A_x = [−Φ_R ω², −Φ_R 2ξω]`, `A_w = Φ_R Γ`.
+    ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+    /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+    /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+    /// which reads columns.
     ///
     /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2R`) and those of
     /// [`Modal::new`](crate::Modal::new).
     ///
     /// Cost: that of the modal build (`O(N³)`) plus `O(R·(N + I))`.
-    pub const fn modal_from_rows<const R: usize>(
+    pub const fn from_rows_modal<const R: usize>(
         m: Rows<N>,
         k: Rows<N>,
         damping: Damping<N>,
@@ -713,10 +733,10 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         }
     }
 
-    /// [`StateSpace::modal_from_rows`] with the `R` lowest modes, from `nalgebra`
+    /// [`StateSpace::from_rows_modal`] with the `R` lowest modes, from `nalgebra`
     /// matrices (run time; same numbers).
     ///
-    /// Errors and cost: as [`StateSpace::modal_from_rows`].
+    /// Errors and cost: as [`StateSpace::from_rows_modal`].
     pub fn modal<const R: usize>(
         m: &SMatrix<f64, N, N>,
         k: &SMatrix<f64, N, N>,
@@ -724,7 +744,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         b: &SMatrix<f64, N, I>,
         h: f64,
     ) -> Result<Self, Error> {
-        Self::modal_from_rows::<R>(
+        Self::from_rows_modal::<R>(
             rows_f64(m),
             rows_f64(k),
             *damping,
@@ -736,7 +756,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
 
     /// The modal coordinates `[η; η']` of a full state `(u, v)`, `η = Φ_Rᵀ M u` (exact when
     /// `u` lies in the span of the kept modes), for a model from
-    /// [`StateSpace::modal_from_rows`]. `m` is the mass matrix it was built with.
+    /// [`StateSpace::from_rows_modal`]. `m` is the mass matrix it was built with.
     ///
     /// Cost: `2N²` + `2N·R` flops.
     pub fn modal_coordinates(

@@ -82,7 +82,7 @@ impl<T: Real, const N: usize> StepState for CompensatedState<T, N> {
 ///
 /// ```
 /// use aemstep::{CompensatedLinear, Stepper};
-/// use aemstep::nalgebra::{matrix, vector};
+/// use aemstep::{matrix, vector};
 /// let sys = CompensatedLinear::<f32, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![1.0], 1e-2)?;
 /// let mut s = sys.start(&vector![1.0], &vector![0.0], &vector![0.0])?;
 /// for _ in 0..1000 {
@@ -129,28 +129,40 @@ impl<T: Real, const N: usize> CompensatedLinear<T, N> {
 
 /// Const-fn construction, for operators computed at compile time into flash.
 macro_rules! const_ctor {
-    ($t:ident) => {
+    ($t:ident, $from_rows:ident) => {
         impl<const N: usize> CompensatedLinear<$t, N> {
             /// `const fn` twin of [`CompensatedLinear::new`] (row-major `f64` arrays, `h`
             /// in s), bit-identical to it and to
-            /// [`Linear::from_rows`](crate::Linear::from_rows)'s operators. Size limit at
-            /// compile time and errors: as [`Linear::from_rows`](crate::Linear::from_rows).
-            pub const fn from_rows(
+            /// [`Linear::from_rows_f32`](crate::Linear::from_rows_f32)'s operators. Size limit at
+            /// compile time and errors: as [`Linear::from_rows_f32`](crate::Linear::from_rows_f32).
+            ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`); convert with
+            /// [`models::matrix_of`](crate::models::matrix_of) /
+            /// [`models::rows_of`](crate::models::rows_of), not `SMatrix::from`, which
+            /// reads columns.
+            pub const fn $from_rows(
                 m: Rows<N>,
                 c: Rows<N>,
                 k: Rows<N>,
                 h: f64,
             ) -> Result<Self, Error> {
-                match Kernel::<$t, N, AemKinematics<$t>>::aem_from_rows(&m, &c, &k, h) {
+                match Kernel::<$t, N, AemKinematics<$t>>::from_rows_aem(&m, &c, &k, h) {
                     Ok(kernel) => Ok(Self { kernel }),
                     Err(e) => Err(e),
                 }
             }
+
+            /// The time step `h` (s), usable in `const` contexts: the same value as
+            /// [`Stepper::time_step`](crate::Stepper::time_step), which generic code still
+            /// calls. Cost: none.
+            pub const fn time_step(&self) -> $t {
+                self.kernel.kin.h
+            }
         }
     };
 }
-const_ctor!(f32);
-const_ctor!(f64);
+const_ctor!(f32, from_rows_f32);
+const_ctor!(f64, from_rows_f64);
 
 impl<T: Real, const N: usize> Stepper<T, N> for CompensatedLinear<T, N> {
     type Input = SVector<T, N>;
@@ -194,7 +206,7 @@ impl<T: Real, const N: usize> Stepper<T, N> for CompensatedLinear<T, N> {
 
     /// The state with the carried errors added (`u + du`, `v + dv`, rounded). Cost: `2N`.
     fn full_state(&self, s: &CompensatedState<T, N>) -> State<T, N> {
-        State::from_parts(
+        State::unchecked(
             s.state.u + s.lo.du,
             s.state.v + s.lo.dv,
             s.state.a,

@@ -63,7 +63,7 @@ fn mac<T: Real, const N: usize>(y: &mut [T; N], a: &[[T; N]; N], x: &[T; N]) {
 ///
 /// ```
 /// use aemstep::{Exact, Stepper};
-/// use aemstep::nalgebra::{matrix, vector};
+/// use aemstep::{matrix, vector};
 /// // u'' + 25 u = 0 with a step as long as a third of the period: still exact.
 /// let h = 0.4;
 /// let sys = Exact::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], h)?;

@@ -33,6 +33,7 @@ use crate::linalg::{
 use crate::{Error, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AlphaParameters {
     /// Weight of the previous acceleration in the inertia term.
@@ -199,7 +200,7 @@ pub(crate) const fn alpha_operators<const N: usize>(
 ///
 /// ```
 /// use aemstep::{GeneralizedAlpha, Stepper};
-/// use aemstep::nalgebra::{matrix, vector};
+/// use aemstep::{matrix, vector};
 /// let sys = GeneralizedAlpha::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], 0.01, 0.8)?;
 /// let mut s = sys.start(&vector![1.0], &vector![0.0], &vector![0.0])?;
 /// for _ in 0..100 {

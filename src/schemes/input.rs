@@ -27,7 +27,7 @@ use crate::{Error, Real, State, Stepper};
 ///
 /// Same scheme and same results as [`Linear`](crate::Linear) fed `p_n = B w_n` (to
 /// rounding), at `2N² + N·I + 7N` multiply-adds a step instead of `3N² + 7N`. Build it
-/// with [`LinearInput::new`] (run time) or `LinearInput::from_rows` (`const fn`,
+/// with [`LinearInput::new`] (run time) or `LinearInput::from_rows_f32`/`_f64` (`const fn`,
 /// operators computed by the compiler into flash; bit-identical), then
 /// [`Stepper::start`] and [`Stepper::step`] with the inputs `w`.
 ///
@@ -35,12 +35,12 @@ use crate::{Error, Real, State, Stepper};
 ///
 /// ```
 /// use aemstep::{models, LinearInput, Stepper};
-/// use aemstep::nalgebra::vector;
+/// use aemstep::vector;
 ///
 /// // The benchmark 5-storey building under base acceleration a_g: B = −M ι.
 /// let (m, c, k) = models::five_storey_building();
 /// let b = models::base_excitation(&m);
-/// let sys = LinearInput::<f64, 5, 1>::from_rows(m, c, k, b, 0.02)?;
+/// let sys = LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k, b, 0.02)?;
 /// let mut s = sys.start(&Default::default(), &Default::default(), &vector![0.0])?;
 /// sys.step(&mut s, &vector![0.1 * 9.80665]); // a_g = 0.1 g
 /// assert!(s.u()[4] < 0.0); // the roof lags behind the ground
@@ -167,21 +167,26 @@ impl<T: Real, const N: usize, const I: usize> LinearInput<T, N, I> {
 
 /// Const-fn construction, for operators computed at compile time into flash.
 macro_rules! const_ctor {
-    ($t:ident) => {
+    ($t:ident, $from_rows:ident) => {
         impl<const N: usize, const I: usize> LinearInput<$t, N, I> {
             /// `const fn` twin of [`LinearInput::new`]: `M, C, K` (`N×N`) and `B` (`N×I`)
             /// as row-major `f64` arrays, `h` in seconds; bit-identical to
             /// [`LinearInput::new`] given the same values. In a `static`, no factorization
             /// code is linked in.
             ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+            /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+            /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+            /// which reads columns.
+            ///
             /// **Size limit at compile time**, as for
-            /// [`Linear::from_rows`](crate::Linear::from_rows): measured with rustc 1.95,
+            /// [`Linear::from_rows_f32`](crate::Linear::from_rows_f32): measured with rustc 1.95,
             /// `LinearInput<f32, N, 1>` compiles in a `static` up to `N = 63` and stops at 64
             /// with the `long_running_const_eval` lint (allow it at the firmware's crate
             /// root, or build at run time with [`LinearInput::new`]).
             ///
             /// Errors: as [`LinearInput::new`].
-            pub const fn from_rows(
+            pub const fn $from_rows(
                 m: Rows<N>,
                 c: Rows<N>,
                 k: Rows<N>,
@@ -225,11 +230,18 @@ macro_rules! const_ctor {
                     condition: op.condition,
                 })
             }
+
+            /// The time step `h` (s), usable in `const` contexts: the same value as
+            /// [`Stepper::time_step`](crate::Stepper::time_step), which generic code still
+            /// calls. Cost: none.
+            pub const fn time_step(&self) -> $t {
+                self.kin.h
+            }
         }
     };
 }
-const_ctor!(f32);
-const_ctor!(f64);
+const_ctor!(f32, from_rows_f32);
+const_ctor!(f64, from_rows_f64);
 
 impl<T: Real, const N: usize, const I: usize> Stepper<T, N> for LinearInput<T, N, I> {
     type Input = SVector<T, I>;

@@ -24,7 +24,7 @@ use crate::{AForm, Error, Real};
 /// The linear constant-coefficient AEM stepper (paper Algorithm 1, eliminated form).
 ///
 /// `T` is `f32` or `f64`; `N` the number of degrees of freedom. Build it once with
-/// [`Linear::new`] (run time, from `nalgebra` matrices) or [`Linear::from_rows`]
+/// [`Linear::new`] (run time, from `nalgebra` matrices) or [`Linear::from_rows_f32`]
 /// (`const fn`, from row-major arrays: operators computed by the compiler into flash).
 /// Both take the data in `f64` and round the operators once, so they are bit-identical.
 /// Then [`Stepper::start`](crate::Stepper::start) and [`Stepper::step`](crate::Stepper::step) (or the checked [`Stepper::try_step`](crate::Stepper::try_step)).
@@ -33,7 +33,7 @@ use crate::{AForm, Error, Real};
 ///
 /// ```
 /// use aemstep::{Linear, Stepper};
-/// use aemstep::nalgebra::{matrix, vector};
+/// use aemstep::{matrix, vector};
 ///
 /// // u'' + 25 u = 0 (paper Example 1), h = 0.01 s
 /// let sys = Linear::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], 0.01)?;
@@ -57,7 +57,7 @@ impl<T: Real, const N: usize> Linear<T, N> {
     ///
     /// `M, C, K` are `N×N` in `f64` (whatever `T`: the operators are computed in `f64`
     /// and rounded once, so the same data gives bit-identical operators through
-    /// [`Linear::from_rows`]), fully populated, not necessarily symmetric. `M` may be
+    /// [`Linear::from_rows_f32`]), fully populated, not necessarily symmetric. `M` may be
     /// singular as long as `M + (h/2) C + (h²/4) K` is not (then start with
     /// [`Stepper::start_with_acceleration`](crate::Stepper::start_with_acceleration)).
     ///
@@ -117,24 +117,31 @@ impl<T: Real, const N: usize> Linear<T, N> {
 
 /// Const-fn construction, for operators computed at compile time into flash.
 macro_rules! const_ctor {
-    ($t:ident) => {
+    ($t:ident, $from_rows:ident) => {
         impl<const N: usize> Linear<$t, N> {
             /// `const fn` twin of [`Linear::new`]: `M, C, K` as row-major `f64` arrays
             /// (`m[i][j]` is row `i`, column `j`), `h` in seconds. Bit-identical to
-            /// [`Linear::new`] given the same values.
+            /// [`Linear::new`] given the same values. `from_rows_f32` builds a
+            /// `Linear<f32, N>`, `from_rows_f64` a `Linear<f64, N>`: the scalar in the name
+            /// lets a typed `static` infer `N` with no turbofish.
+            ///
+            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+            /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+            /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+            /// which reads columns.
             ///
             /// In a `static`, the operators are evaluated by the compiler and no
             /// factorization code is linked in:
             ///
             /// ```
             /// use aemstep::Linear;
-            /// static SYS: Linear<f32, 1> = match Linear::<f32, 1>::from_rows(
+            /// static SYS: Linear<f32, 1> = match Linear::from_rows_f32(
             ///     [[1.0]], [[0.28]], [[4.0]], 0.002,
             /// ) {
             ///     Ok(s) => s,
             ///     Err(e) => panic!("{}", e.as_str()),
             /// };
-            /// assert_eq!(SYS.time_step_const(), 0.002);
+            /// assert_eq!(SYS.time_step(), 0.002);
             /// ```
             ///
             /// **Size limit at compile time.** The compiler evaluates about `4N³` flops;
@@ -146,26 +153,28 @@ macro_rules! const_ctor {
             /// [`Linear::new`] at run time.
             ///
             /// Errors: as [`Linear::new`].
-            pub const fn from_rows(
+            pub const fn $from_rows(
                 m: Rows<N>,
                 c: Rows<N>,
                 k: Rows<N>,
                 h: f64,
             ) -> Result<Self, Error> {
-                match Kernel::<$t, N, AemKinematics<$t>>::aem_from_rows(&m, &c, &k, h) {
+                match Kernel::<$t, N, AemKinematics<$t>>::from_rows_aem(&m, &c, &k, h) {
                     Ok(kernel) => Ok(Self { kernel }),
                     Err(e) => Err(e),
                 }
             }
 
-            /// The time step `h` (s), in `const` contexts.
-            pub const fn time_step_const(&self) -> $t {
+            /// The time step `h` (s), usable in `const` contexts: the same value as
+            /// [`Stepper::time_step`](crate::Stepper::time_step), which generic code (`S:
+            /// Stepper<T, N>`) still calls. Cost: none.
+            pub const fn time_step(&self) -> $t {
                 self.kernel.kin.h
             }
         }
     };
 }
-const_ctor!(f32);
-const_ctor!(f64);
+const_ctor!(f32, from_rows_f32);
+const_ctor!(f64, from_rows_f64);
 
 kernel_stepper!(Linear);

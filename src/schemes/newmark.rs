@@ -26,7 +26,7 @@ use crate::{Error, Real};
 ///
 /// ```
 /// use aemstep::{Linear, Newmark, Stepper};
-/// use aemstep::nalgebra::{matrix, vector};
+/// use aemstep::{matrix, vector};
 /// let (m, c, k, h) = (matrix![1.0], matrix![0.0], matrix![25.0], 0.01);
 /// // let sys = Linear::new(&m, &c, &k, h)?;
 /// let sys = Newmark::<f64, 1>::linear_acceleration(&m, &c, &k, h)?;

@@ -15,7 +15,7 @@ use core::f64::consts::TAU;
 /// `static`, the compiler computes the operators into flash).
 ///
 /// Each sample interval is one step of every oscillator by its whole-interval operator
-/// (for the exact scheme the exact map over `dt`; for the AEM the composition of its `n_p`
+/// (for the exact scheme the exact map over `h`; for the AEM the composition of its `n_p`
 /// sub-steps), a loop over `p` on a structure of arrays (one `[T; P]` per coefficient) that
 /// the compiler vectorizes. The sub-steps only locate peaks between samples: they are
 /// walked, from the interval's start, only for the oscillators whose peak could rise inside
@@ -61,10 +61,10 @@ pub struct Bank<T, const P: usize> {
     pub(super) period: [f64; P],
     /// Damping ratios, as given.
     pub(super) damping: [f64; P],
-    /// Sample interval (s).
-    pub(super) dt: f64,
-    /// `1/dt` (1/s).
-    pub(super) inv_dt: T,
+    /// Sample interval `h` (s).
+    pub(super) time_step: f64,
+    /// `1/h` (1/s).
+    pub(super) inv_h: T,
     pub(super) scheme: Scheme,
 }
 
@@ -78,13 +78,13 @@ pub(super) struct OpsF64<const P: usize> {
     pub n: [u16; P],
 }
 
-/// Sub-steps per sample for period `t` under `rule` (`dt`, `t` validated).
-pub(super) const fn substeps_for(rule: Substeps, dt: f64, t: f64) -> u16 {
+/// Sub-steps per sample for period `t` under `rule` (`h`, `t` validated).
+pub(super) const fn substeps_for(rule: Substeps, h: f64, t: f64) -> u16 {
     match rule {
         Substeps::Fixed(n) => n,
         Substeps::PointsPerPeriod(r) => {
-            // n = ceil(r·dt/T), clamped to [1, MAX_SUBSTEPS]
-            let x = r as f64 * dt / t;
+            // n = ceil(r·h/T), clamped to [1, MAX_SUBSTEPS]
+            let x = r as f64 * h / t;
             if x >= MAX_SUBSTEPS as f64 {
                 MAX_SUBSTEPS
             } else {
@@ -99,14 +99,14 @@ pub(super) const fn substeps_for(rule: Substeps, dt: f64, t: f64) -> u16 {
 /// The homogeneous part of a map is bounded as a damped oscillator's must be: the energy
 /// `(ω²u² + v²)/2` never grows, so `|uu|, |vv|, ω|uv|, |vu|/ω ≤ 1` (exactly for both
 /// schemes; here within `1e-6`). The exact scheme's matrix exponential loses that, and all
-/// accuracy, far beyond `ω dt ≈ 1e10` (its squarings amplify rounding by about `ω dt`):
-/// the fuzzer found a whole-interval `uu = 6e134` at `ω dt ≈ 3e18`.
+/// accuracy, far beyond `ω h ≈ 1e10` (its squarings amplify rounding by about `ω h`):
+/// the fuzzer found a whole-interval `uu = 6e134` at `ω h ≈ 3e18`.
 const fn contractive(m: &SdofOps, w: f64) -> bool {
     let b = 1.0 + 1e-6;
     m.uu.abs() <= b && m.vv.abs() <= b && (m.uv * w).abs() <= b && (m.vu / w).abs() <= b
 }
 
-/// Every operator of one oscillator, and `1/dt`, fits the scalar type (largest finite value
+/// Every operator of one oscillator, and `1/h`, fits the scalar type (largest finite value
 /// `max`), the coefficients the bank derives from `ω` and `ζ` included, and both maps are
 /// [`contractive`].
 const fn oscillator_fits(op: &SdofOps, whole: &SdofOps, w: f64, z: f64, ka: f64, max: f64) -> bool {
@@ -146,12 +146,12 @@ const fn oscillator_fits(op: &SdofOps, whole: &SdofOps, w: f64, z: f64, ka: f64,
 pub(super) const fn build_f64<const P: usize>(
     period: &[f64; P],
     damping: &[f64; P],
-    dt: f64,
+    h: f64,
     scheme: Scheme,
     rule: Substeps,
     max: f64,
 ) -> Result<OpsF64<P>, Error> {
-    if !(dt.is_finite() && dt > 0.0) {
+    if !(h.is_finite() && h > 0.0) {
         return Err(Error::InvalidTimeStep);
     }
     if let Substeps::Fixed(n) = rule
@@ -193,18 +193,18 @@ pub(super) const fn build_f64<const P: usize>(
             return Err(Error::InvalidDamping);
         }
         let w = TAU / t;
-        let n = substeps_for(rule, dt, t);
-        let h = dt / n as f64;
+        let n = substeps_for(rule, h, t);
+        let hs = h / n as f64;
         out.w2[p] = w * w;
         out.c2[p] = 2.0 * z * w;
         out.n[p] = n;
         out.ops[p] = match scheme {
-            Scheme::Exact => operators::exact(w, 2.0 * z * w, h),
-            Scheme::Aem => operators::aem(w * w, 2.0 * z * w, h),
+            Scheme::Exact => operators::exact(w, 2.0 * z * w, hs),
+            Scheme::Aem => operators::aem(w * w, 2.0 * z * w, hs),
         };
         out.whole[p] = match scheme {
-            // exact over dt directly (composing n exact sub-steps agrees to rounding)
-            Scheme::Exact => operators::exact(w, 2.0 * z * w, dt),
+            // exact over h directly (composing n exact sub-steps agrees to rounding)
+            Scheme::Exact => operators::exact(w, 2.0 * z * w, h),
             Scheme::Aem => operators::compose(&out.ops[p], n),
         };
         // 1/(ω√(1 + 4ζ²)) without a square root: √(1 + x) by 6 Newton steps from 1 + x/2
@@ -217,52 +217,130 @@ pub(super) const fn build_f64<const P: usize>(
             it += 1;
         }
         out.ka[p] = 1.0 / (w * r);
-        // Operators that overflow (or come out NaN: the exact map over `ω dt ≈ 1e106` was
+        // Operators that overflow (or come out NaN: the exact map over `ω h ≈ 1e106` was
         // NaN, found by fuzzing) are an error, not a bank that steps to NaN — reported
         // after every period and damping ratio has been checked (bad data first).
         fits_all &= oscillator_fits(&out.ops[p], &out.whole[p], w, z, out.ka[p], max);
         p += 1;
     }
-    if !(fits_all && fits_value(1.0 / dt, max)) {
+    if !(fits_all && fits_value(1.0 / h, max)) {
         return Err(Error::OperatorOverflow);
     }
     Ok(out)
 }
 
+impl<T: Real, const P: usize> Bank<T, P> {
+    /// A bank of oscillators with periods `period` (s, finite, at least `1e-150` — shorter
+    /// ones, whose `ω²` overflows, are `InvalidPeriod` too — in non-decreasing order),
+    /// damping ratios `damping` (in `[0, 1)`), sample interval `h` (s, finite, `> 0`), the
+    /// exact scheme, and the sub-step rule [`Substeps::AUTO`]. Run time, for either scalar
+    /// (generic code, `T` inferred); in a `static` use the `const fn`
+    /// [`Bank::new_f32`] / [`Bank::new_f64`], bit-identical to it.
+    ///
+    /// Cost: about 1 000 `f64` flops per oscillator, once.
+    ///
+    /// Errors: [`Error::InvalidPeriod`], [`Error::InvalidDamping`],
+    /// [`Error::InvalidTimeStep`], [`Error::OperatorOverflow`] (an operator is not finite
+    /// in `T`, e.g. `ω²` beyond `f32`, or not bounded as an oscillator's map must be: `T/h`
+    /// so small that the exact map over `h` cannot be formed, `ω h` far beyond `1e10`).
+    pub fn new(period: [f64; P], damping: [f64; P], h: f64) -> Result<Self, Error> {
+        Self::with(period, damping, h, Scheme::Exact, Substeps::AUTO)
+    }
+
+    /// As [`Bank::new`] with the scheme and the sub-step rule chosen (run time; the
+    /// `const fn` twins are [`Bank::with_f32`] / [`Bank::with_f64`]).
+    ///
+    /// Errors: as [`Bank::new`], and [`Error::InvalidParameter`] for `Substeps::Fixed(0)`,
+    /// `Substeps::Fixed(n > MAX_SUBSTEPS)` or `Substeps::PointsPerPeriod(0)`.
+    pub fn with(
+        period: [f64; P],
+        damping: [f64; P],
+        h: f64,
+        scheme: Scheme,
+        substeps: Substeps,
+    ) -> Result<Self, Error> {
+        // The `f64` bank with every operator checked against `T`'s range, then each value
+        // rounded once: what the `const fn` of `T` computes, value for value.
+        Bank::<f64, P>::checked_for(period, damping, h, scheme, substeps, T::MAX)
+            .map(|b| b.rounded())
+    }
+}
+
+impl<const P: usize> Bank<f64, P> {
+    /// Every stored value rounded once to `T` (each was computed in `f64`, as the `const`
+    /// constructors round it).
+    fn rounded<T: Real>(&self) -> Bank<T, P> {
+        let r = |a: &[f64; P]| a.map(T::from_f64_rounded);
+        Bank {
+            su: self.su.map(|row| r(&row)),
+            sv: self.sv.map(|row| r(&row)),
+            uu: r(&self.uu),
+            uv: r(&self.uv),
+            ug: r(&self.ug),
+            ud: r(&self.ud),
+            vu: r(&self.vu),
+            vv: r(&self.vv),
+            vg: r(&self.vg),
+            vd: r(&self.vd),
+            w2: r(&self.w2),
+            c2: r(&self.c2),
+            w: r(&self.w),
+            ka: r(&self.ka),
+            inv_w2: r(&self.inv_w2),
+            inv_w: r(&self.inv_w),
+            k2: r(&self.k2),
+            inv_n: r(&self.inv_n),
+            n: self.n,
+            m1: self.m1,
+            period: self.period,
+            damping: self.damping,
+            time_step: self.time_step,
+            inv_h: T::from_f64_rounded(self.inv_h),
+            scheme: self.scheme,
+        }
+    }
+}
+
+/// The `const fn` constructors of `Bank<f32, P>` and `Bank<f64, P>`: the scalar is in
+/// the name (`new_f32`, `with_f64`, …), so a typed `static` needs no turbofish.
 macro_rules! bank_ctor {
-    ($t:ident) => {
+    ($t:ident, $new:ident, $with:ident) => {
         impl<const P: usize> Bank<$t, P> {
-            /// A bank of oscillators with periods `period` (s, finite, at least `1e-150`
-            /// — shorter ones, whose `ω²` overflows, are `InvalidPeriod` too — in
-            /// non-decreasing order), damping ratios `damping` (in `[0, 1)`), sample
-            /// interval `dt` (s, finite, `> 0`), the exact scheme, and the sub-step rule
-            /// [`Substeps::AUTO`].
+            /// `const fn` twin of [`Bank::new`] (same arguments, checks and errors; `h`
+            /// the sample interval in s), bit-identical to it: in a `static`, the compiler
+            /// computes the operators (flash). Cost: about 1 000 `f64` flops per
+            /// oscillator, once.
             ///
-            /// `const fn`: in a `static`, the compiler computes the operators (flash).
-            /// Cost: about 1 000 `f64` flops per oscillator, once.
-            ///
-            /// Errors: [`Error::InvalidPeriod`], [`Error::InvalidDamping`],
-            /// [`Error::InvalidTimeStep`], [`Error::OperatorOverflow`] (an operator is not
-            /// finite in the scalar type, e.g. `ω²` beyond `f32`, or not bounded as an
-            /// oscillator's map must be: `T/dt` so small that the exact map over `dt`
-            /// cannot be formed, `ω dt` far beyond `1e10`).
-            pub const fn new(period: [f64; P], damping: [f64; P], dt: f64) -> Result<Self, Error> {
-                Self::with(period, damping, dt, Scheme::Exact, Substeps::AUTO)
+            /// Errors: as [`Bank::new`].
+            pub const fn $new(period: [f64; P], damping: [f64; P], h: f64) -> Result<Self, Error> {
+                Self::$with(period, damping, h, Scheme::Exact, Substeps::AUTO)
             }
 
-            /// As [`Bank::new`] with the scheme and the sub-step rule chosen.
+            /// `const fn` twin of [`Bank::with`], bit-identical to it.
             ///
-            /// Errors: as [`Bank::new`], and [`Error::InvalidParameter`] for
-            /// `Substeps::Fixed(0)`, `Substeps::Fixed(n > MAX_SUBSTEPS)` or
-            /// `Substeps::PointsPerPeriod(0)`.
-            pub const fn with(
+            /// Errors: as [`Bank::with`].
+            pub const fn $with(
                 period: [f64; P],
                 damping: [f64; P],
-                dt: f64,
+                h: f64,
                 scheme: Scheme,
                 substeps: Substeps,
             ) -> Result<Self, Error> {
-                let o = match build_f64(&period, &damping, dt, scheme, substeps, $t::MAX as f64) {
+                Self::checked_for(period, damping, h, scheme, substeps, $t::MAX as f64)
+            }
+
+            /// The bank with its operators checked against `max`, the largest finite
+            /// value of the scalar type the values end in (`$t`'s own, or a narrower one
+            /// the `f64` bank is rounded to by [`Bank::with`]).
+            const fn checked_for(
+                period: [f64; P],
+                damping: [f64; P],
+                h: f64,
+                scheme: Scheme,
+                substeps: Substeps,
+                max: f64,
+            ) -> Result<Self, Error> {
+                let o = match build_f64(&period, &damping, h, scheme, substeps, max) {
                     Ok(o) => o,
                     Err(e) => return Err(e),
                 };
@@ -289,8 +367,8 @@ macro_rules! bank_ctor {
                     m1: 0,
                     period,
                     damping,
-                    dt,
-                    inv_dt: (1.0 / dt) as $t,
+                    time_step: h,
+                    inv_h: (1.0 / h) as $t,
                     scheme,
                 };
                 let mut p = 0;
@@ -348,14 +426,15 @@ macro_rules! bank_ctor {
         }
     };
 }
-bank_ctor!(f32);
-bank_ctor!(f64);
+bank_ctor!(f32, new_f32, with_f32);
+bank_ctor!(f64, new_f64, with_f64);
 
 /// The running response of a [`Bank`]: the state of every oscillator and the peaks so
 /// far. Start with [`Bank::at_rest`]; feed samples with [`Bank::step`].
 ///
 /// Units follow the samples: with `a_g` in m/s², displacements are m, velocities m/s and
 /// accelerations m/s². Size: `5P + 1` values of `T` and two counters.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Response<T, const P: usize> {
     pub(super) u: [T; P],
@@ -426,7 +505,7 @@ fn keep_max<T: Real>(m: &mut T, x: T) {
 impl<T: Real, const P: usize> Bank<T, P> {
     /// Feed the next ground-acceleration sample `ag` (m/s² or any unit; the response is in
     /// the same unit system). Sample 0 is the ground acceleration at `t = 0`, with every
-    /// oscillator at rest; each later sample advances time by `dt`, the load linear
+    /// oscillator at rest; each later sample advances time by `h`, the load linear
     /// between samples. Peaks are taken at the samples and, for oscillator `p`, at the ends
     /// of its `n_p` sub-steps in between.
     ///
@@ -443,7 +522,7 @@ impl<T: Real, const P: usize> Bank<T, P> {
     /// `O(h²)` error, and a peak may be missed by that much.
     ///
     /// A non-finite sample (NaN, ±∞) is skipped and counted ([`Response::skipped`]): time
-    /// still advances by `dt`, with the last finite sample held in its place, so later
+    /// still advances by `h`, with the last finite sample held in its place, so later
     /// samples stay on their times; the peaks so far are kept.
     ///
     /// Cost: `P` whole-interval steps (10 multiply-adds, 3 absolute values and 3
@@ -470,7 +549,7 @@ impl<T: Real, const P: usize> Bank<T, P> {
     }
 
     /// Continue after the record in free vibration: the ground acceleration returns
-    /// linearly to zero over one `dt` and stays zero for `samples − 1` more intervals;
+    /// linearly to zero over one `h` and stays zero for `samples − 1` more intervals;
     /// peaks keep updating ([`Response::samples`] does not count these).
     /// [`Bank::free_vibration_samples`] is long enough for every oscillator's peak.
     ///
@@ -487,7 +566,7 @@ impl<T: Real, const P: usize> Bank<T, P> {
         }
     }
 
-    /// One period of the longest oscillator, in samples (`⌈T_max/dt⌉`): after the record,
+    /// One period of the longest oscillator, in samples (`⌈T_max/h⌉`): after the record,
     /// a damped oscillator's free vibration decays, so its peak (displacement, velocity and
     /// absolute acceleration) comes within one period; stepping this long catches it.
     /// Cost: a scan of the periods.
@@ -498,7 +577,7 @@ impl<T: Real, const P: usize> Bank<T, P> {
                 t = p;
             }
         }
-        let x = t / self.dt;
+        let x = t / self.time_step;
         let f = x as u32; // saturating cast
         if (f as f64) < x {
             f.saturating_add(1)
@@ -513,7 +592,7 @@ impl<T: Real, const P: usize> Bank<T, P> {
     fn advance(&self, r: &mut Response<T, P>, a0: T, a1: T) {
         let d = a1 - a0;
         let zero = T::from_f64_rounded(0.0);
-        let slope = d * self.inv_dt;
+        let slope = d * self.inv_h;
         let amax = if abs(a0) > abs(a1) { abs(a0) } else { abs(a1) };
         let m1 = if self.m1 < P { self.m1 } else { P };
         let mut need = [false; P];
@@ -594,9 +673,10 @@ impl<T: Real, const P: usize> Bank<T, P> {
     pub fn damping(&self) -> &[f64; P] {
         &self.damping
     }
-    /// Sample interval (s). Cost: none.
-    pub fn dt(&self) -> f64 {
-        self.dt
+    /// The sample interval `h` (s), the time step of every oscillator's whole-interval
+    /// map. Cost: none.
+    pub fn time_step(&self) -> f64 {
+        self.time_step
     }
     /// The scheme the operators were built with. Cost: none.
     pub fn scheme(&self) -> Scheme {

@@ -8,7 +8,7 @@ use super::bank::{Bank, Response};
 use crate::Real;
 
 /// The spectra of many records (each a slice of ground-acceleration samples at the bank's
-/// `dt`), on `threads` threads (`0`: as many as `std::thread::available_parallelism`).
+/// time step [`Bank::time_step`]), on `threads` threads (`0`: as many as `std::thread::available_parallelism`).
 /// Each record is stepped through the whole bank ([`Bank::step`]), then continued
 /// `free_vibration` samples in free vibration ([`Bank::free_vibration`]; pass
 /// [`Bank::free_vibration_samples`] for every peak, `0` for none).

@@ -6,8 +6,8 @@
 //! ```
 //! use aemstep::spectrum::Bank;
 //!
-//! // 3 periods, 5 % damping, dt = 0.01 s; operators computed by the compiler.
-//! static BANK: Bank<f32, 3> = match Bank::<f32, 3>::new([0.1, 0.5, 2.0], [0.05; 3], 0.01) {
+//! // 3 periods, 5 % damping, h = 0.01 s; operators computed by the compiler.
+//! static BANK: Bank<f32, 3> = match Bank::new_f32([0.1, 0.5, 2.0], [0.05; 3], 0.01) {
 //!     Ok(b) => b,
 //!     Err(e) => panic!("{}", e.as_str()),
 //! };
@@ -28,7 +28,7 @@
 //! whole-interval map is the composition of its sub-steps, so sub-steps also make its
 //! state more accurate); it is kept for the speed–accuracy comparison.
 //!
-//! **Short periods** ([`Substeps`]): the state at the samples is exact whatever `T/dt`,
+//! **Short periods** ([`Substeps`]): the state at the samples is exact whatever `T/h`,
 //! but the peak falls between samples. Oscillator `p` has `n_p` sub-steps per sample
 //! (load linear between samples) at whose ends the peaks are taken; they are walked only
 //! for the intervals where a bound on the motion says the peak could rise (about 2 % of
@@ -90,7 +90,7 @@ pub enum Scheme {
 pub enum Substeps {
     /// The same count for every oscillator (`1 ..= MAX_SUBSTEPS`).
     Fixed(u16),
-    /// `n_p = ⌈r·dt/T_p⌉`, clamped to `1 ..= MAX_SUBSTEPS`: at least `r` points per period
+    /// `n_p = ⌈r·h/T_p⌉`, clamped to `1 ..= MAX_SUBSTEPS`: at least `r` points per period
     /// where the peak is taken (`r ≥ 1`).
     PointsPerPeriod(u16),
 }

@@ -6,13 +6,15 @@ use super::operators::cos_sin;
 use crate::Real;
 
 /// The rotation angles of a RotD computation: `K` angles `θ_j = jπ/K`, `j = 0 … K−1`
-/// (`K = 180` is the usual 1° increment). Build with [`RotD::new`] (`const fn`).
+/// (`K = 180` is the usual 1° increment). Build with [`RotD::new`] (run time, generic)
+/// or the `const fn` [`RotD::new_f32`] / [`RotD::new_f64`] (in a `static`), bit-identical.
 ///
 /// The response of an oscillator to the two components rotated by `θ` is
 /// `u_θ(t) = u_x(t) cos θ + u_y(t) sin θ` (linearity), so one pass over the record with
 /// both components gives the peak `max_t |u_θ|` for every angle. RotD100 is the largest
 /// of the `K` peaks, RotD50 their median (Boore 2010); both are spectral displacements
 /// (m), [`Bank::psa`] turns them into pseudo-accelerations.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RotD<T, const K: usize> {
     cos: [T; K],
@@ -22,6 +24,7 @@ pub struct RotD<T, const K: usize> {
 /// The running two-component response: each component's [`Response`] and the peak
 /// rotated displacement of every oscillator at every angle. Size: `2·(5P + 1) + K·P`
 /// values of `T`.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RotDResponse<T, const P: usize, const K: usize> {
     x: Response<T, P>,
@@ -29,11 +32,33 @@ pub struct RotDResponse<T, const P: usize, const K: usize> {
     peak: [[T; K]; P],
 }
 
+impl<T: Real, const K: usize> RotD<T, K> {
+    /// The `K` angles `jπ/K` (run time, either scalar; `K ≥ 1`, cost `40K` flops once):
+    /// the `f64` cosines and sines rounded once to `T`, bit-identical to the `const fn`
+    /// [`RotD::new_f32`] / [`RotD::new_f64`].
+    pub fn new() -> Self {
+        let r = RotD::<f64, K>::new_f64();
+        RotD {
+            cos: r.cos.map(T::from_f64_rounded),
+            sin: r.sin.map(T::from_f64_rounded),
+        }
+    }
+}
+
+impl<T: Real, const K: usize> Default for RotD<T, K> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The `const fn` constructors of `RotD<f32, K>` and `RotD<f64, K>` (the scalar in the
+/// name: a typed `static` needs no turbofish).
 macro_rules! rotd_ctor {
-    ($t:ident) => {
+    ($t:ident, $new:ident) => {
         impl<const K: usize> RotD<$t, K> {
-            /// The `K` angles `jπ/K` (`const fn`; `K ≥ 1`, cost `40K` flops once).
-            pub const fn new() -> Self {
+            /// `const fn` twin of [`RotD::new`]: the `K` angles `jπ/K` (`K ≥ 1`, cost
+            /// `40K` flops once).
+            pub const fn $new() -> Self {
                 let mut r = RotD {
                     cos: [0.0; K],
                     sin: [0.0; K],
@@ -60,16 +85,10 @@ macro_rules! rotd_ctor {
                 }
             }
         }
-
-        impl<const K: usize> Default for RotD<$t, K> {
-            fn default() -> Self {
-                Self::new()
-            }
-        }
     };
 }
-rotd_ctor!(f32);
-rotd_ctor!(f64);
+rotd_ctor!(f32, new_f32);
+rotd_ctor!(f64, new_f64);
 
 #[inline(always)]
 fn abs<T: Real>(x: T) -> T {
@@ -78,7 +97,7 @@ fn abs<T: Real>(x: T) -> T {
 
 impl<T: Real, const K: usize> RotD<T, K> {
     /// Feed the next samples of the two horizontal components (`ax`, `ay`, same unit and
-    /// same `dt`). Each component behaves as in [`Bank::step`] (a non-finite sample is
+    /// same sample interval `h`). Each component behaves as in [`Bank::step`] (a non-finite sample is
     /// skipped, counted and held); each component's own peaks are kept too
     /// ([`RotDResponse::x`], [`RotDResponse::y`]).
     ///

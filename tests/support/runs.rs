@@ -207,7 +207,7 @@ pub fn trajectory<
     let mut s = sys.start(&u0, &v0, &load(0.0)).unwrap();
     let f = |s: &State<T, N>| {
         let c = |x: &SVector<T, N>| x.map(|y| y.as_f64());
-        State::from_parts(c(s.u()), c(s.v()), c(s.a()), s.steps())
+        State::restore(c(s.u()), c(s.v()), c(s.a()), s.steps()).expect("a finite state")
     };
     let mut out = vec![f(&s)];
     for n in 1..=steps {
@@ -271,7 +271,9 @@ pub fn cross_check<const N: usize>() -> CrossCheck<N> {
     let tn = nm
         .iter()
         .enumerate()
-        .map(|(n, (u, v, a))| State::from_parts(sv(u), sv(v), sv(a), n as u64))
+        .map(|(n, (u, v, a))| {
+            State::restore(sv(u), sv(v), sv(a), n as u64).expect("a finite reference")
+        })
         .collect();
     CrossCheck {
         tf: trajectory(&fast, steps),

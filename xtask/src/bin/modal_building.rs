@@ -67,7 +67,7 @@ fn full_history(ag: &[f64], sub: usize) -> History {
 fn modal_history<const R: usize>(ag: &[f64]) -> History {
     let (m, c, k) = models::five_storey_building();
     let y = storey_drifts::<5>();
-    let sys = Modal::<f64, 5, R, 1, 5>::from_rows_with_modes(
+    let sys = Modal::<f64, 5, R, 1, 5>::from_rows_with_modes_f64(
         m,
         k,
         Damping::Matrix(c),

@@ -1,0 +1,261 @@
+//! Fuzz target `spectrum` (`fuzz_targets/spectrum.rs`): checks Bank::new, Bank::with (both
+//! schemes, every sub-step rule), RotD, the host batch; f32 and f64.
+//!
+//! The decoder and the checks every target shares are in `common.rs`.
+
+use std::fmt::Debug;
+
+use aemstep::spectrum::{Bank, Response, RotD, RotDResponse, Scheme, Substeps};
+use aemstep::{Error, Real};
+
+use super::common::*;
+
+const SP: &str = "spectrum";
+
+/// Target `spectrum`.
+pub fn spectrum(data: &[u8]) {
+    let mut b = Bytes::new(data);
+    let mut period = [0.0; 3];
+    for p in &mut period {
+        *p = match b.pick(4) {
+            0 => b.value(),
+            _ => 10f64.powf(-2.0 + 3.0 * b.unit()),
+        };
+        b.note(*p);
+    }
+    if b.flag() {
+        period.sort_by(f64::total_cmp);
+    }
+    let damping = [b.param(0.0, 0.3), b.param(0.0, 0.3), b.param(0.0, 0.3)];
+    let dt = match b.pick(3) {
+        0 => b.time_step(),
+        _ => 10f64.powf(-3.0 + 2.0 * b.unit()),
+    };
+    b.note(dt);
+    let scheme = if b.flag() { Scheme::Exact } else { Scheme::Aem };
+    let sub = match b.pick(4) {
+        0 => Substeps::AUTO,
+        1 => Substeps::Fixed(b.u16() % 1100),
+        2 => Substeps::PointsPerPeriod(b.u16() % 64),
+        _ => Substeps::Fixed(1),
+    };
+    let samples: Vec<(f64, f64)> = (0..12)
+        .map(|_| match b.pick(8) {
+            0 => (b.value(), b.value()),
+            _ => (b.ordinary(), b.ordinary()),
+        })
+        .collect();
+    let batch = b.pick(8) == 0;
+    set_context(format!(
+        "periods = {period:?}, damping = {damping:?}, dt = {dt:e}, scheme = {scheme:?}, substeps = {sub:?}, samples = {samples:?}, batch = {batch}"
+    ));
+    let r64 = bank_typed::<f64>(&period, &damping, dt, scheme, sub, &samples, batch);
+    let r32 = bank_typed::<f32>(&period, &damping, dt, scheme, sub, &samples, batch);
+    same_kind(SP, "Bank f64 vs f32", &r64, &r32);
+    count(SP, "inputs");
+    count(SP, b.category());
+}
+
+fn bank_typed<T: Real + Send + Sync + 'static>(
+    period: &[f64; 3],
+    damping: &[f64; 3],
+    dt: f64,
+    scheme: Scheme,
+    sub: Substeps,
+    samples: &[(f64, f64)],
+    batch: bool,
+) -> Option<Error>
+where
+    Bank<T, 3>: Debug,
+{
+    let (bank, default) = if eps::<T>() > 1e-10 {
+        (
+            cast_bank::<T>(
+                Bank::<f32, 3>::with_f32(*period, *damping, dt, scheme, sub).map(BankAny::F32),
+            ),
+            cast_bank::<T>(Bank::<f32, 3>::new_f32(*period, *damping, dt).map(BankAny::F32)),
+        )
+    } else {
+        (
+            cast_bank::<T>(
+                Bank::<f64, 3>::with_f64(*period, *damping, dt, scheme, sub).map(BankAny::F64),
+            ),
+            cast_bank::<T>(Bank::<f64, 3>::new_f64(*period, *damping, dt).map(BankAny::F64)),
+        )
+    };
+    outcome(SP, &bank);
+    outcome(SP, &default);
+    // The documented rule, in its order: dt, the sub-step rule, then per oscillator its
+    // period (finite, ≥ 1e-150, not below the previous) and its damping ratio ([0, 1)).
+    let rule_err = if !(dt.is_finite() && dt > 0.0) {
+        Some(Error::InvalidTimeStep)
+    } else if matches!(sub, Substeps::Fixed(0) | Substeps::PointsPerPeriod(0))
+        || matches!(sub, Substeps::Fixed(n) if n > aemstep::spectrum::MAX_SUBSTEPS)
+    {
+        Some(Error::InvalidParameter)
+    } else {
+        (0..3).find_map(|p| {
+            let t = period[p];
+            if !(t.is_finite() && t >= 1e-150) || (p > 0 && t < period[p - 1]) {
+                Some(Error::InvalidPeriod)
+            } else if !(damping[p] >= 0.0 && damping[p] < 1.0) {
+                Some(Error::InvalidDamping)
+            } else {
+                None
+            }
+        })
+    };
+    let got = bank.as_ref().err().copied();
+    match rule_err {
+        Some(e) => check!(
+            got == Some(e),
+            "{SP}: Bank::with gave {got:?}, the rule says {e:?}"
+        ),
+        // Operators that do not fit the scalar type are an overflow.
+        None => check!(
+            got.is_none() || got == Some(Error::OperatorOverflow),
+            "{SP}: Bank::with gave {got:?} for data within the rule"
+        ),
+    }
+    let Ok(bank) = bank else { return got };
+    check!(
+        bank.periods() == period
+            && bank.damping() == damping
+            && bank.time_step() == dt
+            && bank.scheme() == scheme,
+        "{SP}: the bank does not keep its data"
+    );
+    let _ = bank.free_vibration_samples();
+    let (rot, mut r, mut rr) = at_rest(&bank);
+    let mut held = T::zero();
+    let mut record = Vec::new();
+    for &(ax, ay) in samples {
+        let (x, y) = (T::from_f64_rounded(ax), T::from_f64_rounded(ay));
+        record.push(x);
+        let before = r;
+        bank.step(&mut r, x);
+        count(SP, "samples");
+        if !x.is_finite() {
+            count(SP, "samples skipped");
+            // A skipped sample: counted, and the same as the last finite sample held.
+            let mut held_r = before;
+            bank.step(&mut held_r, held);
+            check!(
+                r.skipped() == before.skipped() + 1
+                    && bits(&(
+                        r.displacement(),
+                        r.velocity(),
+                        r.sd(),
+                        r.sv(),
+                        r.sa(),
+                        r.samples(),
+                        r.walks()
+                    )) == bits(&(
+                        held_r.displacement(),
+                        held_r.velocity(),
+                        held_r.sd(),
+                        held_r.sv(),
+                        held_r.sa(),
+                        held_r.samples(),
+                        held_r.walks()
+                    )),
+                "{SP}: a non-finite sample was not skipped as documented"
+            );
+        } else {
+            held = x;
+        }
+        // Peaks never fall.
+        for p in 0..3 {
+            check!(
+                r.sd()[p] >= before.sd()[p]
+                    && r.sv()[p] >= before.sv()[p]
+                    && r.sa()[p] >= before.sa()[p],
+                "{SP}: a peak fell"
+            );
+        }
+        rot.step(&bank, &mut rr, x, y);
+    }
+    // Ordinary samples: each at most 10 (m/s²) in size, or skipped (not finite).
+    let ordinary = samples
+        .iter()
+        .all(|&(x, _)| !x.is_finite() || x.abs() <= 10.0);
+    let fv = bank.free_vibration_samples().min(40);
+    let mut rf = r;
+    bank.free_vibration(&mut rf, fv);
+    if ordinary {
+        // Ok ⇒ finite operators: ordinary samples give a finite response.
+        let all = r
+            .displacement()
+            .iter()
+            .chain(r.velocity())
+            .chain(r.sd())
+            .chain(r.sv())
+            .chain(r.sa())
+            .chain(rf.sd())
+            .chain(rf.sv())
+            .chain(rf.sa());
+        let fin = all.copied().all(|x| x.is_finite());
+        check!(
+            fin,
+            "{SP}: Bank Ok, ordinary samples gave a non-finite response: {r:?} (bank {bank:?})"
+        );
+        check!(
+            bank.psa(r.sd())
+                .iter()
+                .chain(&bank.psv(r.sd()))
+                .all(|x| x.is_finite()),
+            "{SP}: PSA/PSV not finite"
+        );
+        count(SP, "response checked finite");
+    }
+    let _ = (rr.rotd50(), rr.rotd100());
+    #[cfg(feature = "std")]
+    if batch {
+        let out = aemstep::spectrum::batch::spectra(&bank, &[&record[..]], 0, 1);
+        check!(
+            out.len() == 1 && bits(&out[0]) == bits(&r),
+            "{SP}: batch differs from stepping"
+        );
+        count(SP, "batch compared");
+    }
+    let _ = batch;
+    None
+}
+
+/// A bank of either scalar, for the generic checks (short-lived: its size is no matter).
+#[allow(clippy::large_enum_variant)]
+enum BankAny {
+    F32(Bank<f32, 3>),
+    F64(Bank<f64, 3>),
+}
+
+fn cast_bank<T: Real + 'static>(b: Result<BankAny, Error>) -> Result<Bank<T, 3>, Error> {
+    b.map(|b| {
+        let any: Box<dyn std::any::Any> = match b {
+            BankAny::F32(x) => Box::new(x),
+            BankAny::F64(x) => Box::new(x),
+        };
+        *any.downcast::<Bank<T, 3>>()
+            .expect("bank of the scalar asked for")
+    })
+}
+
+fn at_rest<T: Real + 'static>(
+    bank: &Bank<T, 3>,
+) -> (RotD<T, 4>, Response<T, 3>, RotDResponse<T, 3, 4>) {
+    // `at_rest` and `RotD::new_f32`/`new_f64` are `const fn` of each scalar type: pick `T`'s.
+    let bk: &dyn std::any::Any = bank;
+    let x: Box<dyn std::any::Any> = if let Some(b) = bk.downcast_ref::<Bank<f32, 3>>() {
+        let rot = RotD::<f32, 4>::new_f32();
+        let rr = rot.at_rest(b);
+        Box::new((rot, b.at_rest(), rr))
+    } else {
+        let b = bk
+            .downcast_ref::<Bank<f64, 3>>()
+            .expect("a bank of f32 or f64");
+        let rot = RotD::<f64, 4>::new_f64();
+        let rr = rot.at_rest(b);
+        Box::new((rot, b.at_rest(), rr))
+    };
+    *x.downcast().expect("the scalar asked for")
+}

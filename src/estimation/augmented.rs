@@ -1,0 +1,161 @@
+//! The augmented Kalman filter (Lourens et al. 2012): the unknown input joins the state
+//! as a random walk.
+//!
+//! On the standard form of [`InputModel`] (`ξ_n = A ξ_{n−1} + B w_{n−1}`,
+//! `y_n = C ξ_n + D̃ w_n`), the state `z = [ξ; w]` (`Z = S + I` values) with the force
+//! model `w_n = w_{n−1} + η_n`, `E η ηᵀ = Q_w`:
+//!
+//! ```text
+//! z_n = [A B; 0 I] z_{n−1} + [q; η]        y_n = [C D̃] z_n + r
+//! ```
+//!
+//! is an ordinary linear model: [`AugmentedModel`] builds it as a
+//! [`StateSpace`] with no known input (`I = 0`) and a [`Measurement`], so the crate's
+//! [`SteadyState`] (the Riccati gain, `const fn`), [`Observer`](crate::observer::Observer)
+//! (fixed gain, `f32`/`f64`, `S² + 2S·O` multiply-adds a step on the augmented size) and
+//! [`Kalman`](crate::observer::Kalman) (covariance propagated) run it unchanged. The
+//! estimate `z` splits into `x̂ = ξ̂ + Γ₁ ŵ` and `ŵ` ([`AugmentedModel::split`]).
+//!
+//! The random walk's eigenvalue `1` must be seen by the sensors: with acceleration-only
+//! sensing the static force–displacement pair is invisible (an invariant zero at `z = 1`),
+//! the augmented pair is not detectable and there is no steady state: the time-varying
+//! filter drifts, and [`AugmentedModel::steady_state`] returns
+//! [`Error::InputNotIdentifiable`]. One displacement (or strain) measurement removes it.
+
+use nalgebra::SVector;
+
+use super::InputModel;
+use crate::linalg::{Mat, all_finite};
+use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
+use crate::{Error, Real};
+
+/// The augmented model of an [`InputModel`] with `S` states and `I` inputs: `Z = S + I`
+/// states (checked: [`Error::StateSizeMismatch`]), `O` measurements; `f64`, row-major.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AugmentedModel<const S: usize, const I: usize, const Z: usize, const O: usize> {
+    /// `[A B; 0 I]` as a model with no known input (`Γ₀ = Γ₁ = 0`, no output maps: use
+    /// the measurement).
+    pub model: StateSpace<0, Z, 0>,
+    /// `[C D̃]` (`D = 0`).
+    pub measurement: Measurement<Z, 0, O>,
+    /// `diag(Q, Q_w)` (`Z×Z`).
+    pub process_noise: [[f64; Z]; Z],
+    /// `Γ₁` of the physical state `x = ξ + Γ₁ w`.
+    pub gamma1: [[f64; I]; S],
+}
+
+impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedModel<S, I, Z, O> {
+    /// The augmented model of `m` with process noise `q` on `ξ` (`S×S`, symmetric positive
+    /// semidefinite) and the random walk's covariance `qw` (`I×I`, input units squared per
+    /// step; it sets how fast the force estimate may move). `const fn`.
+    ///
+    /// Errors: [`Error::StateSizeMismatch`] (`Z ≠ S + I`), [`Error::InvalidCovariance`],
+    /// [`Error::NonFiniteInput`]. Cost: `O(Z²)`.
+    pub const fn from_parts(
+        m: &InputModel<S, I, O>,
+        q: &[[f64; S]; S],
+        qw: &[[f64; I]; I],
+    ) -> Result<Self, Error> {
+        if Z != S + I {
+            return Err(Error::StateSizeMismatch);
+        }
+        if !(is_covariance(q, false) && is_covariance(qw, false)) {
+            return Err(Error::InvalidCovariance);
+        }
+        if !(all_finite(&m.a) && all_finite(&m.b) && all_finite(&m.c) && all_finite(&m.d)) {
+            return Err(Error::NonFiniteInput);
+        }
+        let mut phi: Mat<Z, Z> = [[0.0; Z]; Z];
+        let mut pn: Mat<Z, Z> = [[0.0; Z]; Z];
+        let mut h: Mat<O, Z> = [[0.0; Z]; O];
+        let mut i = 0;
+        while i < S {
+            let mut j = 0;
+            while j < S {
+                phi[i][j] = m.a[i][j];
+                pn[i][j] = q[i][j];
+                j += 1;
+            }
+            let mut j = 0;
+            while j < I {
+                phi[i][S + j] = m.b[i][j];
+                j += 1;
+            }
+            i += 1;
+        }
+        let mut i = 0;
+        while i < I {
+            phi[S + i][S + i] = 1.0;
+            let mut j = 0;
+            while j < I {
+                pn[S + i][S + j] = qw[i][j];
+                j += 1;
+            }
+            i += 1;
+        }
+        let mut o = 0;
+        while o < O {
+            let mut j = 0;
+            while j < S {
+                h[o][j] = m.c[o][j];
+                j += 1;
+            }
+            let mut j = 0;
+            while j < I {
+                h[o][S + j] = m.d[o][j];
+                j += 1;
+            }
+            o += 1;
+        }
+        Ok(Self {
+            model: StateSpace {
+                phi,
+                gamma0: [[0.0; 0]; Z],
+                gamma1: [[0.0; 0]; Z],
+                dof_u: [],
+                dof_v: [],
+                dof_a: [],
+                dof_a_input: [],
+                time_step: m.time_step,
+            },
+            measurement: Measurement {
+                h,
+                d: [[0.0; 0]; O],
+            },
+            process_noise: pn,
+            gamma1: m.gamma1,
+        })
+    }
+
+    /// The steady-state Kalman gain of the augmented model with measurement noise `r`
+    /// ([`SteadyState::from_parts`], `const fn`), for an
+    /// [`Observer`](crate::observer::Observer) on `(self.model, self.measurement)`.
+    ///
+    /// Errors: [`Error::InputNotIdentifiable`] where the Riccati equation has no
+    /// stabilizing solution (the random walk not detectable: an invariant zero at `z = 1`,
+    /// acceleration-only sensing), and the other errors of [`SteadyState::from_parts`]
+    /// ([`Error::InvalidCovariance`], [`Error::OperatorOverflow`]).
+    ///
+    /// Cost: that of [`SteadyState::from_parts`] with `S = Z`.
+    pub const fn steady_state(&self, r: &[[f64; O]; O]) -> Result<SteadyState<Z, O>, Error> {
+        match SteadyState::from_parts(&self.model, &self.measurement, &self.process_noise, r) {
+            Ok(s) => Ok(s),
+            Err(Error::RiccatiNotConverged) => Err(Error::InputNotIdentifiable),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// The physical state `x̂ = ξ̂ + Γ₁ ŵ` and the input `ŵ` of an augmented estimate
+    /// `z = [ξ̂; ŵ]` (`Γ₁` rounded to `T`). Cost: `S·I` multiply-adds.
+    pub fn split<T: Real>(&self, z: &SVector<T, Z>) -> (SVector<T, S>, SVector<T, I>) {
+        let w = SVector::<T, I>::from_fn(|i, _| z[S + i]);
+        let x = SVector::<T, S>::from_fn(|i, _| {
+            let mut s = z[i];
+            for j in 0..I {
+                s += T::from_f64_rounded(self.gamma1[i][j]) * w[j];
+            }
+            s
+        });
+        (x, w)
+    }
+}
