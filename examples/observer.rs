@@ -33,11 +33,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut ks = [models::FIVE_STOREY_STIFFNESS; 5];
     ks[0] *= 0.9;
     let (_, k_true) = models::shear_building([models::FIVE_STOREY_MASS; 5], ks);
-    let truth = LinearInput::<f64, 5, 1>::from_rows(m, c, k_true, base_excitation(&m), H)?;
+    let truth = LinearInput::<f64, 5, 1>::from_rows_f64(m, c, k_true, base_excitation(&m), H)?;
 
     // The observer: the model's discrete state space, the accelerometers, the drift readout
     // and the steady-state Kalman gain (process noise: white forces on every floor).
-    let model = StateSpace::aem_from_rows(m, c, k, base_excitation(&m), H)?;
+    let model = StateSpace::from_rows_aem(m, c, k, base_excitation(&m), H)?;
     let meas = model.outputs(&Outputs::absolute_accelerations(
         Outputs::<5, 1, 2>::select(SENSORS),
         0,
@@ -45,13 +45,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let drifts = model.outputs(&Outputs::displacements(models::storey_drifts::<5>()))?;
     let mut unit_forces = [[0.0; 5]; 5];
     (0..5).for_each(|i| unit_forces[i][i] = 1.0);
-    let forces = StateSpace::aem_from_rows(m, c, k, unit_forces, H)?;
+    let forces = StateSpace::from_rows_aem(m, c, k, unit_forces, H)?;
     let mut qf = [[0.0; 5]; 5];
     (0..5).for_each(|i| qf[i][i] = SIGMA_F * SIGMA_F);
     let r = [[SIGMA_Y * SIGMA_Y, 0.0], [0.0, SIGMA_Y * SIGMA_Y]];
-    let gain = SteadyState::solve(&model, &meas, &forces.input_noise(&qf), &r)?;
-    let obs = Observer::<f64, 10, 1, 2>::from_parts(&model, &meas, &gain.gain)?;
-    let readout = Readout::<f64, 10, 1, 5>::from_parts(&drifts)?;
+    let gain = SteadyState::from_parts(&model, &meas, &forces.input_noise(&qf), &r)?;
+    let obs = Observer::<f64, 10, 1, 2>::from_parts_f64(&model, &meas, &gain.gain)?;
+    let readout = Readout::<f64, 10, 1, 5>::from_parts_f64(&drifts)?;
 
     let w = |a: f64| SVector::from([a]);
     let zero = SVector::zeros();
