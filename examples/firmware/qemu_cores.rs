@@ -13,7 +13,7 @@
 //! CORE <form> <T> <N> <instructions per step> <multiply-adds> <symbol>
 //! ```
 //!
-//! Method as `examples/qemu_cost.rs`: SysTick counts the core clock, which `-icount
+//! Method as `examples/firmware/qemu_cost.rs`: SysTick counts the core clock, which `-icount
 //! shift=0` ties to the instruction count (`fw::TICK_NS_X2`, set per board by
 //! `--cfg aemstep_board="…"`, checked against 100 000 `nop`s first); a case times `reps`
 //! steps and subtracts the same loop around an empty out-of-line call.
@@ -42,7 +42,7 @@ use nalgebra::{SVector, vector};
 /// Step (s) of the `Linear` cases; the cost does not depend on it.
 const H: f64 = 0.01;
 
-/// An `N`-storey uniform shear building with Rayleigh damping, as `examples/qemu_cost.rs`.
+/// An `N`-storey uniform shear building with Rayleigh damping, as `examples/firmware/qemu_cost.rs`.
 const fn building<const N: usize>() -> (Rows<N>, Rows<N>, Rows<N>) {
     let (m, k) = shear_building([1.0e5; N], [1.0e8; N]);
     let c = rayleigh(&m, &k, 0.5, 1.0e-3);
@@ -145,7 +145,7 @@ const BUILDING5: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();
 const ROOF: [[f64; 5]; 1] = [[0.0, 0.0, 0.0, 0.0, 1.0]];
 
 /// `Modal<$t, 5, 2>` of the benchmark building (modes solved by the compiler), one step
-/// and the roof drift: `R·I + 7R + O·R = 18` multiply-adds (as `examples/qemu_modal.rs`).
+/// and the roof drift: `R·I + 7R + O·R = 18` multiply-adds (as `examples/firmware/qemu_modal.rs`).
 macro_rules! modal {
     ($syst:expr, $t:ident, $reps:expr, $sym:ident) => {{
         static S: Modal<$t, 5, 2> = match from_rows!(

@@ -17,7 +17,7 @@
 //!
 //! Run: `cargo run -p aemstep-firmware --features defmt --release --target
 //! thumbv7em-none-eabihf --example qemu_defmt | defmt-print -e
-//! target/thumbv7em-none-eabihf/release/examples/qemu_defmt` (or `bash scripts/qemu.sh`).
+//! target/thumbv7em-none-eabihf/release/examples/firmware/qemu_defmt` (or `bash scripts/qemu.sh`).
 #![no_std]
 #![no_main]
 

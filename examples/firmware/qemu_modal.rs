@@ -13,7 +13,7 @@
 //! and exits with failure if the difference exceeds the truncation bound measured there.
 //!
 //! Before the timer starts it counts the instructions of one step (SysTick under
-//! `-icount shift=0`, as `examples/qemu_cost.rs`) for `Modal<f32, 5, R>`, R = 1…5 (step
+//! `-icount shift=0`, as `examples/firmware/qemu_cost.rs`) for `Modal<f32, 5, R>`, R = 1…5 (step
 //! and roof output), the full `LinearInput<f32, 5, 1>` and the full `Linear<f32, 5>` fed
 //! `p = B a_g`, and prints one `COST` line each.
 //!

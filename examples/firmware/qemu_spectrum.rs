@@ -13,7 +13,7 @@
 //! the whole spectrum against the host's `f32` run (hash). Exits with failure otherwise.
 //!
 //! Before the timer starts it counts the instructions per incoming sample (SysTick under
-//! `-icount shift=0`, as `examples/qemu_cost.rs`), averaged over the whole record (the
+//! `-icount shift=0`, as `examples/firmware/qemu_cost.rs`), averaged over the whole record (the
 //! sub-step walks happen where a peak can rise, so the cost varies from sample to sample),
 //! of `Bank<f32, 10>` (periods 0.05–5 s) and `Bank<f32, 100>`, and prints
 //! `COST spectrum_P10 <instructions> <multiply-adds>` and `COST spectrum_P100 …`
