@@ -30,6 +30,7 @@ const STEADY_RESIDUAL: f64 = 1e-9;
 
 /// The steady-state solution of the joint input–state filter (all `f64`, row-major).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct InputStateGains<const S: usize, const I: usize, const O: usize> {
     /// `P⁻` (`S×S`): the a-priori error covariance of `ξ` (units of `x` squared).
     pub covariance: [[f64; S]; S],
