@@ -366,7 +366,8 @@ pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
 /// use aemstep::estimation::{InputModel, InputStateGains, InputStateObserver};
 /// use aemstep::models;
 /// use aemstep::observer::{Outputs, StateSpace};
-/// use aemstep::nalgebra::{SMatrix, vector};
+/// use aemstep::nalgebra::SMatrix;
+/// use aemstep::vector;
 ///
 /// // The 5-storey building, an unknown force at the roof; absolute accelerations of
 /// // floors 1, 3, 5 and the roof displacement measured (fixed base: no ground input).
