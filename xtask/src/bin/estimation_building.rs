@@ -423,15 +423,15 @@ fn acceleration_only(md: &mut String) {
     let mut est: [(Vec<SVector<f64, 10>>, Vec<f64>); 3] =
         core::array::from_fn(|_| (vec![SVector::zeros()], vec![0.0]));
     let mut trace = Vec::new();
-    for k in 1..n {
-        tv.try_step(&mut s, &ys[k]).unwrap();
+    for (k, y) in ys.iter().enumerate().skip(1) {
+        tv.try_step(&mut s, y).unwrap();
         est[0].0.push(tv.state(&s));
         est[0].1.push(s.estimate().input()[0]);
-        kf.try_step(&mut ks, &SVector::zeros(), &ys[k]).unwrap();
+        kf.try_step(&mut ks, &SVector::zeros(), y).unwrap();
         let (xa, wa) = aug.split(ks.estimate().x());
         est[1].0.push(xa);
         est[1].1.push(wa[0]);
-        df.try_step(&mut de, &ys[k]).unwrap();
+        df.try_step(&mut de, y).unwrap();
         est[2].0.push(df.state(&de));
         est[2].1.push(de.input()[0]);
         if k % (120.0 / H) as usize == 0 {
