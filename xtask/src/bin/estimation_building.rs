@@ -619,22 +619,30 @@ use aemstep::vector;
 let (m, c, k) = models::five_storey_building();
 let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
 let ss = StateSpace::<5, 10, 1>::aem_from_rows(m, c, k, roof, 0.02)?;
-// Process noise on the state (unmodelled forces of 100 N per floor) and sensor noise.
-let q = SMatrix::<f64, 10, 10>::identity() * 1e-14;
+// Process noise Q on the state: unmodelled white forces of σ = 100 N on every floor, through
+// the same model with those forces as inputs (B = I): Q = (Γ₀ + Γ₁) σ² I (Γ₀ + Γ₁)ᵀ.
+let (mut b, mut qf) = ([[0.0; 5]; 5], [[0.0; 5]; 5]);
+for i in 0..5 {
+    b[i][i] = 1.0;
+    qf[i][i] = 100.0 * 100.0; // N²
+}
+let qr = StateSpace::<5, 10, 5>::aem_from_rows(m, c, k, b, 0.02)?.input_noise(&qf);
+let q = SMatrix::<f64, 10, 10>::from_fn(|i, j| qr[i][j]);
 
 // Accelerations of floors 1, 3, 5 alone: a constant force and its static displacement give
-// no acceleration, and the check says so when the gains are built.
+// no acceleration, and the check says so when the gains are built. Sensor noise R: each
+// accelerometer σ = 0.03 m/s².
 let acc = Outputs::accelerations(Outputs::<5, 1, 3>::select([0, 2, 4]));
 let acc_only = InputModel::from_parts(&ss, &ss.outputs(&acc)?)?;
-let r3 = SMatrix::<f64, 3, 3>::identity() * 1e-3;
+let r3 = SMatrix::<f64, 3, 3>::identity() * 9e-4;
 assert_eq!(InputStateGains::new(&acc_only, &q, &r3), Err(Error::InputNotIdentifiable));
 
-// The same accelerometers and the roof displacement (m): identifiable.
+// The same accelerometers and the roof displacement (m, σ = 0.1 mm): identifiable.
 let mut out = Outputs::<5, 1, 4>::zero();
 out.a = [[1.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 1.0], [0.0; 5]];
 out.u[3] = [0.0, 0.0, 0.0, 0.0, 1.0];
 let model = InputModel::from_parts(&ss, &ss.outputs(&out)?)?;
-let r = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e-3, 1e-3, 1e-3, 1e-8]);
+let r = SMatrix::<f64, 4, 4>::from_diagonal(&vector![9e-4, 9e-4, 9e-4, 1e-8]);
 let gains = InputStateGains::new(&model, &q, &r)?; // `solve` is the `const fn` twin
 let f = InputStateObserver::<f32, 10, 1, 4>::new(&model, &gains)?;
 let drifts = Readout::<f32, 10, 1, 5>::new(
@@ -696,9 +704,12 @@ fixed seeds, no timing) — do not edit by hand; `python3 scripts/check_docs.py`
     acceleration_only(&mut md);
     let _ = writeln!(
         md,
-        "\nThe filters that still run follow the force's oscillating part but not the static pair: its error \
-         is never corrected and wanders with the force's and the noise's low-frequency content. With a \
-         displacement sensor this is gone (below).\n"
+        "\nNone of the filters that still run gives a usable estimate. The static pair's error is never \
+         corrected: in the time-varying joint filter and the dual filter it wanders, driven by the noise and the \
+         force's low-frequency content, far beyond the force itself (the joint filter's error grows window after \
+         window; the dual filter's error dynamics keep the eigenvalue 1); the augmented KF stays \
+         bounded only because its force estimate stays small. One displacement sensor removes the zero at \
+         z = 1 (below).\n"
     );
 
     // One force at the roof, + roof displacement.
