@@ -671,8 +671,8 @@ The crate's schemes carry the load at both ends of a step, `x_n = Φ x_{n−1} +
 while the filters are written for `ξ_n = A ξ_{n−1} + B w_{n−1}`, `y_n = C ξ_n + D̃ w_n`. With
 `ξ = x − Γ₁ w` the two are the same model exactly: `A = Φ`, `B = Φ Γ₁ + Γ₀`, `C = H`,
 `D̃ = H Γ₁ + D`, and the physical state is `x̂ = ξ̂ + Γ₁ ŵ`
-(derivation and the identifiability conditions: the rustdoc of `aemstep::estimation`,
-[module docs](https://docs.rs/aemstep/latest/aemstep/estimation/index.html); `tests/estimation.rs`
+(derivation and the identifiability conditions: the module docs of `aemstep::estimation`,
+`cargo doc --open` or [on docs.rs](https://docs.rs/aemstep/latest/aemstep/estimation/index.html); `tests/estimation.rs`
 drives the form with a known force and reproduces the stepper to rounding).
 
 "##;
@@ -691,7 +691,7 @@ fixed seeds, no timing) — do not edit by hand; `python3 scripts/check_docs.py`
          load is a wind-like force at the roof: white noise (xorshift64*, Irwin–Hall normal samples, fixed seeds) \
          through a 4th-order Butterworth low-pass at 5 Hz (two bilinear sections, pre-warped), scaled to an RMS of \
          {:.0} kN. The truth is the AEM stepper (`Linear`). Measured: absolute accelerations of floors 1, 3 and 5 \
-         (fixed base: the relative ones) and, from the second section on, displacements; each sensor with white \
+         (fixed base: the relative ones) and, after the acceleration-only section, one or two floor displacements; each sensor with white \
          noise of σ = 3 % of its noise-free signal's RMS over the run. Process noise for the filters: white forces \
          of σ = {SIGMA_F:.0} N on every floor; measurement noise: the sensors' σ²; the augmented and dual filters' \
          random walk: σ = {:.0} kN per step. All estimators start at rest.\n",
