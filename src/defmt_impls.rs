@@ -10,6 +10,10 @@
 
 use defmt::{Format, Formatter, write};
 
+use crate::estimation::smoother::{FixedLag, FixedLagState};
+use crate::estimation::{
+    InputStateFilter, InputStateFilterState, InputStateObserver, JointEstimate, dual::DualFilter,
+};
 use crate::hysteresis::{EnergyAccount, Law, ShearBuilding, Trial};
 use crate::observer::{
     Estimate, Kalman, KalmanState, Measurement, Observer, Outputs, Readout, StateSpace, SteadyState,
@@ -313,5 +317,106 @@ impl<const S: usize, const I: usize, const O: usize> Format for Measurement<S, I
 impl<const S: usize, const O: usize> Format for SteadyState<S, O> {
     fn format(&self, f: Formatter) {
         write!(f, "SteadyState {{ S: {=usize}, O: {=usize} }}", S, O)
+    }
+}
+
+// Joint input–state estimation: estimates print their numbers, filters their sizes.
+
+impl<T: Real + Format, const S: usize, const I: usize> Format for JointEstimate<T, S, I> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "JointEstimate {{ n: {}, missing: {}, xi: {}, input: {} }}",
+            self.steps(),
+            self.missing(),
+            self.xi().as_slice(),
+            self.input().as_slice()
+        )
+    }
+}
+
+impl<T: Real + Format, const S: usize, const I: usize, const O: usize> Format
+    for InputStateFilterState<T, S, I, O>
+{
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "InputStateFilterState {{ estimate: {}, covariance (columns): {}, cross_covariance (columns): {}, input_covariance (columns): {} }}",
+            self.estimate(),
+            self.covariance().as_slice(),
+            self.cross_covariance().as_slice(),
+            self.input_covariance().as_slice()
+        )
+    }
+}
+
+impl<T: Real + Format, const S: usize, const I: usize, const L: usize> Format
+    for FixedLagState<T, S, I, L>
+{
+    fn format(&self, f: Formatter) {
+        let (x, w) = self.lagged();
+        write!(
+            f,
+            "FixedLagState {{ n: {}, missing: {}, filtered: {}, lagged: {}, lagged_input: {} }}",
+            self.steps(),
+            self.missing(),
+            self.filtered().as_slice(),
+            x.as_slice(),
+            w.as_slice()
+        )
+    }
+}
+
+impl<T: Real + Format, const S: usize, const I: usize, const O: usize> Format
+    for InputStateObserver<T, S, I, O>
+{
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "InputStateObserver {{ S: {=usize}, I: {=usize}, O: {=usize}, h: {} }}",
+            S,
+            I,
+            O,
+            self.time_step()
+        )
+    }
+}
+
+impl<T: Real + Format, const S: usize, const I: usize, const O: usize> Format
+    for DualFilter<T, S, I, O>
+{
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "DualFilter {{ S: {=usize}, I: {=usize}, O: {=usize}, h: {} }}",
+            S,
+            I,
+            O,
+            self.time_step()
+        )
+    }
+}
+
+impl<T: Real, const S: usize, const I: usize, const O: usize> Format
+    for InputStateFilter<T, S, I, O>
+{
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "InputStateFilter {{ S: {=usize}, I: {=usize}, O: {=usize} }}",
+            S, I, O
+        )
+    }
+}
+
+impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize> Format
+    for FixedLag<T, S, I, O, L>
+{
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "FixedLag {{ S: {=usize}, I: {=usize}, O: {=usize}, L: {=usize} }}",
+            S, I, O, L
+        )
     }
 }

@@ -32,6 +32,7 @@ use crate::{Error, Real};
 /// The augmented model of an [`InputModel`] with `S` states and `I` inputs: `Z = S + I`
 /// states (checked: [`Error::StateSizeMismatch`]), `O` measurements; `f64`, row-major.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct AugmentedModel<const S: usize, const I: usize, const Z: usize, const O: usize> {
     /// `[A B; 0 I]` as a model with no known input (`Γ₀ = Γ₁ = 0`, no output maps: use
     /// the measurement).

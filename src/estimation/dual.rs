@@ -36,6 +36,7 @@ use crate::{Error, Real};
 
 /// The steady gains of a [`DualFilter`] (`f64`, row-major).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DualGains<const S: usize, const I: usize, const O: usize> {
     /// The input stage's Kalman solution: `G_w` (`I×O`) is its `gain`.
     pub input: SteadyState<I, O>,

@@ -30,6 +30,7 @@ const STEADY_RESIDUAL: f64 = 1e-9;
 
 /// The steady-state solution of the joint input–state filter (all `f64`, row-major).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct InputStateGains<const S: usize, const I: usize, const O: usize> {
     /// `P⁻` (`S×S`): the a-priori error covariance of `ξ` (units of `x` squared).
     pub covariance: [[f64; S]; S],
@@ -365,7 +366,8 @@ pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
 /// use aemstep::estimation::{InputModel, InputStateGains, InputStateObserver};
 /// use aemstep::models;
 /// use aemstep::observer::{Outputs, StateSpace};
-/// use aemstep::nalgebra::{SMatrix, vector};
+/// use aemstep::nalgebra::SMatrix;
+/// use aemstep::vector;
 ///
 /// // The 5-storey building, an unknown force at the roof; absolute accelerations of
 /// // floors 1, 3, 5 and the roof displacement measured (fixed base: no ground input).

@@ -129,6 +129,7 @@ use crate::observer::{Measurement, StateSpace, is_covariance, lu_of, symmetrize}
 /// [module docs](self)): `ξ_{n} = A ξ_{n−1} + B w_{n−1}`, `y_n = C ξ_n + D̃ w_n`, with
 /// `ξ = x − Γ₁ w`, `S` states, `I` unknown inputs, `O` measurements; `f64`, row-major.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct InputModel<const S: usize, const I: usize, const O: usize> {
     /// `A = Φ` (`S×S`).
     pub a: [[f64; S]; S],
