@@ -1,7 +1,7 @@
 //! Firmware: an observer loop from a timer interrupt on a Cortex-M4F (QEMU `mps2-an386`):
 //! every storey drift of the 5-storey building estimated from two accelerometers.
 //!
-//! The scene of `examples/observer_building.rs` (`scenes/observer/scene.rs`): the
+//! The scene of `xtask/src/bin/observer_building.rs` (`scenes/observer/scene.rs`): the
 //! model, its discrete state-space form, the accelerometers and the steady-state Kalman
 //! gain are `static`s computed by the compiler (`Observer<f32, 10, 1, 2>`: no
 //! factorization or Riccati code in flash). The main loop plays the sensors: it steps the

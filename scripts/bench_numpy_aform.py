@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 """The numpy comparator for `AForm`: a plain numpy loop of the paper's literal A-form,
 U_n = A U_{n-1} + b p_n (U = (q, v, u), A is 3N x 3N, b is 3N x N: 12N^2 multiply-adds a
-step), on the same random systems as `benches/steps.rs` (same generator and seed), h = 0.01.
+step), on the same random systems as `xtask/benches/steps.rs` (same generator and seed), h = 0.01.
 
 Not part of the test command (numpy comes from PyPI: `pip install numpy`). Run it beside
-`cargo bench --bench steps -- 'step/f64/aem-aform'` and compare (docs/performance.md):
+`cargo bench -p xtask --bench steps -- 'step/f64/aem-aform'` and compare (docs/performance.md):
 
     python3 scripts/bench_numpy_aform.py [N ...]
 
@@ -18,7 +18,7 @@ import numpy as np
 
 
 def rng(seed):
-    """The xorshift generator of benches/steps.rs, values in [-1, 1)."""
+    """The xorshift generator of xtask/benches/steps.rs, values in [-1, 1)."""
     s = seed & 0xFFFFFFFFFFFFFFFF
     while True:
         s ^= (s << 13) & 0xFFFFFFFFFFFFFFFF

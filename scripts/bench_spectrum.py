@@ -6,10 +6,10 @@ accuracy tables and test measurements, every number from a command run here.
     pip install sdof          # the comparator (only this script needs it)
     python3 scripts/bench_spectrum.py [--quick]
 
-Runs, in this order: sdof timed; `cargo bench --features std --bench spectrum`; sdof timed
+Runs, in this order: sdof timed; `cargo bench -p xtask --bench spectrum`; sdof timed
 again (so a change of machine load between the two shows); the accuracy tables
-(`cargo run --release --features std --example spectrum -- --tables`); the CSV spectra and
-the plot (`... --example spectrum -- --out docs`); the measurements printed by
+(`cargo run --release -p xtask --bin spectrum -- --tables`); the CSV spectra and
+the plot (`... --bin spectrum -- --out docs`); the measurements printed by
 `cargo test --release --features std --test spectrum`; the firmware under QEMU
 (`cargo run --release --target thumbv7em-none-eabihf --features qemu --example qemu_spectrum`).
 
@@ -105,7 +105,7 @@ def main():
     ag = elcentro()
     load0 = os.getloadavg()
     sdof_before = time_sdof(ag)
-    bench_args = ["cargo", "bench", "--features", "std", "--bench", "spectrum"]
+    bench_args = ["cargo", "bench", "-p", "xtask", "--bench", "spectrum"]
     if "--quick" in sys.argv:
         bench_args += ["--", "--quick"]
     bench_out = sh(bench_args)
@@ -113,12 +113,12 @@ def main():
     sdof_after = time_sdof(ag)
     load1 = os.getloadavg()
     res = criterion()
-    tables = sh(["cargo", "run", "-q", "--release", "--features", "std", "--example", "spectrum", "--", "--tables"])
-    files = sh(["cargo", "run", "-q", "--release", "--features", "std", "--example", "spectrum", "--", "--out", "docs"])
+    tables = sh(["cargo", "run", "-q", "--release", "-p", "xtask", "--bin", "spectrum", "--", "--tables"])
+    files = sh(["cargo", "run", "-q", "--release", "-p", "xtask", "--bin", "spectrum", "--", "--out", "docs"])
     tests = sh(["cargo", "test", "-q", "--release", "--features", "std", "--test", "spectrum", "--",
                 "--nocapture", "--test-threads", "1"])
     lin = [np.array([float(x) for x in l.split()]) for l in sh(
-        ["cargo", "run", "-q", "--release", "--features", "std", "--example", "spectrum", "--", "--linear-sd"]
+        ["cargo", "run", "-q", "--release", "-p", "xtask", "--bin", "spectrum", "--", "--linear-sd"]
     ).split("\n") if l.strip()]
     sd_sdof = sdof.spectrum(ag, DT, 0.05, periods=np.linspace(0.01, 10.0, 100), threads=1)[0][1]
     d_aem = np.abs(sd_sdof - lin[0]) / lin[0]
@@ -141,7 +141,7 @@ def main():
     w("`sdof.spectrum(ag, dt, 0.05, periods, threads=1)` (its C path, one thread; it takes the periods as a linear range, so the")
     w("comparison uses 100 periods spaced linearly from `0.01 s` to `10 s` for both) was timed "
       f"{REPS} times before and {REPS} times after")
-    w("`cargo bench --features std --bench spectrum` in the same run; the benchmark times each spectrum by criterion")
+    w("`cargo bench -p xtask --bench spectrum` in the same run; the benchmark times each spectrum by criterion")
     w("(20 samples; the median of its per-sample means is shown) and then as 200 single calls (`sdof`: the median")
     w("of its calls). Times are wall-clock on a shared machine; the ratio compares the fastest single call of each side (the same estimator on both, the")
     w("least disturbed by the other processes).\n")
@@ -168,12 +168,12 @@ def main():
     w("`sdof` is given Newmark's average acceleration (its defaults β = 1/4, γ = 1/2: the AEM's scheme). Its Sd")
     w(f"differs from the bank's \"AEM, no sub-steps\" by {100 * d_aem.max():.1f} % at most (median {100 * np.median(d_aem):.1f} %), <!-- peer run -->")
     w(f"from the exact scheme with the default rule by {100 * d_exact.max():.1f} % at most (median {100 * np.median(d_exact):.1f} %; <!-- peer run -->")
-    w("`cargo run --release --features std --example spectrum -- --linear-sd` against `sdof.spectrum`). The like-for-like")
+    w("`cargo run --release -p xtask --bin spectrum -- --linear-sd` against `sdof.spectrum`). The like-for-like")
     w("comparison is therefore the \"no sub-steps\" rows; the default rule also searches the peaks between samples")
     w("(accuracy below).\n")
     w("### Batch throughput (host timings)\n")
     w("`spectrum::batch::spectra`: 32 records (El Centro scaled), `Bank<f64, 100>` (log periods, exact,")
-    w("default rule), from `cargo bench --features std --bench spectrum` (group `batch32`).\n")
+    w("default rule), from `cargo bench -p xtask --bench spectrum` (group `batch32`).\n")
     w("| threads | host: fastest (ms) for 32 records | host: records / s |")
     w("|---:|---:|---:|")
     for key in sorted(k for k in res if k.startswith("batch32/")):
@@ -197,13 +197,13 @@ def main():
     w("## Accuracy\n")
     w("The tables (peak error against the sub-step count, the sub-step rule, free vibration after the")
     w("record, schemes and precision) are in [spectrum_tables.md](spectrum_tables.md), generated by")
-    w("`cargo run --release --features std --example spectrum -- --tables` and re-checked by the test command.")
+    w("`cargo run --release -p xtask --bin spectrum -- --tables` and re-checked by the test command.")
     w("`tests/spectrum.rs` checks the bank against closed forms (step and harmonic ground motion, every period)")
     w("and independent computations (Nigam–Jennings steps and a small-step RK4 on El Centro), each against a")
     w("bound derived in the test; `cargo test --release --features std --test spectrum -- --nocapture` prints")
     w("the measured ratios.\n")
     w("## Files\n")
-    w("`cargo run --release --features std --example spectrum -- --out docs` read `data/` (the one-column")
+    w("`cargo run --release -p xtask --bin spectrum -- --out docs` read `data/` (the one-column")
     w("El Centro file and its `.AT2` re-formatting) and wrote:\n")
     for line in files.splitlines():
         w(f"- `{line}`")

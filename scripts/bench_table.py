@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Turn criterion's output of `cargo bench --bench steps` into the README's tables.
+"""Turn criterion's output of `cargo bench -p xtask --bench steps` into the README's tables.
 
 Reads target/criterion/**/new/{benchmark,estimates}.json (median estimates) and prints
 Markdown: time per step against N for every scheme and scalar type, the multiply-add
@@ -88,7 +88,7 @@ for n in [25, 50, 100]:
 SIZE = {"f64": 8, "f32": 4}
 for ty in ["f64", "f32"]:
     peak = fast.get(("floor", f"compute-{ty}", None)) or fast.get(("floor", f"compute-{ty}", ""))
-    macs = elements.get(("floor", f"compute-{ty}", None))  # LANES·256 (benches/steps.rs)
+    macs = elements.get(("floor", f"compute-{ty}", None))  # LANES·256 (xtask/benches/steps.rs)
     peak = macs / peak if peak and macs else None  # multiply-adds per ns
     print(f"\n`Linear<{ty}, N>` against the floor (fastest sample; compute peak of this run "
           f"(AVX where the CPU has it) {peak:.1f} multiply-adds per ns; operators {3 * SIZE[ty]}N² bytes):\n" if peak else "")

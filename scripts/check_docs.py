@@ -58,7 +58,8 @@ README_LIMIT = 12288
 
 
 def example(name, *args):
-    return ["cargo", "run", "-q", "--release", "--example", name] + (["--"] + list(args) if args else [])
+    """A page generator: a binary of the `xtask` workspace member (xtask/src/bin/NAME.rs)."""
+    return ["cargo", "run", "-q", "--release", "-p", "xtask", "--bin", name] + (["--"] + list(args) if args else [])
 
 
 def fenced(title, command, what):
@@ -80,7 +81,7 @@ GENERATED = {
         out="stdout",
         wrap=fenced(
             "Energy of the nonlinear stepper: measured",
-            "cargo run --release --example energy",
+            "cargo run --release -p xtask --bin energy",
             "deterministic IEEE arithmetic, no timing",
         ),
     ),
@@ -89,7 +90,7 @@ GENERATED = {
         out="stdout",
         wrap=(
             "# The 5-storey building under El Centro: measured\n\n"
-            "Produced by `cargo run --release --example modal_building`. Generated page: "
+            "Produced by `cargo run --release -p xtask --bin modal_building`. Generated page: "
             "`python3 scripts/check_docs.py --write` writes it; the test command regenerates it "
             "and compares every number except the columns headed \"host\", which are host "
             "timings (this machine, best of 7 passes; they vary by up to 2x between runs).\n\n",
@@ -98,11 +99,11 @@ GENERATED = {
     ),
     "docs/tradeoff.md": dict(cmd=example("tradeoff", "{dir}"), out="file"),
     "docs/spectrum_tables.md": dict(
-        cmd=["cargo", "run", "-q", "--release", "--features", "std", "--example", "spectrum", "--", "--tables"],
+        cmd=example("spectrum", "--tables"),
         out="stdout",
         wrap=(
             "# Response spectra: accuracy tables\n\n"
-            "Produced by `cargo run --release --features std --example spectrum -- --tables` "
+            "Produced by `cargo run --release -p xtask --bin spectrum -- --tables` "
             "(deterministic IEEE arithmetic, no timing). Generated page: "
             "`python3 scripts/check_docs.py --write` writes it; the test command regenerates it and "
             "fails when a number differs by more than one unit in its last printed digit.\n\n",

@@ -18,10 +18,13 @@ step "format and lints"
 cargo fmt --all -- --check || fail "cargo fmt: run 'cargo fmt --all'"
 cargo clippy --all-targets -- -D warnings || fail "clippy"
 cargo clippy --all-targets --features std -- -D warnings || fail "clippy (std)"
+cargo clippy -p xtask --all-targets -- -D warnings || fail "clippy (xtask: page generators, benchmarks)"
 
 step "host tests (debug: overflow checks on)"
 tests cargo test --all-targets --features std || fail "host tests (with the host-only std feature)"
 tests cargo test --doc --features std || fail "doctests"
+# The page generators and benchmarks (workspace member xtask/): build, benchmarks run once each.
+tests cargo test -p xtask --all-targets || fail "xtask tests (generators, benchmarks once)"
 
 step "long host tests (release)"
 tests cargo test --release --all-targets --features std -- --ignored || fail "long tests"
@@ -35,7 +38,19 @@ bash scripts/fuzz.sh ||
     fail "fuzzing found a crash (scripts/fuzz.sh; inputs in fuzz/target/fuzz-run/<target>/crash-*)"
 
 step "energy behaviour of the nonlinear stepper (numbers quoted in README.md)"
-cargo run --release --example energy || fail "energy example"
+cargo run --release -p xtask --bin energy || fail "energy example"
+
+step "the examples a user runs first: they run and print their units"
+out=$(mktemp)
+cargo run -q --release --example yielding_building > "$out" || fail "yielding_building example"
+grep -q 'peak drift (m)' "$out" && grep -q 'kN' "$out" && grep -q 'ductility' "$out" ||
+    fail "yielding_building: drifts (m), base shear (kN), ductility expected"
+cargo run -q --release --example spectrum_csv > "$out" || fail "spectrum_csv example"
+[ "$(head -1 "$out")" = "period_s,sd_m,sv_m_per_s,sa_g" ] && [ "$(wc -l < "$out")" -eq 51 ] ||
+    fail "spectrum_csv: a header and 50 rows expected"
+cargo run -q --release --example observer > "$out" || fail "observer example"
+grep -q 'RMS drift error (m)' "$out" || fail "observer: RMS drift errors (m) expected"
+rm -f "$out"
 
 step "no_std builds for thumb targets"
 for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi thumbv8m.main-none-eabihf; do

@@ -4,7 +4,7 @@
 //! 0 < t ≤ 20 s (2000 steps), `f32`, exactly 2 Newton iterations a step.
 //!
 //! The run itself (`trajectory`, Newton tolerance `TOL`, exact solution and load) is
-//! `tests/support/duffing.rs`, which `examples/verification.rs` prints from.
+//! `tests/support/duffing.rs`, which `xtask/src/bin/verification.rs` prints from.
 //!
 //! This test is where the firmware's bound comes from: it measures the same f32 error and
 //! asserts the same bound (`FIRMWARE_BOUND`, copied into the firmware as `BOUND`), and

@@ -5,7 +5,7 @@
 //!
 //! Every bound is derived (from the method's error or rounding) and quoted next to the
 //! value measured when it was set; `docs/hysteresis.md` gives the figures and
-//! `cargo run --release --example hysteresis_report` prints them.
+//! `cargo run --release -p xtask --bin hysteresis_report` prints them.
 
 #[path = "../scenes/hysteretic/building.rs"]
 mod building;
@@ -550,8 +550,8 @@ fn el_centro_energy_balance_closes_at_order_2() {
 
 #[test]
 fn docs_quote_the_building_tables_as_computed() {
-    // The rows of docs/hysteresis_figures.md (written by `cargo run --release --example
-    // hysteresis_report`) at h = 2.5 ms and 1.25 ms are fully determined by the runs here:
+    // The rows of docs/hysteresis_figures.md (written by `cargo run --release -p xtask
+    // --bin hysteresis_report`) at h = 2.5 ms and 1.25 ms are fully determined by the runs here:
     // they must appear verbatim, so the page cannot drift from the code even where
     // scripts/check_docs.py does not run.
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/hysteresis_figures.md");

@@ -686,7 +686,7 @@ fn kalman_filter_is_consistent_nees_in_its_95_percent_band() {
 }
 
 // ---------------------------------------------------------------------------------------
-// The scene (examples/observer_building.rs) and the firmware (examples/qemu_observer.rs).
+// The scene (xtask/src/bin/observer_building.rs) and the firmware (examples/qemu_observer.rs).
 
 #[path = "../scenes/observer/reference.rs"]
 mod reference;

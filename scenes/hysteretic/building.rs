@@ -1,7 +1,7 @@
 //! The yielding 3-storey shear building of the hysteresis tests, report and firmware:
 //! storey data as `const`s, shared by `examples/qemu_hysteretic.rs` (f32, on target),
 //! `tests/firmware_hysteretic.rs` and `tests/hysteresis.rs` (f64, host) and
-//! `examples/hysteresis_report.rs`.
+//! `xtask/src/bin/hysteresis_report.rs`.
 #![allow(dead_code)] // each includer uses a different subset
 
 use aemstep::hysteresis::{Bilinear, BoucWen, ShearBuilding};

@@ -1,4 +1,4 @@
-//! The observer scene, shared by the host example (`examples/observer_building.rs`), the
+//! The observer scene, shared by the host example (`xtask/src/bin/observer_building.rs`), the
 //! firmware (`examples/qemu_observer.rs`) and the tests (`tests/observer.rs`): the 5-storey
 //! building under El Centro; the "true" structure has a storey-1 stiffness 10 % below the
 //! model's; the absolute accelerations of floors 2 and 5 are measured with noise; the

@@ -34,7 +34,7 @@ use crate::Real;
 
 /// Operators of fewer bytes (`K·N²` values) stay on the inlined SSE2 loop: there a step is
 /// a few tens of nanoseconds and the call's overhead is a fair share of it. Measured with
-/// the threshold at 0 (`cargo bench --bench steps -- 'step/f(32|64)/aem/'`, N = 1…12): AVX
+/// the threshold at 0 (`cargo bench -p xtask --bench steps -- 'step/f(32|64)/aem/'`, N = 1…12): AVX
 /// is slower up to `Linear<f64, 7>` (1176 bytes) and `Linear<f32, 11>` (1452), faster from
 /// `f64` N = 8 (1536) and `f32` N = 12 (1728).
 pub(crate) const MIN_BYTES: usize = 1536;

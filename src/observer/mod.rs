@@ -25,7 +25,7 @@
 //! a parameter of its own, checked at construction: [`Error::StateSizeMismatch`](crate::Error::StateSizeMismatch)),
 //! `I` inputs, `O` measurements.
 //!
-//! The scene (`cargo run --release --example observer_building`, `docs/observer.md`): the
+//! The scene (`cargo run --release -p xtask --bin observer_building`, `docs/observer.md`): the
 //! 5-storey building under El Centro, absolute accelerations of floors 2 and 5 measured,
 //! every drift estimated.
 

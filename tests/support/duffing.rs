@@ -2,7 +2,7 @@
 //! u0 = 0, v0 = 1, `p(t)` chosen so that the exact solution is `u = e^{−0.1t} sin t`, run
 //! as the firmware (`examples/qemu_nonlinear.rs`) runs it: exactly 2 Newton iterations a
 //! step. Shared by `tests/firmware_duffing.rs` (which derives the firmware's bound from
-//! it) and `examples/verification.rs` (which prints it).
+//! it) and `xtask/src/bin/verification.rs` (which prints it).
 #![allow(dead_code)]
 
 use aemstep::models::Duffing;

@@ -1,7 +1,7 @@
 //! Runs of the hysteretic building under El Centro with an energy account kept
 //! independently of the stepper: every energy is a quadrature of sampled powers or a
 //! function of the committed history, written here from the law's parameters.
-//! Shared by `tests/hysteresis.rs` and `examples/hysteresis_report.rs`.
+//! Shared by `tests/hysteresis.rs` and `xtask/src/bin/hysteresis_report.rs`.
 #![allow(dead_code, clippy::type_complexity)]
 
 use aemstep::hysteresis::{HistoryModel, Law, ShearBuilding};

@@ -1,7 +1,7 @@
 //! The law-level figures of `docs/hysteresis_figures.md`: each law driven along prescribed
 //! deformations and compared with a closed form or an independent implementation written
 //! here. Shared by `tests/hysteresis.rs` (which asserts on them) and
-//! `examples/hysteresis_report.rs` (which prints them).
+//! `xtask/src/bin/hysteresis_report.rs` (which prints them).
 #![allow(dead_code)]
 
 use std::f64::consts::PI;

@@ -1,7 +1,7 @@
 //! The paper's conservative nonlinear examples and the runs that track their energy:
 //! Example 6, the pendulum `θ'' + sin θ = 0` (l = g = 9.81), and Example 7, the elastic
 //! pendulum. Shared by `tests/nonlinear.rs` (which asserts on the runs) and
-//! `examples/energy.rs` (which prints them).
+//! `xtask/src/bin/energy.rs` (which prints them).
 #![allow(dead_code)]
 
 use aemstep::{Error, Model, NewtonSettings, Nonlinear, Real, Tangent};

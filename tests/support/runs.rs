@@ -1,7 +1,7 @@
 //! Runs of the crate's linear and time-varying steppers on the paper's examples and on
 //! random systems, measured against the references of `support` (exact solutions, the
 //! independent Newmark loop). Shared by `tests/linear.rs` and `tests/varying.rs` (which
-//! assert bounds on these numbers) and `examples/verification.rs` (which prints them), so
+//! assert bounds on these numbers) and `xtask/src/bin/verification.rs` (which prints them), so
 //! the page and the tests measure the same runs.
 #![allow(dead_code, clippy::needless_range_loop, clippy::type_complexity)]
 

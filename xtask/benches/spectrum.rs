@@ -8,11 +8,11 @@
 //! printed as `FASTEST <id> <seconds>`: the estimator `scripts/bench_spectrum.py` applies
 //! to `sdof.spectrum` too (on a shared machine the fastest call is the least disturbed).
 //!
-//! Run: `cargo bench --features std --bench spectrum` (about a minute);
+//! Run: `cargo bench -p xtask --bench spectrum` (about a minute);
 //! `python3 scripts/bench_spectrum.py` runs it beside `sdof.spectrum` and writes
 //! `docs/spectrum.md`.
 
-#[path = "../scenes/modal/elcentro.rs"]
+#[path = "../../scenes/modal/elcentro.rs"]
 mod elcentro;
 
 use std::hint::black_box;

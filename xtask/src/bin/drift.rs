@@ -11,7 +11,7 @@
 //!   `n·Φ`, `Φ = 2 atan(ωh/2)` computed in `f64` (independent of the stepper), tracked
 //!   unwrapped every 64 steps.
 //!
-//! Run: `cargo run --release --example drift -- STEPS [DIR]` (STEPS defaults to 10⁸;
+//! Run: `cargo run --release -p xtask --bin drift -- STEPS [DIR]` (STEPS defaults to 10⁸;
 //! writes `DIR/drift.md`, DIR defaults to `docs`). The test command regenerates the page
 //! with the page's own step count.
 
@@ -82,7 +82,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = args.get(2).cloned().unwrap_or_else(|| "docs".into());
     let mut md = format!(
         "# A day of `f32` steps: amplitude and phase drift\n\n\
-         Produced by `cargo run --release --example drift -- {steps}` (writes this page; \
+         Produced by `cargo run --release -p xtask --bin drift -- {steps}` (writes this page; \
          deterministic IEEE arithmetic except the columns headed \"host\", host timings of \
          the same run, not checked). The test command regenerates it and compares every \
          other number.\n\n\

@@ -1,7 +1,7 @@
 //! The measured numbers of `docs/verification.md`, computed from scratch against exact
 //! solutions and independent implementations (`tests/support/`), printed as the page.
 //!
-//! Run: `cargo run --release --example verification` (a few seconds). The page is this
+//! Run: `cargo run --release -p xtask --bin verification` (a few seconds). The page is this
 //! program's output: `python3 scripts/check_docs.py --write` writes it, and the test command
 //! (`bash scripts/test.sh`, through `scripts/check_docs.py`) regenerates it and fails when
 //! a committed number differs by more than one unit in its last printed digit.
@@ -9,11 +9,11 @@
 //! The tests in `tests/` assert bounds on the same quantities; this program only measures
 //! and prints. Everything here is deterministic IEEE arithmetic (no timing).
 
-#[path = "../tests/support/duffing.rs"]
+#[path = "../../../tests/support/duffing.rs"]
 mod duffing;
-#[path = "../tests/support/runs.rs"]
+#[path = "../../../tests/support/runs.rs"]
 mod runs;
-#[path = "../tests/support/mod.rs"]
+#[path = "../../../tests/support/mod.rs"]
 mod support;
 
 use aemstep::models::base_excitation;
@@ -80,7 +80,7 @@ fn input_vs_linear<T: Real>() -> f64 {
 
 /// El Centro 1940 NS in m/s² (the data file is in g).
 fn elcentro<T: Real>() -> Vec<T> {
-    let text = include_str!("../data/elcentro-ns-1940.txt");
+    let text = include_str!("../../../data/elcentro-ns-1940.txt");
     text.lines()
         .filter(|l| !l.trim_start().starts_with('#'))
         .flat_map(|l| l.split_whitespace())
@@ -112,7 +112,7 @@ fn duffing<T: Real>(h: f64) -> (f64, u32) {
 fn main() {
     println!("# Verification: measured numbers\n");
     println!(
-        "Produced by `cargo run --release --example verification` (a few seconds; deterministic, no timing).\n\
+        "Produced by `cargo run --release -p xtask --bin verification` (a few seconds; deterministic, no timing).\n\
          Generated page: `python3 scripts/check_docs.py --write` writes it, and the test command\n\
          (`bash scripts/test.sh`) regenerates it and fails when a number differs by more than one\n\
          unit in its last printed digit. The tests in `tests/` assert bounds on the same\n\

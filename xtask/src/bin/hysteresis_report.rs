@@ -4,16 +4,16 @@
 //! convergence orders, Newton iterations, branch changes), and the host twin of the
 //! firmware (f32, fixed iterations, against f64). Deterministic IEEE arithmetic, no timing.
 //!
-//! Run: `cargo run --release --example hysteresis_report` (`python3 scripts/check_docs.py
+//! Run: `cargo run --release -p xtask --bin hysteresis_report` (`python3 scripts/check_docs.py
 //! --write` writes the page; the test command regenerates and compares it).
 
-#[path = "../scenes/hysteretic/building.rs"]
+#[path = "../../../scenes/hysteretic/building.rs"]
 mod building;
-#[path = "../scenes/modal/elcentro.rs"]
+#[path = "../../../scenes/modal/elcentro.rs"]
 mod elcentro;
-#[path = "../tests/support/hyst.rs"]
+#[path = "../../../tests/support/hyst.rs"]
 mod hyst;
-#[path = "../tests/support/laws.rs"]
+#[path = "../../../tests/support/laws.rs"]
 mod laws;
 
 use aemstep::NewtonSettings;
@@ -36,7 +36,7 @@ fn ords(v: &[f64]) -> String {
 fn main() {
     println!("# Hysteresis: measured figures\n");
     println!(
-        "Produced by `cargo run --release --example hysteresis_report` (deterministic IEEE \
+        "Produced by `cargo run --release -p xtask --bin hysteresis_report` (deterministic IEEE \
          arithmetic, no timing). Generated page: `python3 scripts/check_docs.py --write` writes \
          it; the test command regenerates it and fails when a number differs by more than one \
          unit in its last printed digit. Explained in [hysteresis.md](hysteresis.md); \

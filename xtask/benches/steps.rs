@@ -1,9 +1,9 @@
 //! Host benchmarks: time per step against N for every form and scheme, f32 and f64, and
 //! the paper's Example 10 timing table (spec §8) re-run at the same N, t_tot and h.
 //!
-//! Run: `cargo bench --bench steps` (a few minutes), then
+//! Run: `cargo bench -p xtask --bench steps` (a few minutes), then
 //! `python3 scripts/bench_table.py` turns `target/criterion/**/estimates.json` into the
-//! README tables. Filter with e.g. `cargo bench --bench steps -- step/f64`.
+//! README tables. Filter with e.g. `cargo bench -p xtask --bench steps -- step/f64`.
 //!
 //! Beside every stepper, the same run times two references (see `docs/performance.md`):
 //! - `nalgebra-dmatrix`: a plain Newmark average-acceleration loop on `nalgebra::DMatrix`

@@ -3,7 +3,7 @@
 //! model, and what each costs a step on this host.
 //!
 //! ```text
-//! cargo run --release --example modal_building
+//! cargo run --release -p xtask --bin modal_building
 //! ```
 //!
 //! Errors are against the full model `Linear<f64, 5>` at the same step h = 0.02 s (the
@@ -13,7 +13,7 @@
 //! Timing: a loop over the record, best of 7 runs of 100 passes, `black_box` on the input
 //! and the output; ns per step, including reading the one output (roof drift).
 
-#[path = "../scenes/modal/elcentro.rs"]
+#[path = "../../../scenes/modal/elcentro.rs"]
 mod elcentro;
 
 use std::hint::black_box;

@@ -3,7 +3,7 @@
 //! 5-storey building under the El Centro 1940 NS record; and the paper's Figs. 2–3
 //! (period elongation and amplitude decay against h/T) from the `analysis` module.
 //!
-//! Run: `cargo run --release --example tradeoff [DIR]` (a few seconds). Writes
+//! Run: `cargo run --release -p xtask --bin tradeoff [DIR]` (a few seconds). Writes
 //! `DIR/tradeoff.md` (summary and full tables; `DIR` is `docs` unless given),
 //! `DIR/tradeoff_example4.svg`, `DIR/tradeoff_elcentro.svg`, `DIR/period_elongation.svg`,
 //! `DIR/amplitude_decay.svg`, and prints the page. `scripts/check_docs.py` regenerates it
@@ -20,9 +20,9 @@
 //! - Generalized-α and HHT get the load as the textbook scheme does,
 //!   `(1 − α_f) p_n + α_f p_{n−1}` (`step_with_previous_input`).
 
-#[path = "../scenes/modal/elcentro.rs"]
+#[path = "../../../scenes/modal/elcentro.rs"]
 mod elcentro;
-#[path = "../tests/support/mod.rs"]
+#[path = "../../../tests/support/mod.rs"]
 mod support;
 
 use std::fmt::Write as _;
@@ -565,7 +565,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = std::env::args().nth(1).unwrap_or_else(|| "docs".into());
     std::fs::create_dir_all(&dir)?;
     let mut md = String::from(
-        "# Speed against accuracy: full tables\n\nProduced by `cargo run --release --example tradeoff` (checked by `scripts/check_docs.py`). Relative error = max over the step grid of ‖u − u_ref‖∞ / max ‖u_ref‖∞. Columns headed \"host\" are host timings from a timing loop in the same run (this machine, ±30 % between runs; not checked); every other number is deterministic.\n",
+        "# Speed against accuracy: full tables\n\nProduced by `cargo run --release -p xtask --bin tradeoff` (checked by `scripts/check_docs.py`). Relative error = max over the step grid of ‖u − u_ref‖∞ / max ‖u_ref‖∞. Columns headed \"host\" are host timings from a timing loop in the same run (this machine, ±30 % between runs; not checked); every other number is deterministic.\n",
     );
     let ex4 = example4();
     let rows4 = sweep(&ex4);

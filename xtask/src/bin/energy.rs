@@ -6,9 +6,9 @@
 //! - Example 7, the elastic pendulum with gravity, h = 0.01 s to t = 1000 s, in f64 and f32;
 //! - Example 7 without gravity: the step sweep where the energy stops being bounded.
 //!
-//! Run: `cargo run --release --example energy`
+//! Run: `cargo run --release -p xtask --bin energy`
 
-#[path = "../tests/support/pendulums.rs"]
+#[path = "../../../tests/support/pendulums.rs"]
 mod pendulums;
 
 use aemstep::Real;
