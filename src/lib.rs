@@ -209,3 +209,8 @@ pub struct SpectrumDocDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/observer.md")]
 pub struct ObserverDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/detection.md")]
+pub struct DetectionDocDoctests;

@@ -18,6 +18,7 @@ const SKIP: &[(&str, &str)] = &[
     ("HysteresisDocDoctests", "cfg(doctest) marker"),
     ("SpectrumDocDoctests", "cfg(doctest) marker"),
     ("ObserverDocDoctests", "cfg(doctest) marker"),
+    ("DetectionDocDoctests", "cfg(doctest) marker"),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
