@@ -35,8 +35,9 @@
 //! ```
 //! use aemstep::detection::{ChiSquareTest, Detector, Whitener, Window, innovation_covariance};
 //! use aemstep::models::{self, base_excitation};
-//! use aemstep::nalgebra::{SMatrix, vector};
+//! use aemstep::nalgebra::SMatrix;
 //! use aemstep::observer::{Observer, Outputs, StateSpace, SteadyState};
+//! use aemstep::vector;
 //!
 //! let (m, c, k) = models::five_storey_building();
 //! let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02)?;
