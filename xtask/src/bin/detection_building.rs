@@ -196,6 +196,12 @@ fn chi2_upper_tail(k: u64, x: f64) -> f64 {
     1.0 - lp.exp()
 }
 
+/// One sample of a run's trace: the window sum, the CUSUM statistic, the bank's
+/// log-likelihoods.
+type Sample = (f64, f64, [f64; HYPOTHESES]);
+/// A plotted curve: its name, points, colour and line width.
+type Curve = (&'static str, Vec<(f64, f64)>, RGBColor, u32);
+
 /// What one run of the damage scene measured (times in s after the damage).
 struct DamageRun {
     delay: Option<f64>,
@@ -207,7 +213,7 @@ struct DamageRun {
     alarms_before: u32,
     top_before: usize,
     /// Per sample: the window sum, the CUSUM statistic, the bank's log-likelihoods.
-    trace: Vec<(f64, f64, [f64; HYPOTHESES])>,
+    trace: Vec<Sample>,
 }
 
 /// Times (s) at which the bank's top model is recorded.
@@ -419,7 +425,7 @@ fn plot(
     let (top, bottom) = root.split_vertically(450);
     let t_end = 60.0;
     let n_end = ((t_end / H) as usize).min(run.trace.len());
-    let pts = |f: &dyn Fn(&(f64, f64, [f64; HYPOTHESES])) -> f64| -> Vec<(f64, f64)> {
+    let pts = |f: &dyn Fn(&Sample) -> f64| -> Vec<(f64, f64)> {
         run.trace[..n_end]
             .iter()
             .enumerate()
@@ -445,7 +451,7 @@ fn plot(
         .x_desc("t (s)")
         .y_desc("statistic")
         .draw()?;
-    let series: [(&str, Vec<(f64, f64)>, RGBColor, u32); 4] = [
+    let series: [Curve; 4] = [
         (
             "window sum of νᵀS⁻¹ν (150 dof)",
             pts(&|v| v.0.max(1.0)),
