@@ -29,8 +29,9 @@
 //!   the last `W` samples ([`ModelBank::ranking`]).
 //!
 //! Everything is fixed size (`O` measurements, `W` samples, `M` models are const
-//! generics), allocation-free and `no_std`; a missing sample (a non-finite innovation)
-//! is skipped and counted; a failed step changes nothing.
+//! generics), allocation-free and `no_std`; a missing sample (a NaN innovation) is
+//! skipped and counted, while an infinite one enters a window as its capped term (an
+//! alarm, [`Window::push`]); a failed step changes nothing.
 //!
 //! ```
 //! use aemstep::detection::{ChiSquareTest, Detector, Whitener, Window, innovation_covariance};
