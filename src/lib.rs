@@ -214,3 +214,8 @@ pub struct ObserverDocDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/estimation.md")]
 pub struct EstimationDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/detection.md")]
+pub struct DetectionDocDoctests;

@@ -28,7 +28,7 @@ impl<T: Real, const N: usize> State<T, N> {
     ///
     /// ```
     /// use aemstep::{Error, State};
-    /// use aemstep::nalgebra::vector;
+    /// use aemstep::vector;
     /// let s = State::restore(vector![0.1], vector![0.0], vector![-2.5], 40)?;
     /// assert_eq!((s.u()[0], s.steps()), (0.1, 40));
     /// assert_eq!(

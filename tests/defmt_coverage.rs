@@ -19,6 +19,7 @@ const SKIP: &[(&str, &str)] = &[
     ("SpectrumDocDoctests", "cfg(doctest) marker"),
     ("ObserverDocDoctests", "cfg(doctest) marker"),
     ("EstimationDocDoctests", "cfg(doctest) marker"),
+    ("DetectionDocDoctests", "cfg(doctest) marker"),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

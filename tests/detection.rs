@@ -1095,3 +1095,154 @@ fn kalman_innovation_at_steady_state_is_the_observers() {
         .unwrap();
     assert!(nu[0].is_nan() && s.iter().all(|v| v.is_finite()));
 }
+
+// ---------------------------------------------------------------------------------------
+// Properties (in the style of tests/properties.rs): random steps with finite, extreme and
+// non-finite inputs and samples.
+// ---------------------------------------------------------------------------------------
+
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, RngSeed};
+    use std::sync::OnceLock;
+
+    /// The bank's window in these properties (short, so that it fills).
+    const WP: usize = 4;
+
+    type Parts = (
+        ModelBank<f64, 10, 1, 3, 2>,
+        [Whitener<f64, 3>; 2],
+        Detector<f64, 3, WP>,
+        Cusum,
+    );
+
+    /// The intact building and storey 1 softer, built once (a Riccati solution each).
+    fn parts() -> &'static Parts {
+        static PARTS: OnceLock<Parts> = OnceLock::new();
+        PARTS.get_or_init(|| {
+            let r = r_rows([0.2; 3]);
+            let (o0, w0, _) = observer_of(&model([1.0; 5]), &r);
+            let (o1, w1, _) = observer_of(&model(hypothesis(1)), &r);
+            (
+                ModelBank::new([o0, o1], [w0, w1]).unwrap(),
+                [w0, w1],
+                Detector::new(w0, ChiSquareTest::new(3, 0.01).unwrap()),
+                Cusum::new(3, 2.0, 1e-3).unwrap(),
+            )
+        })
+    }
+
+    /// A fixed seed (reproducible), 1500 cases or `AEMSTEP_PROP_CASES`.
+    fn config() -> Config {
+        Config {
+            cases: std::env::var("AEMSTEP_PROP_CASES")
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .unwrap_or(1500),
+            failure_persistence: None,
+            rng_seed: RngSeed::Fixed(21),
+            ..Config::default()
+        }
+    }
+
+    /// A sample or input: ordinary (m/s²), extreme, or not finite.
+    fn entry() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            12 => -10.0f64..10.0,
+            1 => Just(f64::NAN),
+            1 => Just(f64::INFINITY),
+            1 => Just(f64::NEG_INFINITY),
+            1 => Just(1e300),
+            1 => Just(-f64::MAX),
+        ]
+    }
+
+    fn steps() -> impl Strategy<Value = Vec<(f64, [f64; 3])>> {
+        prop::collection::vec((entry(), [entry(), entry(), entry()]), 1..24)
+    }
+
+    proptest! {
+        #![proptest_config(config())]
+
+        /// A failed bank step leaves the state bit-identical (compared through `Debug`,
+        /// so `−0.0` and `0.0` differ). A successful one is each model's observer step
+        /// (a non-finite sample: predicted only, counted missing); its window skips the
+        /// term (counted) exactly when the normalized innovation squared is NaN (a NaN
+        /// sample, or an overflow to `∞ − ∞`) and takes one term otherwise (an infinite
+        /// one is capped: an alarm, see `Window::push`).
+        #[test]
+        fn bank_step_fails_cleanly_and_skips_nan(s in steps()) {
+            let (bank, whiteners, _, _) = parts();
+            let ag = &elcentro::AG_F64;
+            let mut st = bank.start::<WP>(&SVector::zeros(), &SVector::from([ag[0]])).unwrap();
+            for (w, y) in s {
+                let (w, y) = (SVector::from([w]), SVector::from(y));
+                let before = st;
+                let dbg = format!("{before:?}");
+                match bank.try_step(&mut st, &w, &y) {
+                    Err(e) => {
+                        prop_assert_eq!(format!("{st:?}"), dbg);
+                        prop_assert_eq!(
+                            e,
+                            if w[0].is_finite() { Error::NonFiniteState } else { Error::NonFiniteInput }
+                        );
+                    }
+                    Ok(()) => {
+                        prop_assert!(w[0].is_finite());
+                        let finite = y.iter().all(|v| v.is_finite());
+                        for m in 0..2 {
+                            let (wb, wa) = (before.window(m), st.window(m));
+                            let (eb, ea) = (before.estimate(m), st.estimate(m));
+                            prop_assert_eq!(ea.missing(), eb.missing() + u64::from(!finite));
+                            let mut e = *eb;
+                            let nu = bank.observer(m).step_innovation(&mut e, &w, &y);
+                            prop_assert_eq!(format!("{e:?}"), format!("{ea:?}"));
+                            if whiteners[m].nis(&nu).is_nan() {
+                                prop_assert!(!finite || nu.iter().any(|v| v.is_nan()));
+                                prop_assert_eq!(
+                                    (wa.len(), wa.skipped(), wa.sum_fixed()),
+                                    (wb.len(), wb.skipped() + 1, wb.sum_fixed())
+                                );
+                            } else {
+                                prop_assert_eq!(
+                                    (wa.len(), wa.skipped()),
+                                    ((wb.len() + 1).min(WP), wb.skipped())
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+
+        /// The detector and the CUSUM skip a NaN innovation (counted, nothing else
+        /// changed, the decision the one of the window as it was) and push any other.
+        #[test]
+        fn detector_and_cusum_skip_nan(nus in prop::collection::vec([entry(), entry(), entry()], 1..24)) {
+            let (_, _, det, cusum) = parts();
+            let mut win = Window::<WP>::new();
+            let mut cs = CusumState::new();
+            for nu in nus {
+                let nu = SVector::from(nu);
+                let q = det.whitener.nis(&nu);
+                let (wb, cb) = (win, cs);
+                let alarm = det.update(&mut win, &nu);
+                let c_alarm = cusum.update(&mut cs, q);
+                if q.is_nan() {
+                    prop_assert!(nu.iter().any(|v| !v.is_finite()));
+                    prop_assert_eq!((win.len(), win.skipped(), win.sum_fixed()), (wb.len(), wb.skipped() + 1, wb.sum_fixed()));
+                    prop_assert_eq!(alarm, det.test.alarm(&wb));
+                    prop_assert_eq!(cs.statistic().to_bits(), cb.statistic().to_bits());
+                    prop_assert_eq!(cs.skipped(), cb.skipped() + 1);
+                    prop_assert!(!c_alarm);
+                } else {
+                    prop_assert!(q >= 0.0);
+                    prop_assert_eq!((win.len(), win.skipped()), ((wb.len() + 1).min(WP), wb.skipped()));
+                    prop_assert_eq!(cs.skipped(), cb.skipped());
+                    prop_assert!(cs.statistic() >= 0.0);
+                }
+            }
+        }
+    }
+}

@@ -94,7 +94,10 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const M: usize>
     }
 
     /// One step of every model with input `w` (`w_n`) and measurement `y` (a non-finite
-    /// entry: a missing sample, every model predicts only and skips it).
+    /// entry: a missing sample, every model predicts only). Each window skips (and
+    /// counts) a NaN normalized innovation squared — a NaN sample, or `∞ − ∞` — and takes
+    /// an infinite one as its capped term ([`Window::push`]): an infinite sample (its term
+    /// is then usually infinite) weighs against every model for a window's length.
     ///
     /// Errors, `state` unchanged: [`Error::NonFiniteInput`] (`w`),
     /// [`Error::NonFiniteState`] (a model's estimate would not be finite). No allocation,

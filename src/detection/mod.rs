@@ -29,14 +29,16 @@
 //!   the last `W` samples ([`ModelBank::ranking`]).
 //!
 //! Everything is fixed size (`O` measurements, `W` samples, `M` models are const
-//! generics), allocation-free and `no_std`; a missing sample (a non-finite innovation)
-//! is skipped and counted; a failed step changes nothing.
+//! generics), allocation-free and `no_std`; a missing sample (a NaN innovation) is
+//! skipped and counted, while an infinite one enters a window as its capped term (an
+//! alarm, [`Window::push`]); a failed step changes nothing.
 //!
 //! ```
 //! use aemstep::detection::{ChiSquareTest, Detector, Whitener, Window, innovation_covariance};
 //! use aemstep::models::{self, base_excitation};
-//! use aemstep::nalgebra::{SMatrix, vector};
+//! use aemstep::nalgebra::SMatrix;
 //! use aemstep::observer::{Observer, Outputs, StateSpace, SteadyState};
+//! use aemstep::vector;
 //!
 //! let (m, c, k) = models::five_storey_building();
 //! let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02)?;
