@@ -47,7 +47,7 @@ fn built() -> &'static Built {
     static B: OnceLock<Built> = OnceLock::new();
     B.get_or_init(|| {
         let (m, c, k) = models::five_storey_building();
-        let ss = StateSpace::<5, 10, 1>::aem_from_rows(
+        let ss = StateSpace::<5, 10, 1>::from_rows_aem(
             m,
             c,
             k,

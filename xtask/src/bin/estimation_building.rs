@@ -108,7 +108,7 @@ fn rows<const R: usize, const C: usize>(a: &SMatrix<f64, R, C>) -> [[f64; C]; R]
 fn process_noise() -> SMatrix<f64, 10, 10> {
     let eye: [[f64; 5]; 5] =
         core::array::from_fn(|i| core::array::from_fn(|j| f64::from(u8::from(i == j))));
-    let f = StateSpace::<5, 10, 5>::aem_from_rows(BLD.0, BLD.1, BLD.2, eye, H).unwrap();
+    let f = StateSpace::<5, 10, 5>::from_rows_aem(BLD.0, BLD.1, BLD.2, eye, H).unwrap();
     let qw = core::array::from_fn(|i| {
         core::array::from_fn(|j| if i == j { SIGMA_F * SIGMA_F } else { 0.0 })
     });
@@ -361,7 +361,7 @@ fn estimators<const I: usize, const O: usize, const Z: usize>(
 /// augmented KF and the dual KF do anyway, error per window.
 fn acceleration_only(md: &mut String) {
     const ROOF: [[f64; 1]; 5] = [[0.0], [0.0], [0.0], [0.0], [1.0]];
-    let ss = StateSpace::<5, 10, 1>::aem_from_rows(BLD.0, BLD.1, BLD.2, ROOF, H).unwrap();
+    let ss = StateSpace::<5, 10, 1>::from_rows_aem(BLD.0, BLD.1, BLD.2, ROOF, H).unwrap();
     let b = SMatrix::<f64, 5, 1>::from_fn(|i, _| ROOF[i][0]);
     let out = sensors::<1, 3>(&[]);
     let n = (T_ACC_ONLY / H) as usize + 1;
@@ -625,7 +625,7 @@ use aemstep::vector;
 // roof (N), h = 0.02 s.
 let (m, c, k) = models::five_storey_building();
 let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
-let ss = StateSpace::<5, 10, 1>::aem_from_rows(m, c, k, roof, 0.02)?;
+let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02)?;
 // Process noise Q on the state: unmodelled white forces of σ = 100 N on every floor, through
 // the same model with those forces as inputs (B = I): Q = (Γ₀ + Γ₁) σ² I (Γ₀ + Γ₁)ᵀ.
 let (mut b, mut qf) = ([[0.0; 5]; 5], [[0.0; 5]; 5]);
@@ -633,7 +633,7 @@ for i in 0..5 {
     b[i][i] = 1.0;
     qf[i][i] = 100.0 * 100.0; // N²
 }
-let qr = StateSpace::<5, 10, 5>::aem_from_rows(m, c, k, b, 0.02)?.input_noise(&qf);
+let qr = StateSpace::<5, 10, 5>::from_rows_aem(m, c, k, b, 0.02)?.input_noise(&qf);
 let q = SMatrix::<f64, 10, 10>::from_fn(|i, j| qr[i][j]);
 
 // Accelerations of floors 1, 3, 5 alone: a constant force and its static displacement give
@@ -721,7 +721,7 @@ fixed seeds, no timing) — do not edit by hand; `python3 scripts/check_docs.py`
 
     // One force at the roof, + roof displacement.
     const ROOF: [[f64; 1]; 5] = [[0.0], [0.0], [0.0], [0.0], [1.0]];
-    let ss = StateSpace::<5, 10, 1>::aem_from_rows(BLD.0, BLD.1, BLD.2, ROOF, H)?;
+    let ss = StateSpace::<5, 10, 1>::from_rows_aem(BLD.0, BLD.1, BLD.2, ROOF, H)?;
     let b = SMatrix::<f64, 5, 1>::from_fn(|i, _| ROOF[i][0]);
     let out = sensors::<1, 4>(&[4]);
     let n = (T_RUN / H) as usize + 1;
@@ -783,7 +783,7 @@ fixed seeds, no timing) — do not edit by hand; `python3 scripts/check_docs.py`
 
     // Two forces, floors 3 and 5.
     const TWO: [[f64; 2]; 5] = [[0.0, 0.0], [0.0, 0.0], [1.0, 0.0], [0.0, 0.0], [0.0, 1.0]];
-    let ss2 = StateSpace::<5, 10, 2>::aem_from_rows(BLD.0, BLD.1, BLD.2, TWO, H)?;
+    let ss2 = StateSpace::<5, 10, 2>::from_rows_aem(BLD.0, BLD.1, BLD.2, TWO, H)?;
     let b2 = SMatrix::<f64, 5, 2>::from_fn(|i, j| TWO[i][j]);
     let (wa, wb) = (wind(n, 0x5EED_0021), wind(n, 0x5EED_0022));
     let w2: Vec<SVector<f64, 2>> = wa
