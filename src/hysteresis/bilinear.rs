@@ -107,15 +107,17 @@ impl<T: Real> Law<T> for Bilinear<T> {
     #[inline]
     fn trial(&self, committed: &BilinearHistory<T>, d: T, _rate: T) -> LawTrial<T, Self::History> {
         let dp = committed.plastic;
-        // `k d − k d_p`, not `k (d − d_p)`: with a tiny `k` and deformations near `T::MAX`,
-        // `d − d_p` (up to `2·T::MAX`) can overflow though the force fits.
-        let f_tr = self.k * d - self.k * dp;
+        // `k (d − d_p)` at half scale: with a tiny `k` and deformations near `T::MAX`,
+        // `d − d_p` (up to `2·T::MAX`) can overflow though the force fits. Halving and
+        // doubling are exact in the normal range, so this rounds as `k (d − d_p)` does
+        // (no cancellation of `k d − k d_p`); only subnormal deformations lose a bit.
+        let two = T::one() + T::one();
+        let half = T::one() / two;
+        let f_tr = self.k * (d * half - dp * half) * two;
         let xi = f_tr - self.hard * dp;
         let excess = xi.abs() - self.fy;
         if excess > T::zero() {
             let s = if xi > T::zero() { T::one() } else { -T::one() };
-            let two = T::one() + T::one();
-            let half = T::one() / two;
             return LawTrial {
                 force: f_tr - s * self.one_minus_alpha * excess,
                 stiffness: self.kt,
