@@ -33,7 +33,7 @@ command re-runs it and fails when a figure here changes or cargo warns.
   benchmarks and fuzzing stay in the repository (the \`include\` list in \`Cargo.toml\`).
 - Public features: ${features} (none by default). \`std\` adds the host-only
   \`spectrum::batch\`; \`defmt\` adds \`defmt::Format\` to the public types. The firmware's crates
-  (cortex-m, cortex-m-rt, semihosting) are dependencies of the \`firmware/\` workspace member,
+  (cortex-m, cortex-m-rt, semihosting) are dependencies of the \`examples/firmware/\` workspace member,
   never of the library.
 - docs.rs builds every feature with \`--cfg docsrs\`, which labels each feature-gated item with
   the feature it needs.
