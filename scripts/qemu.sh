@@ -259,7 +259,7 @@ target_bits=$(sed -n 's/^target storey-1 drift f32 bits = //p' "$OUT/qemu_observ
     fail "observer storey-1 drift: host '$host_bits', target '$target_bits'"
 echo "ok: both $host_bits"
 
-step "qemu: host and Cortex-M4F runs are bit-identical (joint estimator, roof force at 80 s)"
+step "qemu: host and Cortex-M4F runs are bit-identical (joint estimator: roof force and detector window at 80 s)"
 host_log=$(cargo test -q --release --test firmware_estimator -- --nocapture --exact \
     f32_run_within_the_firmware_bound 2>&1)
 for ty in f32 f64; do
@@ -269,6 +269,13 @@ for ty in f32 f64; do
         fail "estimator roof force ($ty): host '$host_bits', target '$target_bits'"
     echo "ok: $ty both $host_bits"
 done
+host_sum=$(cargo test -q --release --test firmware_estimator -- --nocapture --exact \
+    detector_is_quiet_on_the_intact_building_and_sees_a_withheld_force 2>&1 |
+    sed -n 's/^host detector window sum fixed = //p')
+target_sum=$(sed -n 's/^target detector window sum fixed = //p' "$OUT/qemu_estimator-qemu.log")
+[[ -n $host_sum && $host_sum == "$target_sum" ]] ||
+    fail "estimator's detector window sum: host '$host_sum', target '$target_sum'"
+echo "ok: detector window sum (fixed point) both $host_sum"
 
 step "qemu: footprint: a firmware pays only for the capabilities it uses"
 # qemu_footprint uses only Linear<f32, 5>; with control "footprint-modal" also a compile-time
@@ -397,7 +404,9 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo
     echo "One step of the fixed-gain joint input–state estimator (Gillijns–De Moor: predict, estimate the"
     echo "unknown roof force, correct with 3 accelerometers and the roof displacement), \`f32\`:"
-    echo "\`InputStateObserver<f32, 10, 1, 4>\` (10 states, 1 unknown input, 4 sensors)."
+    echo "\`InputStateObserver<f32, 10, 1, 4>\` (10 states, 1 unknown input, 4 sensors). Beside it, the χ² detector:"
+    echo "one step of the known-input \`Observer<f32, 10, 1, 4>\` with its innovation, whitened and pushed into a"
+    echo "50-sample \`Window\` (\`Detector<f32, 4, 50>\`; the window's fixed-point terms go through \`f64\`, soft float here)."
     echo
     echo "| estimator | instructions / step | multiply-adds | instructions / multiply-add |"
     echo "|---|---:|---:|---:|"

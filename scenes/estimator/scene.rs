@@ -9,9 +9,10 @@
 //! produce the same samples bit for bit.
 #![allow(dead_code)] // each includer uses a different subset
 
+use aemstep::detection::innovation_covariance;
 use aemstep::estimation::{InputModel, InputStateGains};
 use aemstep::models::{self, Rows};
-use aemstep::observer::{Measurement, Outputs, StateSpace};
+use aemstep::observer::{Measurement, Outputs, StateSpace, SteadyState};
 
 /// Time step (s).
 pub const H: f64 = 0.02;
@@ -64,6 +65,16 @@ pub const Q: [[f64; 10]; 10] = ok(StateSpace::<5, 10, 5>::from_rows_aem(
 .input_noise(&diag([1e4; 5]));
 /// The steady-state gains of the joint input–state filter, solved by the compiler.
 pub const GAINS: InputStateGains<10, 1, 4> = ok(InputStateGains::solve(&MODEL, &Q, &R));
+
+/// The detector's observer: the steady-state Kalman filter of the same model with the
+/// force as a known input (the sensors' own force reading), solved by the compiler.
+pub const KF: SteadyState<10, 4> = ok(SteadyState::from_parts(&SS, &MEAS, &Q, &R));
+/// Its innovation covariance `S = H P Hᵀ + R`.
+pub const INNOVATION_COV: [[f64; 4]; 4] = ok(innovation_covariance(&KF, &MEAS, &R));
+/// The detector's window: 1 s (50 samples of 4 sensors, 200 degrees of freedom).
+pub const WINDOW: usize = 50;
+/// The detector's false-alarm probability per evaluation.
+pub const ALPHA: f64 = 1e-3;
 
 /// Pole of the force's first-order filter (per step).
 pub const FORCE_POLE: f64 = 0.98;
@@ -196,3 +207,7 @@ pub fn bound(peak: f64) -> f64 {
 /// Multiply-adds of one step of `InputStateObserver<_, 10, 1, 4>`: prediction `S(S+I)`,
 /// innovation `O·S`, input `I·O`, state `S·O`.
 pub const STEP_MADDS: usize = 10 * 11 + 4 * 10 + 4 + 10 * 4;
+
+/// Multiply-adds of one detector step: the known-input observer `S² + 2S·I + 2S·O + O·I`,
+/// then the whitening `O(O+1)/2`.
+pub const DETECTOR_MADDS: usize = 100 + 20 + 80 + 4 + 10;
