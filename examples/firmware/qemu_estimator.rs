@@ -10,15 +10,17 @@
 //! sensor noise, and pushes the samples into a `heapless::spsc::Queue`. SysTick fires every
 //! h = 0.02 s of the core clock; its handler takes the next sample, steps the `f32`
 //! estimator, reads the force and the five drifts, and pushes them through a second queue
-//! back to the main loop. Beside the estimator the handler steps a χ² detector
-//! (`Detector<f32, 4, 50>`) on the innovations of the known-input `Observer<f32, 10, 1, 4>`
-//! of the same model, fed the force the sensors report (the estimator's innovations are
-//! not exposed by its API); on the intact building it must raise no alarm, and its last
-//! window sum is compared bit for bit with the host's by `scripts/qemu.sh`. There the same estimator in `f64` (soft float, bit-identical to
+//! back to the main loop. There the same estimator in `f64` (soft float, bit-identical to
 //! the host's `f64` run of `tests/firmware_estimator.rs`) is stepped on the same samples,
 //! and at the end the largest force and drift differences must be within
 //! `scene::bound(peak)` (`AMPLIFICATION · √(S+I+O) · ε₃₂ · max|·|`), and no sample may be
 //! missing.
+//!
+//! Beside the estimator the handler steps a χ² detector (`Detector<f32, 4, 50>`) on the
+//! innovations of the known-input `Observer<f32, 10, 1, 4>` of the same model, fed the
+//! force the sensors report (the estimator's own innovations are not exposed by its API);
+//! on the intact building it must raise no alarm, and its last window sum is compared bit
+//! for bit with the host's by `scripts/qemu.sh`.
 //!
 //! Before the timer starts it counts the instructions of one estimator step and of one
 //! detector step (SysTick under `-icount shift=0`) and prints `COST` lines; the estimator
