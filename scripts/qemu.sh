@@ -20,13 +20,14 @@ cd "$(dirname "$0")/.."
 TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
-EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum qemu_hysteretic qemu_observer)
+EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum qemu_hysteretic qemu_observer qemu_estimator)
 # Broken on purpose: "example variant" pairs that must exit with failure (status 1); the
 # variant is `--cfg aemstep_broken="<variant>"` (not a public feature, see Cargo.toml).
 BROKEN=("qemu_timer inject-nan" "qemu_timer tight-bound" "qemu_nonlinear inject-nan"
     "qemu_modal modal-tight-bound" "qemu_schemes inject-nan" "qemu_spectrum spectrum-tight-bound"
     "qemu_hysteretic hysteretic-tight-bound"
-    "qemu_observer observer-nan" "qemu_observer observer-tight-bound")
+    "qemu_observer observer-nan" "qemu_observer observer-tight-bound"
+    "qemu_estimator estimator-tight-bound")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
 PKG=(-p aemstep-firmware)
 DEFMT_PRINT_VERSION=1.2.0 # the host decoder; its format must match the target's defmt 1.x
@@ -158,6 +159,10 @@ if "$NM" -C "$OUT/qemu_observer-qemu" | grep -E "$INVERSION|riccati|SteadyState"
     fail "qemu_observer links factorization or Riccati code (symbols above)"
 fi
 echo "ok: qemu_observer has no symbol matching /$INVERSION|riccati|SteadyState/"
+if "$NM" -C "$OUT/qemu_estimator-qemu" | grep -E "$INVERSION|riccati|InputStateGains"; then
+    fail "qemu_estimator links factorization or Riccati code (symbols above)"
+fi
+echo "ok: qemu_estimator has no symbol matching /$INVERSION|riccati|InputStateGains/"
 
 step "qemu: no panic reachable from any step function (call graph of the ELFs)"
 # Roots: every `#[no_mangle]` step symbol (`<example>_step`, `cost_step_*`). Edges: direct
@@ -253,6 +258,24 @@ target_bits=$(sed -n 's/^target storey-1 drift f32 bits = //p' "$OUT/qemu_observ
 [[ -n $host_bits && $host_bits == "$target_bits" ]] ||
     fail "observer storey-1 drift: host '$host_bits', target '$target_bits'"
 echo "ok: both $host_bits"
+
+step "qemu: host and Cortex-M4F runs are bit-identical (joint estimator: roof force and detector window at 80 s)"
+host_log=$(cargo test -q --release --test firmware_estimator -- --nocapture --exact \
+    f32_run_within_the_firmware_bound 2>&1)
+for ty in f32 f64; do
+    host_bits=$(sed -n "s/^host roof force $ty bits = //p" <<<"$host_log")
+    target_bits=$(sed -n "s/^target roof force $ty bits = //p" "$OUT/qemu_estimator-qemu.log")
+    [[ -n $host_bits && $host_bits == "$target_bits" ]] ||
+        fail "estimator roof force ($ty): host '$host_bits', target '$target_bits'"
+    echo "ok: $ty both $host_bits"
+done
+host_sum=$(cargo test -q --release --test firmware_estimator -- --nocapture --exact \
+    detector_is_quiet_on_the_intact_building_and_sees_a_withheld_force 2>&1 |
+    sed -n 's/^host detector window sum fixed = //p')
+target_sum=$(sed -n 's/^target detector window sum fixed = //p' "$OUT/qemu_estimator-qemu.log")
+[[ -n $host_sum && $host_sum == "$target_sum" ]] ||
+    fail "estimator's detector window sum: host '$host_sum', target '$target_sum'"
+echo "ok: detector window sum (fixed point) both $host_sum"
 
 step "qemu: footprint: a firmware pays only for the capabilities it uses"
 # qemu_footprint uses only Linear<f32, 5>; with control "footprint-modal" also a compile-time
@@ -374,6 +397,20 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "| observer | instructions / step | multiply-adds | instructions / multiply-add |"
     echo "|---|---:|---:|---:|"
     grep '^COST ' "$OUT/qemu_observer-qemu.log" | while read -r _ what instr madds; do
+        echo "| \`$what\` | $instr | $madds | $(awk -v a="$instr" -v b="$madds" 'BEGIN { printf "%.2f", a / b }') |"
+    done
+    echo
+    echo "## Joint input–state estimator (\`examples/firmware/qemu_estimator.rs\`)"
+    echo
+    echo "One step of the fixed-gain joint input–state estimator (Gillijns–De Moor: predict, estimate the"
+    echo "unknown roof force, correct with 3 accelerometers and the roof displacement), \`f32\`:"
+    echo "\`InputStateObserver<f32, 10, 1, 4>\` (10 states, 1 unknown input, 4 sensors). Beside it, the χ² detector:"
+    echo "one step of the known-input \`Observer<f32, 10, 1, 4>\` with its innovation, whitened and pushed into a"
+    echo "50-sample \`Window\` (\`Detector<f32, 4, 50>\`; the window's fixed-point terms go through \`f64\`, soft float here)."
+    echo
+    echo "| estimator | instructions / step | multiply-adds | instructions / multiply-add |"
+    echo "|---|---:|---:|---:|"
+    grep '^COST estimator' "$OUT/qemu_estimator-qemu.log" | while read -r _ what instr madds; do
         echo "| \`$what\` | $instr | $madds | $(awk -v a="$instr" -v b="$madds" 'BEGIN { printf "%.2f", a / b }') |"
     done
     echo
