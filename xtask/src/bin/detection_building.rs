@@ -15,6 +15,8 @@
 
 #![allow(clippy::needless_range_loop)] // matrix and record indices read best explicitly
 
+#[path = "../../../scenes/detection/chi2.rs"]
+mod chi2;
 #[path = "../../../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "../../../scenes/detection/gauss.rs"]
@@ -29,6 +31,7 @@ use aemstep::nalgebra::{SMatrix, SVector};
 use aemstep::observer::Observer;
 use plotters::prelude::*;
 
+use chi2::chi2_upper_tail;
 use gauss::Gauss;
 use scene::{
     H, HYPOTHESES, NOISE_FRACTION, SIGMA_F, W, WB, damage_measurements, hypothesis, model, model_q,
@@ -48,39 +51,6 @@ const INTACT_SEEDS: u64 = 400;
 const ALPHAS: [f64; 4] = [1e-2, 1e-3, 1e-4, ALPHA_DAMAGE];
 /// Binomial band: ±4.42 standard deviations (two-sided 10⁻⁵, normal approximation).
 const Z: f64 = 4.42;
-
-/// `ln Γ(k/2)` exactly from `Γ(a + 1) = a Γ(a)`, `Γ(1) = 1`, `Γ(½) = √π`.
-fn ln_gamma_half(k: u64) -> f64 {
-    let mut s = if k.is_multiple_of(2) {
-        0.0
-    } else {
-        0.5 * std::f64::consts::PI.ln()
-    };
-    let mut a = if k.is_multiple_of(2) { 1.0 } else { 0.5 };
-    while a < k as f64 / 2.0 - 1e-9 {
-        s += a.ln();
-        a += 1.0;
-    }
-    s
-}
-
-/// The exact upper tail `P(χ²_k > x)` from the series of the lower regularized gamma
-/// function (Abramowitz & Stegun 6.5.29), independent of the crate's quantile.
-fn chi2_upper_tail(k: u64, x: f64) -> f64 {
-    let a = k as f64 / 2.0;
-    let y = x / 2.0;
-    let (mut term, mut sum, mut n) = (1.0f64, 1.0f64, 1.0f64);
-    loop {
-        term *= y / (a + n);
-        sum += term;
-        if term < 1e-17 * sum {
-            break;
-        }
-        n += 1.0;
-    }
-    let lp = a * y.ln() - y - (a.ln() + ln_gamma_half(k)) + sum.ln();
-    1.0 - lp.exp()
-}
 
 /// One sample of a run's trace: the window sum, the CUSUM statistic, the bank's
 /// log-likelihoods.
