@@ -21,6 +21,8 @@ mod chi2;
 mod elcentro;
 #[path = "../../../scenes/detection/gauss.rs"]
 mod gauss;
+#[path = "../plot.rs"]
+mod plot;
 #[path = "../../../scenes/detection/scene.rs"]
 mod scene;
 
@@ -282,15 +284,12 @@ fn plot(
         .iter()
         .fold(threshold, |m, v| m.max(v.0).max(v.1))
         * 2.0;
-    let mut chart = ChartBuilder::on(&top)
-        .caption(
-            "Intact model's innovations: 1 s window χ² sum and CUSUM (storey 1 −10 % at t = 20 s)",
-            ("sans-serif", 18),
-        )
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..t_end, (1.0..ymax).log_scale())?;
+    let mut chart = plot::chart(
+        &top,
+        "Intact model's innovations: 1 s window χ² sum and CUSUM (storey 1 −10 % at t = 20 s)",
+        0.0..t_end,
+        (1.0..ymax).log_scale(),
+    )?;
     chart
         .configure_mesh()
         .x_desc("t (s)")
@@ -324,22 +323,13 @@ fn plot(
     ];
     for (name, p, col, wdt) in series {
         let style = col.stroke_width(wdt);
-        chart
-            .draw_series(LineSeries::new(p, style))?
-            .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        plot::line(&mut chart, name, p, style)?;
     }
     chart.draw_series(LineSeries::new(
         vec![(20.0, 1.0), (20.0, ymax)],
         BLACK.stroke_width(1),
     ))?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()?;
+    plot::legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     // Bottom: each hypothesis' log-likelihood over the 10 s window, minus the intact one's.
     let rel: Vec<[f64; HYPOTHESES]> = run.trace[..n_end]
         .iter()
@@ -349,15 +339,12 @@ fn plot(
         .iter()
         .flatten()
         .fold((0.0f64, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
-    let mut chart = ChartBuilder::on(&bottom)
-        .caption(
-            "Model bank: log-likelihood over the last 10 s, minus the intact model's",
-            ("sans-serif", 18),
-        )
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..t_end, (lo * 1.1)..(hi * 1.1 + 1.0))?;
+    let mut chart = plot::chart(
+        &bottom,
+        "Model bank: log-likelihood over the last 10 s, minus the intact model's",
+        0.0..t_end,
+        (lo * 1.1)..(hi * 1.1 + 1.0),
+    )?;
     chart
         .configure_mesh()
         .x_desc("t (s)")
@@ -379,22 +366,13 @@ fn plot(
             .step_by(2)
             .map(|(n, v)| (n as f64 * H, v[m]))
             .collect();
-        chart
-            .draw_series(LineSeries::new(p, style))?
-            .label(format!("storey {m} 10 % softer"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        plot::line(&mut chart, format!("storey {m} 10 % softer"), p, style)?;
     }
     chart.draw_series(LineSeries::new(
         vec![(20.0, lo * 1.1), (20.0, hi * 1.1 + 1.0)],
         BLACK.stroke_width(1),
     ))?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()?;
+    plot::legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     root.present()?;
     Ok(())
 }

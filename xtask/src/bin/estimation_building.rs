@@ -10,6 +10,9 @@
 //! Run: `cargo run --release -p xtask --bin estimation_building [DIR]` (default `docs`;
 //! `scripts/check_docs.py` regenerates into a temporary directory and compares).
 
+#[path = "../plot.rs"]
+mod plot;
+
 use std::fmt::Write as _;
 
 use aemstep::estimation::augmented::AugmentedModel;
@@ -580,27 +583,13 @@ fn plot(
         ),
     ] {
         let lim = series[0].1.iter().fold(0.0f64, |m, p| m.max(p.1.abs())) * 1.3;
-        let mut chart = ChartBuilder::on(area)
-            .caption(title, ("sans-serif", 18))
-            .margin(15)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(t0..t1, -lim..lim)?;
+        let mut chart = plot::chart(area, title, t0..t1, -lim..lim)?;
         chart.configure_mesh().x_desc("t (s)").y_desc(unit).draw()?;
         for (name, pts, col) in series {
             let style = col.stroke_width(if *name == "truth" { 3 } else { 1 });
-            chart
-                .draw_series(LineSeries::new(pts.clone(), style))?
-                .label(*name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            plot::line(&mut chart, *name, pts.clone(), style)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .draw()?;
+        plot::legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     }
     root.present()?;
     Ok(())
