@@ -18,7 +18,10 @@ use aemstep::observer::{Kalman, Observer, Outputs, Readout, StateSpace};
 use aemstep::{Error, Linear, Stepper};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+#[path = "../scenes/estimation/start.rs"]
+mod start;
 mod support;
+use start::{augmented_kalman, rows, start_joint};
 use support::Rng;
 
 const EPS: f64 = f64::EPSILON;
@@ -349,10 +352,6 @@ fn building_identifiability() {
     );
 }
 
-fn rows<const R: usize, const C: usize>(a: &SMatrix<f64, R, C>) -> [[f64; C]; R] {
-    core::array::from_fn(|i| core::array::from_fn(|j| a[(i, j)]))
-}
-
 /// Noisy measurements of the building run.
 fn noisy(ys: &[SVector<f64, 4>], seed: u64) -> Vec<SVector<f64, 4>> {
     let mut rng = Rng::new(seed);
@@ -648,14 +647,7 @@ fn missing_samples_failed_steps_and_bad_input() {
     assert_eq!(e, snap);
     // The time-varying filter: the same rules.
     let tv = InputStateFilter::<f64, 10, 1, 4>::new(&model, &q, &r).unwrap();
-    let mut s = tv
-        .start(
-            &SVector::zeros(),
-            &(SMatrix::identity() * 1e-8),
-            &SVector::zeros(),
-            &SMatrix::from([[1e10]]),
-        )
-        .unwrap();
+    let mut s = start_joint(&tv);
     tv.try_step(&mut s, &SVector::from([0.1, 0.2, 0.3, 1e-3]))
         .unwrap();
     let snap = s;
@@ -813,14 +805,7 @@ fn acceleration_only_drifts() {
     let q = process_noise(&ss);
     let r = SMatrix::<f64, 3, 3>::identity() * 9e-4;
     let tv = InputStateFilter::<f64, 10, 1, 3>::new(&model, &q, &r).unwrap();
-    let mut s = tv
-        .start(
-            &SVector::zeros(),
-            &(SMatrix::identity() * 1e-8),
-            &SVector::zeros(),
-            &SMatrix::from([[1e10]]),
-        )
-        .unwrap();
+    let mut s = start_joint(&tv);
     let mut traces = Vec::new();
     for n in 1..=4000 {
         tv.try_step(&mut s, &SVector::zeros()).unwrap();
@@ -835,19 +820,7 @@ fn acceleration_only_drifts() {
     // measured: it grows by the random walk's whole 1000 · Q_w = 1e11 N² every 1000 steps,
     // the data do not reduce it.
     let aug = AugmentedModel::<10, 1, 11, 3>::from_parts(&model, &rows(&q), &[[1e8]]).unwrap();
-    let kf = Kalman::<f64, 11, 0, 3>::new(
-        &aug.model,
-        &aug.measurement,
-        &SMatrix::from_fn(|i, j| aug.process_noise[i][j]),
-        &r,
-    )
-    .unwrap();
-    let p0 = SMatrix::<f64, 11, 11>::from_fn(|i, j| match (i == j, i < 10) {
-        (false, _) => 0.0,
-        (true, true) => 1e-8,
-        (true, false) => 1e10,
-    });
-    let mut s = kf.start(&SVector::zeros(), &p0, &SVector::zeros()).unwrap();
+    let (kf, mut s) = augmented_kalman(&aug, &r);
     let mut var_w = Vec::new();
     for n in 1..=4000 {
         kf.try_step(&mut s, &SVector::zeros(), &SVector::zeros())
@@ -1118,14 +1091,7 @@ fn modal_model_and_f32_time_varying_filter() {
             &SMatrix::from([[1e10]]),
         )
         .unwrap();
-    let mut s64 = f64f
-        .start(
-            &SVector::zeros(),
-            &(SMatrix::identity() * 1e-8),
-            &SVector::zeros(),
-            &SMatrix::from([[1e10]]),
-        )
-        .unwrap();
+    let mut s64 = start_joint(&f64f);
     let mut d = 0.0f64;
     for n in 1..ys.len() {
         f32f.try_step(&mut s32, &ys[n].cast::<f32>()).unwrap();

@@ -12,6 +12,8 @@
 
 #[path = "../plot.rs"]
 mod plot;
+#[path = "../../../scenes/estimation/start.rs"]
+mod start;
 
 use std::fmt::Write as _;
 
@@ -21,9 +23,10 @@ use aemstep::estimation::smoother::FixedLag;
 use aemstep::estimation::{InputModel, InputStateFilter, InputStateGains, InputStateObserver};
 use aemstep::models;
 use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::observer::{Kalman, Observer, Outputs, Readout, StateSpace, SteadyState};
+use aemstep::observer::{Observer, Outputs, Readout, StateSpace, SteadyState};
 use aemstep::{Damping, Linear, Stepper};
 use plotters::prelude::*;
+use start::{augmented_kalman, rows, start_joint};
 
 /// Time step (s).
 const H: f64 = 0.02;
@@ -101,10 +104,6 @@ fn wind(n: usize, seed: u64) -> Vec<f64> {
     }
     let rms = (out.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
     out.iter().map(|v| v * FORCE_RMS / rms).collect()
-}
-
-fn rows<const R: usize, const C: usize>(a: &SMatrix<f64, R, C>) -> [[f64; C]; R] {
-    core::array::from_fn(|i| core::array::from_fn(|j| a[(i, j)]))
 }
 
 /// Process noise on ξ (and x): white forces of σ = `SIGMA_F` on every floor.
@@ -399,27 +398,8 @@ fn acceleration_only(md: &mut String) {
     // The filters that still run: time-varying joint filter, augmented KF (time-varying),
     // dual KF (its two stages each have a steady gain).
     let tv = InputStateFilter::<f64, 10, 1, 3>::new(&model, &q, &r).unwrap();
-    let mut s = tv
-        .start(
-            &SVector::zeros(),
-            &(SMatrix::identity() * 1e-8),
-            &SVector::zeros(),
-            &SMatrix::from([[1e10]]),
-        )
-        .unwrap();
-    let kf = Kalman::<f64, 11, 0, 3>::new(
-        &aug.model,
-        &aug.measurement,
-        &SMatrix::from_fn(|i, j| aug.process_noise[i][j]),
-        &r,
-    )
-    .unwrap();
-    let p0 = SMatrix::<f64, 11, 11>::from_fn(|i, j| match (i == j, i < 10) {
-        (false, _) => 0.0,
-        (true, true) => 1e-8,
-        (true, false) => 1e10,
-    });
-    let mut ks = kf.start(&SVector::zeros(), &p0, &SVector::zeros()).unwrap();
+    let mut s = start_joint(&tv);
+    let (kf, mut ks) = augmented_kalman(&aug, &r);
     let dg = DualGains::new(&model, &q, &qw, &r).unwrap();
     let df = DualFilter::<f64, 10, 1, 3>::new(&model, &dg).unwrap();
     let mut de = df.start(&SVector::zeros(), &SVector::zeros()).unwrap();
