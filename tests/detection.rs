@@ -31,8 +31,8 @@ mod scene;
 use chi2::chi2_upper_tail;
 use gauss::Gauss;
 use scene::{
-    H, HYPOTHESES, NOISE_FRACTION, Rows, SENSORS, SIGMA_F, W, WB, damage_measurements, hypothesis,
-    model, observer_of, peaks, r_rows,
+    H, HYPOTHESES, IntactTruth, NOISE_FRACTION, Rows, SENSORS, SIGMA_F, W, WB, damage_measurements,
+    hypothesis, model, observer_of, peaks, r_rows,
 };
 
 // ---------------------------------------------------------------------------------------
@@ -354,19 +354,7 @@ fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
     let md = model([1.0; 5]);
     let (obs, wh, kf) = observer_of(&md, &r);
     let det = Detector::<f64, 3, W>::new(wh, ChiSquareTest::new(3, ALPHA).unwrap());
-    let (phi, g0, g1) = (
-        md.ss.phi_matrix(),
-        md.ss.gamma0_matrix(),
-        md.ss.gamma1_matrix(),
-    );
-    let (h, d) = (md.meas.h_matrix(), md.meas.d_matrix());
-    let (p, l) = (kf.covariance_matrix(), kf.gain_matrix());
-    let post = (SMatrix::<f64, 10, 10>::identity() - l * h) * p;
-    let post = (post + post.transpose()) * 0.5;
-    let eig = post.symmetric_eigen();
-    let root = eig.eigenvectors
-        * SMatrix::<f64, 10, 10>::from_diagonal(&eig.eigenvalues.map(|v| v.max(0.0).sqrt()));
-    let gf = md.g_force * SIGMA_F;
+    let truth = IntactTruth::new(&md, &kf);
     let ag = &elcentro::AG_F64;
     let (mut trials, mut alarms) = (0u64, 0u64);
     let (mut evals, mut alarm_samples) = (0u64, 0u64);
@@ -378,14 +366,13 @@ fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
     let mut cusum_alarms = 0u64;
     for seed in 0..SEEDS {
         let mut g = Gauss::new(1000 + seed);
-        let mut x = root * SVector::<f64, 10>::from_fn(|_, _| g.next());
+        let mut x = truth.start(&mut g);
         let mut e = obs.start_at_rest(&SVector::from([ag[0]])).unwrap();
         let mut win = Window::<W>::new();
         let mut cs = CusumState::new();
         for n in 1..ag.len() {
-            let (w0, w1) = (SVector::from([ag[n - 1]]), SVector::from([ag[n]]));
-            x = phi * x + g0 * w0 + g1 * w1 + gf * SVector::<f64, 5>::from_fn(|_, _| g.next());
-            let y = h * x + d * w1 + SVector::<f64, 3>::from_fn(|o, _| sigma[o] * g.next());
+            let w1 = SVector::from([ag[n]]);
+            let y = truth.step(&mut x, ag, n, &sigma, &mut g);
             let nu = obs.step_innovation(&mut e, &w1, &y);
             let q = det.whitener.nis(&nu);
             nis_sum += q;

@@ -174,3 +174,72 @@ pub fn damage_measurements(
     }
     ys
 }
+
+/// The intact building as the observer assumes it, for the false-alarm runs: the model
+/// driven by the ground acceleration and by white floor forces of [`SIGMA_F`] (its process
+/// noise `Q`), measured with the accelerometer noise of `R`, from a stationary start.
+pub struct IntactTruth {
+    phi: SMatrix<f64, 10, 10>,
+    g0: SMatrix<f64, 10, 1>,
+    g1: SMatrix<f64, 10, 1>,
+    h: SMatrix<f64, 3, 10>,
+    d: SMatrix<f64, 3, 1>,
+    /// A square root of the a-posteriori covariance `(I − L H) P`.
+    root: SMatrix<f64, 10, 10>,
+    /// `(Γ₀ + Γ₁) σ_F`.
+    gf: SMatrix<f64, 10, 5>,
+}
+
+impl IntactTruth {
+    /// The truth of model `md`, whose observer has the steady state `kf`.
+    pub fn new(md: &Model, kf: &SteadyState<10, 3>) -> Self {
+        let (phi, g0, g1) = (
+            md.ss.phi_matrix(),
+            md.ss.gamma0_matrix(),
+            md.ss.gamma1_matrix(),
+        );
+        let (h, d) = (md.meas.h_matrix(), md.meas.d_matrix());
+        // A stationary start: x₀ ~ N(0, (I − L H) P), so that the a-priori covariance is P
+        // from the first step.
+        let (p, l) = (kf.covariance_matrix(), kf.gain_matrix());
+        let post = (SMatrix::<f64, 10, 10>::identity() - l * h) * p;
+        let post = (post + post.transpose()) * 0.5;
+        let eig = post.symmetric_eigen();
+        let root = eig.eigenvectors
+            * SMatrix::<f64, 10, 10>::from_diagonal(&eig.eigenvalues.map(|v| v.max(0.0).sqrt()));
+        let gf = md.g_force * SIGMA_F;
+        IntactTruth {
+            phi,
+            g0,
+            g1,
+            h,
+            d,
+            root,
+            gf,
+        }
+    }
+
+    /// The initial state, drawn from `g` (10 samples).
+    pub fn start(&self, g: &mut Gauss) -> SVector<f64, 10> {
+        self.root * SVector::<f64, 10>::from_fn(|_, _| g.next())
+    }
+
+    /// Advances the state `x` from sample `n − 1` to `n` of the ground acceleration `ag`
+    /// (5 force samples from `g`) and returns the measurement at `n` with noise of standard
+    /// deviations `sigma` (3 samples from `g`).
+    pub fn step(
+        &self,
+        x: &mut SVector<f64, 10>,
+        ag: &[f64],
+        n: usize,
+        sigma: &[f64; 3],
+        g: &mut Gauss,
+    ) -> SVector<f64, 3> {
+        let (w0, w1) = (SVector::from([ag[n - 1]]), SVector::from([ag[n]]));
+        *x = self.phi * *x
+            + self.g0 * w0
+            + self.g1 * w1
+            + self.gf * SVector::<f64, 5>::from_fn(|_, _| g.next());
+        self.h * *x + self.d * w1 + SVector::<f64, 3>::from_fn(|o, _| sigma[o] * g.next())
+    }
+}

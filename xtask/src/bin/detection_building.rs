@@ -29,15 +29,15 @@ mod scene;
 use std::fmt::Write as _;
 
 use aemstep::detection::{ChiSquareTest, Cusum, CusumState, Detector, ModelBank, Whitener, Window};
-use aemstep::nalgebra::{SMatrix, SVector};
+use aemstep::nalgebra::SVector;
 use aemstep::observer::Observer;
 use plotters::prelude::*;
 
 use chi2::chi2_upper_tail;
 use gauss::Gauss;
 use scene::{
-    H, HYPOTHESES, NOISE_FRACTION, SIGMA_F, W, WB, damage_measurements, hypothesis, model, model_q,
-    observer_of, peaks, r_rows,
+    H, HYPOTHESES, IntactTruth, NOISE_FRACTION, SIGMA_F, W, WB, damage_measurements, hypothesis,
+    model, model_q, observer_of, peaks, r_rows,
 };
 
 /// A larger process noise, to show what it costs: the observer follows the change.
@@ -180,21 +180,7 @@ fn intact_runs(sc: &Scene, tests: &[ChiSquareTest<W>; ALPHAS.len()]) -> Intact {
     let ag = sc.ag;
     let md = model([1.0; 5]);
     let (obs, wh, kf) = observer_of(&md, &r_rows(sc.sigma));
-    let (phi, g0, g1) = (
-        md.ss.phi_matrix(),
-        md.ss.gamma0_matrix(),
-        md.ss.gamma1_matrix(),
-    );
-    let (h, d) = (md.meas.h_matrix(), md.meas.d_matrix());
-    // A stationary start: x₀ ~ N(0, (I − L H) P), so that the a-priori covariance is P
-    // from the first step.
-    let (p, l) = (kf.covariance_matrix(), kf.gain_matrix());
-    let post = (SMatrix::<f64, 10, 10>::identity() - l * h) * p;
-    let post = (post + post.transpose()) * 0.5;
-    let eig = post.symmetric_eigen();
-    let root = eig.eigenvectors
-        * SMatrix::<f64, 10, 10>::from_diagonal(&eig.eigenvalues.map(|v| v.max(0.0).sqrt()));
-    let gf = md.g_force * SIGMA_F;
+    let truth = IntactTruth::new(&md, &kf);
     let cusum = Cusum::new(3, LAMBDA_INTACT, ALPHA_CUSUM).unwrap();
     let mut out = Intact {
         alarms: [0; ALPHAS.len()],
@@ -208,14 +194,13 @@ fn intact_runs(sc: &Scene, tests: &[ChiSquareTest<W>; ALPHAS.len()]) -> Intact {
     let mut nis_sum = 0.0;
     for seed in 0..INTACT_SEEDS {
         let mut g = Gauss::new(1000 + seed);
-        let mut x = root * SVector::<f64, 10>::from_fn(|_, _| g.next());
+        let mut x = truth.start(&mut g);
         let mut e = obs.start_at_rest(&SVector::from([ag[0]])).unwrap();
         let mut win = Window::<W>::new();
         let mut cs = CusumState::new();
         for n in 1..ag.len() {
-            let (w0, w1) = (SVector::from([ag[n - 1]]), SVector::from([ag[n]]));
-            x = phi * x + g0 * w0 + g1 * w1 + gf * SVector::<f64, 5>::from_fn(|_, _| g.next());
-            let y = h * x + d * w1 + SVector::<f64, 3>::from_fn(|o, _| sc.sigma[o] * g.next());
+            let w1 = SVector::from([ag[n]]);
+            let y = truth.step(&mut x, ag, n, &sc.sigma, &mut g);
             let nu = obs.step_innovation(&mut e, &w1, &y);
             let q = wh.nis(&nu);
             nis_sum += q;
