@@ -7,8 +7,9 @@
 //! Writes `docs/detection.md` (detection delay over noise seeds, false alarms on the
 //! intact structure against the rate the threshold was set for, the storey the bank names)
 //! and `docs/detection.svg` (one seed: the window statistic against its threshold, and the
-//! bank's log-likelihoods). Deterministic: fixed seeds, its own xorshift64* generator (the
-//! one of `tests/detection.rs`, which checks the same scene with assertions).
+//! bank's log-likelihoods). Deterministic: fixed seeds, the xorshift64* generator of
+//! `scenes/detection/gauss.rs`. The scene itself is `scenes/detection/scene.rs`, shared with
+//! `tests/detection.rs`, which checks it with assertions.
 //!
 //! Run: `cargo run --release -p xtask --bin detection_building [DIR]` (default `docs`;
 //! `scripts/check_docs.py` regenerates into a temporary directory and compares).
