@@ -9,62 +9,35 @@
 
 #![allow(clippy::needless_range_loop)] // matrix and record indices read best explicitly
 
+use aemstep::Error;
 use aemstep::detection::{
     ChiSquareTest, Cusum, CusumState, Detector, ModelBank, NIS_FRACTION_BITS, Whitener, Window,
     chi_square_quantile, innovation_covariance, normal_quantile,
 };
 use aemstep::models::{self, base_excitation};
 use aemstep::observer::{Measurement, Observer, Outputs, StateSpace, SteadyState};
-use aemstep::{Error, LinearInput, Stepper};
 use nalgebra::{SMatrix, SVector};
 
 #[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 
-const H: f64 = elcentro::DT;
-type Rows<const N: usize> = [[f64; N]; N];
+#[path = "../scenes/detection/chi2.rs"]
+mod chi2;
+#[path = "../scenes/detection/gauss.rs"]
+mod gauss;
+#[path = "../scenes/detection/scene.rs"]
+mod scene;
+
+use chi2::chi2_upper_tail;
+use gauss::Gauss;
+use scene::{
+    H, HYPOTHESES, IntactTruth, NOISE_FRACTION, Rows, SENSORS, SIGMA_F, W, WB, damage_measurements,
+    hypothesis, model, observer_of, peaks, r_rows,
+};
 
 // ---------------------------------------------------------------------------------------
 // (a) The χ² quantile.
 // ---------------------------------------------------------------------------------------
-
-/// `ln Γ(a)` for `a = k/2`, `k ≥ 1` an integer, exactly from the recurrences
-/// `Γ(a + 1) = a Γ(a)`, `Γ(1) = 1`, `Γ(½) = √π` (a sum of logarithms).
-fn ln_gamma_half(k: u64) -> f64 {
-    let mut s = if k.is_multiple_of(2) {
-        0.0
-    } else {
-        0.5 * std::f64::consts::PI.ln()
-    };
-    let mut a = if k.is_multiple_of(2) { 1.0 } else { 0.5 };
-    while a < k as f64 / 2.0 - 1e-9 {
-        s += a.ln();
-        a += 1.0;
-    }
-    s
-}
-
-/// The upper tail `P(χ²_k > x)` = `Q(k/2, x/2)`, from the series of the lower regularized
-/// gamma function `P(a, y) = y^a e^{−y} / Γ(a + 1) · Σ_n y^n / ((a + 1)…(a + n))`
-/// (Abramowitz & Stegun 6.5.29), summed until the terms stop changing the sum. For the
-/// quantiles here (`y ≤ a + 10√a`) the terms fall geometrically once `n > y − a`; `1 − P`
-/// loses `log₁₀(1/Q)` digits, at most 5 of 16 for `Q ≥ 10⁻⁵`.
-fn chi2_upper_tail(k: u64, x: f64) -> f64 {
-    let a = k as f64 / 2.0;
-    let y = x / 2.0;
-    let (mut term, mut sum, mut n) = (1.0f64, 1.0f64, 1.0f64);
-    loop {
-        term *= y / (a + n);
-        sum += term;
-        if term < 1e-17 * sum {
-            break;
-        }
-        n += 1.0;
-    }
-    // ln Γ(a + 1) = ln a + ln Γ(a).
-    let lp = a * y.ln() - y - (a.ln() + ln_gamma_half(k)) + sum.ln();
-    1.0 - lp.exp()
-}
 
 /// The exact upper quantile: bisection of [`chi2_upper_tail`] to 1e-13 relative.
 fn chi2_quantile_exact(k: u64, alpha: f64) -> f64 {
@@ -361,131 +334,8 @@ fn window_sum_is_exact_after_a_long_run_and_skips_nan() {
 }
 
 // ---------------------------------------------------------------------------------------
-// The building, its sensors and noise.
-// ---------------------------------------------------------------------------------------
-
-/// Measured: absolute accelerations of floors 1, 3 and 5 (DOFs 0, 2, 4); the ground
-/// acceleration (the input) is measured exactly.
-const SENSORS: [usize; 3] = [0, 2, 4];
-fn accelerometers() -> Outputs<5, 1, 3> {
-    Outputs::absolute_accelerations(Outputs::<5, 1, 3>::select(SENSORS), 0)
-}
-
-/// Unmodelled white forces on every floor, standard deviation (N): the process noise of
-/// every observer (0.5 % of a storey's weight). A larger one lets the filters follow the
-/// change: with 2·10⁴ N the 10 % loss was not detected at all in this scene (measured).
-const SIGMA_F: f64 = 5.0e3;
-/// Accelerometer noise: 3 % of each sensor's peak under El Centro.
-const NOISE_FRACTION: f64 = 0.03;
-
-/// The building with storey stiffness factors `f` (1 = intact), the model's `M` and `C`.
-fn building(f: [f64; 5]) -> (Rows<5>, Rows<5>, Rows<5>) {
-    let (m, c, _) = models::five_storey_building();
-    let ks: [f64; 5] = core::array::from_fn(|i| models::FIVE_STOREY_STIFFNESS * f[i]);
-    let (_, k) = models::shear_building([models::FIVE_STOREY_MASS; 5], ks);
-    (m, c, k)
-}
-
-struct Model {
-    ss: StateSpace<5, 10, 1>,
-    meas: Measurement<10, 1, 3>,
-    q: SMatrix<f64, 10, 10>,
-    /// `Γ₀ + Γ₁` of the floor forces: the process noise is `G σ_F z`, `z ~ N(0, I)`.
-    g_force: SMatrix<f64, 10, 5>,
-}
-
-fn model(f: [f64; 5]) -> Model {
-    let (m, c, k) = building(f);
-    let ss = StateSpace::from_rows_aem(m, c, k, base_excitation(&m), H).unwrap();
-    let eye: Rows<5> = core::array::from_fn(|i| core::array::from_fn(|j| (i == j) as u8 as f64));
-    let forces = StateSpace::<5, 10, 5>::from_rows_aem(m, c, k, eye, H).unwrap();
-    let qw: Rows<5> = core::array::from_fn(|i| {
-        core::array::from_fn(|j| if i == j { SIGMA_F * SIGMA_F } else { 0.0 })
-    });
-    let q = forces.input_noise(&qw);
-    let meas = ss.outputs(&accelerometers()).unwrap();
-    Model {
-        ss,
-        meas,
-        q: SMatrix::from_fn(|i, j| q[i][j]),
-        g_force: forces.gamma0_matrix() + forces.gamma1_matrix(),
-    }
-}
-
-/// Peak |absolute acceleration| of the intact building at the sensors under El Centro.
-fn peaks() -> [f64; 3] {
-    let md = model([1.0; 5]);
-    let (phi, g0, g1) = (
-        md.ss.phi_matrix(),
-        md.ss.gamma0_matrix(),
-        md.ss.gamma1_matrix(),
-    );
-    let (h, d) = (md.meas.h_matrix(), md.meas.d_matrix());
-    let ag = &elcentro::AG_F64;
-    let mut x = SVector::<f64, 10>::zeros();
-    let mut p = [0.0f64; 3];
-    for n in 1..ag.len() {
-        let (w0, w1) = (SVector::from([ag[n - 1]]), SVector::from([ag[n]]));
-        x = phi * x + g0 * w0 + g1 * w1;
-        let y = h * x + d * w1;
-        for o in 0..3 {
-            p[o] = p[o].max(y[o].abs());
-        }
-    }
-    p
-}
-
-fn r_rows(sigma: [f64; 3]) -> Rows<3> {
-    core::array::from_fn(|i| {
-        core::array::from_fn(|j| if i == j { sigma[i] * sigma[i] } else { 0.0 })
-    })
-}
-
-/// A model's steady-state observer and whitener.
-fn observer_of(
-    md: &Model,
-    r: &Rows<3>,
-) -> (
-    Observer<f64, 10, 1, 3>,
-    Whitener<f64, 3>,
-    SteadyState<10, 3>,
-) {
-    let kf = SteadyState::new(&md.ss, &md.meas, &md.q, &SMatrix::from_fn(|i, j| r[i][j])).unwrap();
-    let obs = Observer::new(&md.ss, &md.meas, &kf.gain_matrix()).unwrap();
-    let s = innovation_covariance(&kf, &md.meas, r).unwrap();
-    (obs, Whitener::new(&s).unwrap(), kf)
-}
-
-/// Standard normal samples: Box–Muller on xorshift64*.
-struct Gauss(u64, Option<f64>);
-impl Gauss {
-    fn new(seed: u64) -> Self {
-        Gauss(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1, None)
-    }
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn next(&mut self) -> f64 {
-        if let Some(z) = self.1.take() {
-            return z;
-        }
-        let (u1, u2) = (self.uniform(), self.uniform());
-        let r = (-2.0 * u1.ln()).sqrt();
-        let t = 2.0 * std::f64::consts::PI * u2;
-        self.1 = Some(r * t.sin());
-        r * t.cos()
-    }
-}
-
-// ---------------------------------------------------------------------------------------
 // (b) False alarms on the intact structure.
 // ---------------------------------------------------------------------------------------
-
-/// Detector window: 1 s (50 samples of 3 accelerometers: 150 degrees of freedom).
-const W: usize = 50;
 
 #[test]
 fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
@@ -499,24 +349,12 @@ fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
     // covariance, so that P⁻ = P from the first step.
     const ALPHA: f64 = 0.01;
     const SEEDS: u64 = 160;
-    let sigma = peaks().map(|p| NOISE_FRACTION * p);
+    let sigma = peaks(&elcentro::AG_F64).map(|p| NOISE_FRACTION * p);
     let r = r_rows(sigma);
     let md = model([1.0; 5]);
     let (obs, wh, kf) = observer_of(&md, &r);
     let det = Detector::<f64, 3, W>::new(wh, ChiSquareTest::new(3, ALPHA).unwrap());
-    let (phi, g0, g1) = (
-        md.ss.phi_matrix(),
-        md.ss.gamma0_matrix(),
-        md.ss.gamma1_matrix(),
-    );
-    let (h, d) = (md.meas.h_matrix(), md.meas.d_matrix());
-    let (p, l) = (kf.covariance_matrix(), kf.gain_matrix());
-    let post = (SMatrix::<f64, 10, 10>::identity() - l * h) * p;
-    let post = (post + post.transpose()) * 0.5;
-    let eig = post.symmetric_eigen();
-    let root = eig.eigenvectors
-        * SMatrix::<f64, 10, 10>::from_diagonal(&eig.eigenvalues.map(|v| v.max(0.0).sqrt()));
-    let gf = md.g_force * SIGMA_F;
+    let truth = IntactTruth::new(&md, &kf);
     let ag = &elcentro::AG_F64;
     let (mut trials, mut alarms) = (0u64, 0u64);
     let (mut evals, mut alarm_samples) = (0u64, 0u64);
@@ -528,14 +366,13 @@ fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
     let mut cusum_alarms = 0u64;
     for seed in 0..SEEDS {
         let mut g = Gauss::new(1000 + seed);
-        let mut x = root * SVector::<f64, 10>::from_fn(|_, _| g.next());
+        let mut x = truth.start(&mut g);
         let mut e = obs.start_at_rest(&SVector::from([ag[0]])).unwrap();
         let mut win = Window::<W>::new();
         let mut cs = CusumState::new();
         for n in 1..ag.len() {
-            let (w0, w1) = (SVector::from([ag[n - 1]]), SVector::from([ag[n]]));
-            x = phi * x + g0 * w0 + g1 * w1 + gf * SVector::<f64, 5>::from_fn(|_, _| g.next());
-            let y = h * x + d * w1 + SVector::<f64, 3>::from_fn(|o, _| sigma[o] * g.next());
+            let w1 = SVector::from([ag[n]]);
+            let y = truth.step(&mut x, ag, n, &sigma, &mut g);
             let nu = obs.step_innovation(&mut e, &w1, &y);
             let q = det.whitener.nis(&nu);
             nis_sum += q;
@@ -605,17 +442,6 @@ fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
 // (c) Storey 1 loses 10 % of its stiffness at t = 20 s.
 // ---------------------------------------------------------------------------------------
 
-/// The hypotheses: intact, and storey `i` 10 % softer (`i = 1…5`).
-const HYPOTHESES: usize = 6;
-fn hypothesis(m: usize) -> [f64; 5] {
-    core::array::from_fn(|i| if m > 0 && i == m - 1 { 0.9 } else { 1.0 })
-}
-
-/// The bank's window: 10 s. Storey 1 is named about a window after the damage (the
-/// window must first shed the samples from before it); with 5 s one noise seed in 8 lost
-/// it again for a while in the weakly excited part near t = 58 s (measured).
-const WB: usize = 500;
-
 /// What one run of the damage scene measured.
 struct DamageRun {
     /// First χ² alarm after the damage (s after it).
@@ -634,38 +460,12 @@ struct DamageRun {
 /// empties the bank's windows at the first alarm if `restart`.
 fn damage_run(seed: u64, verbose: bool, restart: bool) -> DamageRun {
     let ag = &elcentro::AG_F64;
-    let sigma = peaks().map(|p| NOISE_FRACTION * p);
+    let sigma = peaks(&elcentro::AG_F64).map(|p| NOISE_FRACTION * p);
     let r = r_rows(sigma);
     let k_change = (20.0 / H).round() as usize; // sample of t = 20 s
-    // The truth: two AEM steppers, the intact building until t = 20 s, then storey 1 at
-    // 90 %, handed the displacement and velocity (the acceleration follows from the new
-    // stiffness); absolute accelerations at floors 1, 3, 5 plus 3 % noise.
-    let b = base_excitation(&building([1.0; 5]).0);
-    let (m0, c0, k0) = building([1.0; 5]);
-    let (m1, c1, k1) = building(hypothesis(1));
-    let intact = LinearInput::<f64, 5, 1>::from_rows_f64(m0, c0, k0, b, H).unwrap();
-    let damaged = LinearInput::<f64, 5, 1>::from_rows_f64(m1, c1, k1, b, H).unwrap();
-    let z = SVector::<f64, 5>::zeros();
-    let mut s = intact.start(&z, &z, &SVector::from([ag[0]])).unwrap();
-    let mut g = Gauss::new(seed);
-    let mut ys = Vec::with_capacity(ag.len());
-    ys.push(SVector::<f64, 3>::from_element(f64::NAN)); // no sample at t = 0
-    for n in 1..ag.len() {
-        let w = SVector::from([ag[n]]);
-        if n == k_change {
-            s = damaged
-                .start(s.u(), s.v(), &SVector::from([ag[n - 1]]))
-                .unwrap();
-        }
-        if n >= k_change {
-            damaged.step(&mut s, &w);
-        } else {
-            intact.step(&mut s, &w);
-        }
-        ys.push(SVector::from_fn(|o, _| {
-            s.a()[SENSORS[o]] + ag[n] + sigma[o] * g.next()
-        }));
-    }
+    // The truth: the intact building until t = 20 s, then storey 1 at 90 %; absolute
+    // accelerations at floors 1, 3, 5 plus 3 % noise.
+    let ys = damage_measurements(ag, k_change, sigma, seed);
 
     // The detector on the intact model; the bank of six hypotheses.
     let mut obs = Vec::new();

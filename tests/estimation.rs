@@ -18,7 +18,10 @@ use aemstep::observer::{Kalman, Observer, Outputs, Readout, StateSpace};
 use aemstep::{Error, Linear, Stepper};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+#[path = "../scenes/estimation/start.rs"]
+mod start;
 mod support;
+use start::{augmented_kalman, rows, start_joint};
 use support::Rng;
 
 const EPS: f64 = f64::EPSILON;
@@ -62,6 +65,22 @@ fn process_noise(ss: &StateSpace<5, 10, 1>) -> SMatrix<f64, 10, 10> {
     let qw: [[f64; 5]; 5] =
         core::array::from_fn(|i| core::array::from_fn(|j| if i == j { 1e4 } else { 0.0 }));
     SMatrix::from_fn(|i, j| f.input_noise(&qw)[i][j])
+}
+
+/// The scene most tests share: the building, three accelerometers and the roof
+/// displacement, the filters' model, `Q` and `R`.
+#[allow(clippy::type_complexity)] // the five parts, named at each use
+fn displacement_scene() -> (
+    StateSpace<5, 10, 1>,
+    Outputs<5, 1, 4>,
+    InputModel<10, 1, 4>,
+    SMatrix<f64, 10, 10>,
+    SMatrix<f64, 4, 4>,
+) {
+    let ss = building();
+    let out = with_displacement();
+    let model = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
+    (ss, out, model, process_noise(&ss), sensor_noise())
 }
 
 fn eye5() -> [[f64; 5]; 5] {
@@ -123,6 +142,33 @@ struct Gdm {
 }
 
 impl Gdm {
+    /// The paper's filter for the building `ss` measured by `out`, noise covariances `q`
+    /// and `r`, started at zero with `P₀ = 10⁻⁸ I` and the input's variance `10¹⁰`.
+    fn start(
+        ss: &StateSpace<5, 10, 1>,
+        out: &Outputs<5, 1, 4>,
+        q: &SMatrix<f64, 10, 10>,
+        r: &SMatrix<f64, 4, 4>,
+    ) -> Self {
+        let (a, b, c, d) = paper_model(ss, out);
+        Gdm {
+            a,
+            g: b,
+            c,
+            h: d,
+            q: dm(&rows(q)),
+            r: dm(&rows(r)),
+            x: DVector::zeros(10),
+            d: DVector::zeros(1),
+            px: DMatrix::identity(10, 10) * 1e-8,
+            pxd: DMatrix::zeros(10, 1),
+            pd: DMatrix::from_element(1, 1, 1e10),
+            k: DMatrix::zeros(10, 4),
+            m: DMatrix::zeros(1, 4),
+            p_pred: DMatrix::zeros(10, 10),
+        }
+    }
+
     fn step(&mut self, y: &DVector<f64>) {
         // Time update.
         let x_pred = &self.a * &self.x + &self.g * &self.d;
@@ -306,10 +352,6 @@ fn building_identifiability() {
     );
 }
 
-fn rows<const R: usize, const C: usize>(a: &SMatrix<f64, R, C>) -> [[f64; C]; R] {
-    core::array::from_fn(|i| core::array::from_fn(|j| a[(i, j)]))
-}
-
 /// Noisy measurements of the building run.
 fn noisy(ys: &[SVector<f64, 4>], seed: u64) -> Vec<SVector<f64, 4>> {
     let mut rng = Rng::new(seed);
@@ -328,11 +370,7 @@ fn time_varying_filter_matches_the_paper() {
     // input estimate: |M| |y − C ξ⁻| relative to |ŵ|. Bound 1e-12 relative (about
     // 4500 ε: ε times S·O = 40 terms times a gain amplification of about 100 of |M| |y|
     // against |ŵ|); measured about 2e-14.
-    let ss = building();
-    let out = with_displacement();
-    let model = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
-    let q = process_noise(&ss);
-    let r = sensor_noise();
+    let (ss, out, model, q, r) = displacement_scene();
     let w = wind(600, 2);
     let (xs, ys) = truth_run(&ss, &out, &w);
     let ys = noisy(&ys, 3);
@@ -342,23 +380,7 @@ fn time_varying_filter_matches_the_paper() {
     let mut s = f
         .start(&SVector::zeros(), &p0, &SVector::zeros(), &pw0)
         .unwrap();
-    let (a, b, c, d) = paper_model(&ss, &out);
-    let mut g = Gdm {
-        a,
-        g: b,
-        c,
-        h: d,
-        q: dm(&rows(&q)),
-        r: dm(&rows(&r)),
-        x: DVector::zeros(10),
-        d: DVector::zeros(1),
-        px: dm(&rows(&p0)),
-        pxd: DMatrix::zeros(10, 1),
-        pd: DMatrix::from_element(1, 1, 1e10),
-        k: DMatrix::zeros(10, 4),
-        m: DMatrix::zeros(1, 4),
-        p_pred: DMatrix::zeros(10, 10),
-    };
+    let mut g = Gdm::start(&ss, &out, &q, &r); // the same start: P₀ = 1e-8 I, P_w0 = 1e10
     let (mut dw, mut dx, mut wmax, mut xmax) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let (mut err_w, mut err_drift) = (0.0f64, 0.0f64);
     let drifts = Readout::<f64, 10, 1, 5>::new(
@@ -407,29 +429,9 @@ fn steady_gains_are_the_limit_of_the_recursion() {
     // (module docs). The recursion converges linearly; after it stops moving (2·10⁻¹⁴
     // relative a step) the difference is rounding of both, amplified by the Riccati
     // equation's conditioning: bound 1e-12 relative (measured about 2e-14).
-    let ss = building();
-    let out = with_displacement();
-    let model = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
-    let q = process_noise(&ss);
-    let r = sensor_noise();
+    let (ss, out, model, q, r) = displacement_scene();
     let gains = InputStateGains::new(&model, &q, &r).unwrap();
-    let (a, b, c, d) = paper_model(&ss, &out);
-    let mut g = Gdm {
-        a,
-        g: b,
-        c,
-        h: d,
-        q: dm(&rows(&q)),
-        r: dm(&rows(&r)),
-        x: DVector::zeros(10),
-        d: DVector::zeros(1),
-        px: DMatrix::identity(10, 10) * 1e-8,
-        pxd: DMatrix::zeros(10, 1),
-        pd: DMatrix::from_element(1, 1, 1e10),
-        k: DMatrix::zeros(10, 4),
-        m: DMatrix::zeros(1, 4),
-        p_pred: DMatrix::zeros(10, 10),
-    };
+    let mut g = Gdm::start(&ss, &out, &q, &r);
     let y = DVector::zeros(4);
     let mut last = DMatrix::zeros(10, 10);
     let mut steps = 0;
@@ -645,14 +647,7 @@ fn missing_samples_failed_steps_and_bad_input() {
     assert_eq!(e, snap);
     // The time-varying filter: the same rules.
     let tv = InputStateFilter::<f64, 10, 1, 4>::new(&model, &q, &r).unwrap();
-    let mut s = tv
-        .start(
-            &SVector::zeros(),
-            &(SMatrix::identity() * 1e-8),
-            &SVector::zeros(),
-            &SMatrix::from([[1e10]]),
-        )
-        .unwrap();
+    let mut s = start_joint(&tv);
     tv.try_step(&mut s, &SVector::from([0.1, 0.2, 0.3, 1e-3]))
         .unwrap();
     let snap = s;
@@ -717,11 +712,7 @@ fn augmented_kalman_filter_matches_an_independent_filter() {
     // matrices, filtered by a Kalman filter written here (predict, gain by inverse,
     // Joseph update), against the crate's Kalman on `AugmentedModel` and the fixed-gain
     // Observer with the steady gain against the independent filter's converged gain.
-    let ss = building();
-    let out = with_displacement();
-    let model = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
-    let q = process_noise(&ss);
-    let r = sensor_noise();
+    let (ss, out, model, q, r) = displacement_scene();
     let qw = 1e8; // random-walk step of 10⁴ N
     let aug = AugmentedModel::<10, 1, 11, 4>::from_parts(&model, &rows(&q), &[[qw]]).unwrap();
     let (a, b, c, d) = paper_model(&ss, &out);
@@ -814,14 +805,7 @@ fn acceleration_only_drifts() {
     let q = process_noise(&ss);
     let r = SMatrix::<f64, 3, 3>::identity() * 9e-4;
     let tv = InputStateFilter::<f64, 10, 1, 3>::new(&model, &q, &r).unwrap();
-    let mut s = tv
-        .start(
-            &SVector::zeros(),
-            &(SMatrix::identity() * 1e-8),
-            &SVector::zeros(),
-            &SMatrix::from([[1e10]]),
-        )
-        .unwrap();
+    let mut s = start_joint(&tv);
     let mut traces = Vec::new();
     for n in 1..=4000 {
         tv.try_step(&mut s, &SVector::zeros()).unwrap();
@@ -836,19 +820,7 @@ fn acceleration_only_drifts() {
     // measured: it grows by the random walk's whole 1000 · Q_w = 1e11 N² every 1000 steps,
     // the data do not reduce it.
     let aug = AugmentedModel::<10, 1, 11, 3>::from_parts(&model, &rows(&q), &[[1e8]]).unwrap();
-    let kf = Kalman::<f64, 11, 0, 3>::new(
-        &aug.model,
-        &aug.measurement,
-        &SMatrix::from_fn(|i, j| aug.process_noise[i][j]),
-        &r,
-    )
-    .unwrap();
-    let p0 = SMatrix::<f64, 11, 11>::from_fn(|i, j| match (i == j, i < 10) {
-        (false, _) => 0.0,
-        (true, true) => 1e-8,
-        (true, false) => 1e10,
-    });
-    let mut s = kf.start(&SVector::zeros(), &p0, &SVector::zeros()).unwrap();
+    let (kf, mut s) = augmented_kalman(&aug, &r);
     let mut var_w = Vec::new();
     for n in 1..=4000 {
         kf.try_step(&mut s, &SVector::zeros(), &SVector::zeros())
@@ -890,10 +862,8 @@ fn dual_filter_matches_an_independent_filter_and_drifts_without_displacement() {
     // D̃ᵀ + R)⁻¹, P = P⁻ − G D̃ P⁻; state: P⁻ = A P Aᵀ + Q, G = P⁻ Cᵀ (C P⁻ Cᵀ + R)⁻¹,
     // P = P⁻ − G C P⁻), iterated to their limits, against the crate's steady gains; then
     // the fixed-gain steps of both on the same data.
-    let ss = building();
-    let out = with_displacement();
-    let model = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
-    let (q, r, qw) = (process_noise(&ss), sensor_noise(), 1e8);
+    let (ss, out, model, q, r) = displacement_scene();
+    let qw = 1e8;
     let gains = DualGains::new(&model, &q, &SMatrix::from([[qw]]), &r).unwrap();
     let (a, _, c, d) = paper_model(&ss, &out);
     let (qd, rd) = (dm(&rows(&q)), dm(&rows(&r)));
@@ -1001,10 +971,7 @@ fn fixed_lag_smoother_matches_rts_on_each_window() {
     // steady ones at every step), then for each n the Rauch–Tung–Striebel recursion run
     // back L steps over the window (C = P⁺ Φᵀ (P⁻)⁻¹): x̂_{n−L|n}, against the smoother.
     const LAG: usize = 10;
-    let ss = building();
-    let out = with_displacement();
-    let model = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
-    let (q, r) = (process_noise(&ss), sensor_noise());
+    let (ss, out, model, q, r) = displacement_scene();
     let aug = AugmentedModel::<10, 1, 11, 4>::from_parts(&model, &rows(&q), &[[1e8]]).unwrap();
     let steady = aug.steady_state(&rows(&r)).unwrap();
     let sm =
@@ -1124,14 +1091,7 @@ fn modal_model_and_f32_time_varying_filter() {
             &SMatrix::from([[1e10]]),
         )
         .unwrap();
-    let mut s64 = f64f
-        .start(
-            &SVector::zeros(),
-            &(SMatrix::identity() * 1e-8),
-            &SVector::zeros(),
-            &SMatrix::from([[1e10]]),
-        )
-        .unwrap();
+    let mut s64 = start_joint(&f64f);
     let mut d = 0.0f64;
     for n in 1..ys.len() {
         f32f.try_step(&mut s32, &ys[n].cast::<f32>()).unwrap();

@@ -16,8 +16,11 @@ use nalgebra::{SMatrix, SVector};
 mod checks;
 #[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
+#[path = "../scenes/detection/gauss.rs"]
+mod gauss;
 mod support;
 
+use gauss::Gauss;
 use support::{max_abs, riccati_residual, sm, spectral_radius};
 
 const H: f64 = elcentro::DT;
@@ -591,30 +594,6 @@ fn f32_observer_from_the_compiler_is_bit_identical_to_run_time() {
     let kf = SteadyState::new(&ss, &meas, &force_noise(SIGMA_F), &r_matrix()).unwrap();
     let run = Observer::<f32, 10, 1, 2>::new(&ss, &meas, &kf.gain_matrix()).unwrap();
     assert_eq!(OBS, run);
-}
-
-/// Standard normal samples (Box–Muller on the xorshift generator below).
-struct Gauss(u64, Option<f64>);
-impl Gauss {
-    fn new(seed: u64) -> Self {
-        Gauss(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1, None)
-    }
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn next(&mut self) -> f64 {
-        if let Some(z) = self.1.take() {
-            return z;
-        }
-        let (u1, u2) = (self.uniform(), self.uniform());
-        let r = (-2.0 * u1.ln()).sqrt();
-        let t = 2.0 * std::f64::consts::PI * u2;
-        self.1 = Some(r * t.sin());
-        r * t.cos()
-    }
 }
 
 /// Chi-square quantile (Wilson–Hilferty; relative error below 1e-3 for k ≥ 100).

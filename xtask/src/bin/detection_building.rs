@@ -7,46 +7,42 @@
 //! Writes `docs/detection.md` (detection delay over noise seeds, false alarms on the
 //! intact structure against the rate the threshold was set for, the storey the bank names)
 //! and `docs/detection.svg` (one seed: the window statistic against its threshold, and the
-//! bank's log-likelihoods). Deterministic: fixed seeds, its own xorshift64* generator (the
-//! one of `tests/detection.rs`, which checks the same scene with assertions).
+//! bank's log-likelihoods). Deterministic: fixed seeds, the xorshift64* generator of
+//! `scenes/detection/gauss.rs`. The scene itself is `scenes/detection/scene.rs`, shared with
+//! `tests/detection.rs`, which checks it with assertions.
 //!
 //! Run: `cargo run --release -p xtask --bin detection_building [DIR]` (default `docs`;
 //! `scripts/check_docs.py` regenerates into a temporary directory and compares).
 
 #![allow(clippy::needless_range_loop)] // matrix and record indices read best explicitly
 
+#[path = "../../../scenes/detection/chi2.rs"]
+mod chi2;
 #[path = "../../../scenes/modal/elcentro.rs"]
 mod elcentro;
+#[path = "../../../scenes/detection/gauss.rs"]
+mod gauss;
+#[path = "../plot.rs"]
+mod plot;
+#[path = "../../../scenes/detection/scene.rs"]
+mod scene;
 
 use std::fmt::Write as _;
 
-use aemstep::detection::{
-    ChiSquareTest, Cusum, CusumState, Detector, ModelBank, Whitener, Window, innovation_covariance,
-};
-use aemstep::models::{self, base_excitation};
-use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::observer::{Measurement, Observer, Outputs, StateSpace, SteadyState};
-use aemstep::{LinearInput, Stepper};
+use aemstep::detection::{ChiSquareTest, Cusum, CusumState, Detector, ModelBank, Whitener, Window};
+use aemstep::nalgebra::SVector;
+use aemstep::observer::Observer;
 use plotters::prelude::*;
 
-const H: f64 = elcentro::DT;
-type Rows<const N: usize> = [[f64; N]; N];
+use chi2::chi2_upper_tail;
+use gauss::Gauss;
+use scene::{
+    H, HYPOTHESES, IntactTruth, NOISE_FRACTION, SIGMA_F, W, WB, damage_measurements, hypothesis,
+    model, model_q, observer_of, peaks, r_rows,
+};
 
-/// Measured: absolute accelerations of floors 1, 3 and 5 (DOFs 0, 2, 4).
-const SENSORS: [usize; 3] = [0, 2, 4];
-/// Process noise of every observer: white forces of this standard deviation (N) on every
-/// floor (0.5 % of a storey's weight).
-const SIGMA_F: f64 = 5.0e3;
 /// A larger process noise, to show what it costs: the observer follows the change.
 const SIGMA_F_LARGE: f64 = 2.0e4;
-/// Accelerometer noise: 3 % of each sensor's peak under El Centro.
-const NOISE_FRACTION: f64 = 0.03;
-/// Detector window: 1 s (50 samples of 3 accelerometers: 150 degrees of freedom).
-const W: usize = 50;
-/// The bank's window: 10 s.
-const WB: usize = 500;
-/// The hypotheses: intact, and storey `i` 10 % softer (`i = 1…5`).
-const HYPOTHESES: usize = 6;
 /// False-alarm probability per evaluation of the damage scene's χ² test and CUSUM.
 const ALPHA_DAMAGE: f64 = 1e-6;
 /// CUSUM's covariance increase in the damage scene.
@@ -58,150 +54,6 @@ const INTACT_SEEDS: u64 = 400;
 const ALPHAS: [f64; 4] = [1e-2, 1e-3, 1e-4, ALPHA_DAMAGE];
 /// Binomial band: ±4.42 standard deviations (two-sided 10⁻⁵, normal approximation).
 const Z: f64 = 4.42;
-
-fn hypothesis(m: usize) -> [f64; 5] {
-    core::array::from_fn(|i| if m > 0 && i == m - 1 { 0.9 } else { 1.0 })
-}
-
-/// The building with storey stiffness factors `f` (1 = intact): `M`, `C`, `K`.
-fn building(f: [f64; 5]) -> (Rows<5>, Rows<5>, Rows<5>) {
-    let (m, c, _) = models::five_storey_building();
-    let ks: [f64; 5] = core::array::from_fn(|i| models::FIVE_STOREY_STIFFNESS * f[i]);
-    let (_, k) = models::shear_building([models::FIVE_STOREY_MASS; 5], ks);
-    (m, c, k)
-}
-
-struct Model {
-    ss: StateSpace<5, 10, 1>,
-    meas: Measurement<10, 1, 3>,
-    q: SMatrix<f64, 10, 10>,
-    /// `Γ₀ + Γ₁` of the floor forces.
-    g_force: SMatrix<f64, 10, 5>,
-}
-
-fn model(f: [f64; 5]) -> Model {
-    model_q(f, SIGMA_F)
-}
-
-/// As [`model`], with process noise of white floor forces of `sigma_f` (N).
-fn model_q(f: [f64; 5], sigma_f: f64) -> Model {
-    let (m, c, k) = building(f);
-    let ss = StateSpace::from_rows_aem(m, c, k, base_excitation(&m), H).unwrap();
-    let eye: Rows<5> = core::array::from_fn(|i| core::array::from_fn(|j| (i == j) as u8 as f64));
-    let forces = StateSpace::<5, 10, 5>::from_rows_aem(m, c, k, eye, H).unwrap();
-    let qw: Rows<5> = core::array::from_fn(|i| {
-        core::array::from_fn(|j| if i == j { sigma_f * sigma_f } else { 0.0 })
-    });
-    let q = forces.input_noise(&qw);
-    let sensors = Outputs::absolute_accelerations(Outputs::<5, 1, 3>::select(SENSORS), 0);
-    let meas = ss.outputs(&sensors).unwrap();
-    Model {
-        ss,
-        meas,
-        q: SMatrix::from_fn(|i, j| q[i][j]),
-        g_force: forces.gamma0_matrix() + forces.gamma1_matrix(),
-    }
-}
-
-/// Peak |absolute acceleration| of the intact building at the sensors under El Centro.
-fn peaks(ag: &[f64]) -> [f64; 3] {
-    let md = model([1.0; 5]);
-    let (phi, g0, g1) = (
-        md.ss.phi_matrix(),
-        md.ss.gamma0_matrix(),
-        md.ss.gamma1_matrix(),
-    );
-    let (h, d) = (md.meas.h_matrix(), md.meas.d_matrix());
-    let mut x = SVector::<f64, 10>::zeros();
-    let mut p = [0.0f64; 3];
-    for n in 1..ag.len() {
-        let (w0, w1) = (SVector::from([ag[n - 1]]), SVector::from([ag[n]]));
-        x = phi * x + g0 * w0 + g1 * w1;
-        let y = h * x + d * w1;
-        for o in 0..3 {
-            p[o] = p[o].max(y[o].abs());
-        }
-    }
-    p
-}
-
-fn r_rows(sigma: [f64; 3]) -> Rows<3> {
-    core::array::from_fn(|i| {
-        core::array::from_fn(|j| if i == j { sigma[i] * sigma[i] } else { 0.0 })
-    })
-}
-
-/// A model's steady-state observer and whitener.
-fn observer_of(
-    md: &Model,
-    r: &Rows<3>,
-) -> (
-    Observer<f64, 10, 1, 3>,
-    Whitener<f64, 3>,
-    SteadyState<10, 3>,
-) {
-    let kf = SteadyState::new(&md.ss, &md.meas, &md.q, &SMatrix::from_fn(|i, j| r[i][j])).unwrap();
-    let obs = Observer::new(&md.ss, &md.meas, &kf.gain_matrix()).unwrap();
-    let s = innovation_covariance(&kf, &md.meas, r).unwrap();
-    (obs, Whitener::new(&s).unwrap(), kf)
-}
-
-/// Standard normal samples: Box–Muller on xorshift64* (as in `tests/detection.rs`).
-struct Gauss(u64, Option<f64>);
-impl Gauss {
-    fn new(seed: u64) -> Self {
-        Gauss(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1, None)
-    }
-    fn uniform(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-    fn next(&mut self) -> f64 {
-        if let Some(z) = self.1.take() {
-            return z;
-        }
-        let (u1, u2) = (self.uniform(), self.uniform());
-        let r = (-2.0 * u1.ln()).sqrt();
-        let t = 2.0 * std::f64::consts::PI * u2;
-        self.1 = Some(r * t.sin());
-        r * t.cos()
-    }
-}
-
-/// `ln Γ(k/2)` exactly from `Γ(a + 1) = a Γ(a)`, `Γ(1) = 1`, `Γ(½) = √π`.
-fn ln_gamma_half(k: u64) -> f64 {
-    let mut s = if k.is_multiple_of(2) {
-        0.0
-    } else {
-        0.5 * std::f64::consts::PI.ln()
-    };
-    let mut a = if k.is_multiple_of(2) { 1.0 } else { 0.5 };
-    while a < k as f64 / 2.0 - 1e-9 {
-        s += a.ln();
-        a += 1.0;
-    }
-    s
-}
-
-/// The exact upper tail `P(χ²_k > x)` from the series of the lower regularized gamma
-/// function (Abramowitz & Stegun 6.5.29), independent of the crate's quantile.
-fn chi2_upper_tail(k: u64, x: f64) -> f64 {
-    let a = k as f64 / 2.0;
-    let y = x / 2.0;
-    let (mut term, mut sum, mut n) = (1.0f64, 1.0f64, 1.0f64);
-    loop {
-        term *= y / (a + n);
-        sum += term;
-        if term < 1e-17 * sum {
-            break;
-        }
-        n += 1.0;
-    }
-    let lp = a * y.ln() - y - (a.ln() + ln_gamma_half(k)) + sum.ln();
-    1.0 - lp.exp()
-}
 
 /// One sample of a run's trace: the window sum, the CUSUM statistic, the bank's
 /// log-likelihoods.
@@ -240,14 +92,7 @@ fn damage_run(sc: &Scene, seed: u64, restart: bool) -> DamageRun {
     let k_change = (20.0 / H).round() as usize;
     // The truth: the intact building until t = 20 s, then storey 1 at 90 % (an AEM
     // stepper handed the displacement and velocity).
-    let b = base_excitation(&building([1.0; 5]).0);
-    let (m0, c0, k0) = building([1.0; 5]);
-    let (m1, c1, k1) = building(hypothesis(1));
-    let intact = LinearInput::<f64, 5, 1>::from_rows_f64(m0, c0, k0, b, H).unwrap();
-    let damaged = LinearInput::<f64, 5, 1>::from_rows_f64(m1, c1, k1, b, H).unwrap();
-    let z = SVector::<f64, 5>::zeros();
-    let mut s = intact.start(&z, &z, &SVector::from([ag[0]])).unwrap();
-    let mut g = Gauss::new(seed);
+    let ys = damage_measurements(ag, k_change, sc.sigma, seed);
 
     let det = Detector::<f64, 3, W>::new(sc.whs[0], ChiSquareTest::new(3, ALPHA_DAMAGE).unwrap());
     let bank = ModelBank::<f64, 10, 1, 3, HYPOTHESES>::new(
@@ -271,18 +116,7 @@ fn damage_run(sc: &Scene, seed: u64, restart: bool) -> DamageRun {
     let mut trace = vec![(0.0, 0.0, [0.0; HYPOTHESES])];
     for n in 1..ag.len() {
         let w = SVector::from([ag[n]]);
-        if n == k_change {
-            s = damaged
-                .start(s.u(), s.v(), &SVector::from([ag[n - 1]]))
-                .unwrap();
-        }
-        if n >= k_change {
-            damaged.step(&mut s, &w);
-        } else {
-            intact.step(&mut s, &w);
-        }
-        let y: SVector<f64, 3> =
-            SVector::from_fn(|o, _| s.a()[SENSORS[o]] + ag[n] + sc.sigma[o] * g.next());
+        let y = ys[n];
         let nu = sc.obs[0].step_innovation(&mut e, &w, &y);
         let alarm = det.update(&mut win, &nu);
         let c_alarm = cusum.update(&mut cs, det.whitener.nis(&nu));
@@ -347,21 +181,7 @@ fn intact_runs(sc: &Scene, tests: &[ChiSquareTest<W>; ALPHAS.len()]) -> Intact {
     let ag = sc.ag;
     let md = model([1.0; 5]);
     let (obs, wh, kf) = observer_of(&md, &r_rows(sc.sigma));
-    let (phi, g0, g1) = (
-        md.ss.phi_matrix(),
-        md.ss.gamma0_matrix(),
-        md.ss.gamma1_matrix(),
-    );
-    let (h, d) = (md.meas.h_matrix(), md.meas.d_matrix());
-    // A stationary start: x₀ ~ N(0, (I − L H) P), so that the a-priori covariance is P
-    // from the first step.
-    let (p, l) = (kf.covariance_matrix(), kf.gain_matrix());
-    let post = (SMatrix::<f64, 10, 10>::identity() - l * h) * p;
-    let post = (post + post.transpose()) * 0.5;
-    let eig = post.symmetric_eigen();
-    let root = eig.eigenvectors
-        * SMatrix::<f64, 10, 10>::from_diagonal(&eig.eigenvalues.map(|v| v.max(0.0).sqrt()));
-    let gf = md.g_force * SIGMA_F;
+    let truth = IntactTruth::new(&md, &kf);
     let cusum = Cusum::new(3, LAMBDA_INTACT, ALPHA_CUSUM).unwrap();
     let mut out = Intact {
         alarms: [0; ALPHAS.len()],
@@ -375,14 +195,13 @@ fn intact_runs(sc: &Scene, tests: &[ChiSquareTest<W>; ALPHAS.len()]) -> Intact {
     let mut nis_sum = 0.0;
     for seed in 0..INTACT_SEEDS {
         let mut g = Gauss::new(1000 + seed);
-        let mut x = root * SVector::<f64, 10>::from_fn(|_, _| g.next());
+        let mut x = truth.start(&mut g);
         let mut e = obs.start_at_rest(&SVector::from([ag[0]])).unwrap();
         let mut win = Window::<W>::new();
         let mut cs = CusumState::new();
         for n in 1..ag.len() {
-            let (w0, w1) = (SVector::from([ag[n - 1]]), SVector::from([ag[n]]));
-            x = phi * x + g0 * w0 + g1 * w1 + gf * SVector::<f64, 5>::from_fn(|_, _| g.next());
-            let y = h * x + d * w1 + SVector::<f64, 3>::from_fn(|o, _| sc.sigma[o] * g.next());
+            let w1 = SVector::from([ag[n]]);
+            let y = truth.step(&mut x, ag, n, &sc.sigma, &mut g);
             let nu = obs.step_innovation(&mut e, &w1, &y);
             let q = wh.nis(&nu);
             nis_sum += q;
@@ -451,15 +270,12 @@ fn plot(
         .iter()
         .fold(threshold, |m, v| m.max(v.0).max(v.1))
         * 2.0;
-    let mut chart = ChartBuilder::on(&top)
-        .caption(
-            "Intact model's innovations: 1 s window χ² sum and CUSUM (storey 1 −10 % at t = 20 s)",
-            ("sans-serif", 18),
-        )
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..t_end, (1.0..ymax).log_scale())?;
+    let mut chart = plot::chart(
+        &top,
+        "Intact model's innovations: 1 s window χ² sum and CUSUM (storey 1 −10 % at t = 20 s)",
+        0.0..t_end,
+        (1.0..ymax).log_scale(),
+    )?;
     chart
         .configure_mesh()
         .x_desc("t (s)")
@@ -493,22 +309,13 @@ fn plot(
     ];
     for (name, p, col, wdt) in series {
         let style = col.stroke_width(wdt);
-        chart
-            .draw_series(LineSeries::new(p, style))?
-            .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        plot::line(&mut chart, name, p, style)?;
     }
     chart.draw_series(LineSeries::new(
         vec![(20.0, 1.0), (20.0, ymax)],
         BLACK.stroke_width(1),
     ))?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()?;
+    plot::legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     // Bottom: each hypothesis' log-likelihood over the 10 s window, minus the intact one's.
     let rel: Vec<[f64; HYPOTHESES]> = run.trace[..n_end]
         .iter()
@@ -518,15 +325,12 @@ fn plot(
         .iter()
         .flatten()
         .fold((0.0f64, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
-    let mut chart = ChartBuilder::on(&bottom)
-        .caption(
-            "Model bank: log-likelihood over the last 10 s, minus the intact model's",
-            ("sans-serif", 18),
-        )
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..t_end, (lo * 1.1)..(hi * 1.1 + 1.0))?;
+    let mut chart = plot::chart(
+        &bottom,
+        "Model bank: log-likelihood over the last 10 s, minus the intact model's",
+        0.0..t_end,
+        (lo * 1.1)..(hi * 1.1 + 1.0),
+    )?;
     chart
         .configure_mesh()
         .x_desc("t (s)")
@@ -548,22 +352,13 @@ fn plot(
             .step_by(2)
             .map(|(n, v)| (n as f64 * H, v[m]))
             .collect();
-        chart
-            .draw_series(LineSeries::new(p, style))?
-            .label(format!("storey {m} 10 % softer"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        plot::line(&mut chart, format!("storey {m} 10 % softer"), p, style)?;
     }
     chart.draw_series(LineSeries::new(
         vec![(20.0, lo * 1.1), (20.0, hi * 1.1 + 1.0)],
         BLACK.stroke_width(1),
     ))?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()?;
+    plot::legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     root.present()?;
     Ok(())
 }

@@ -10,6 +10,11 @@
 //! Run: `cargo run --release -p xtask --bin estimation_building [DIR]` (default `docs`;
 //! `scripts/check_docs.py` regenerates into a temporary directory and compares).
 
+#[path = "../plot.rs"]
+mod plot;
+#[path = "../../../scenes/estimation/start.rs"]
+mod start;
+
 use std::fmt::Write as _;
 
 use aemstep::estimation::augmented::AugmentedModel;
@@ -18,9 +23,10 @@ use aemstep::estimation::smoother::FixedLag;
 use aemstep::estimation::{InputModel, InputStateFilter, InputStateGains, InputStateObserver};
 use aemstep::models;
 use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::observer::{Kalman, Observer, Outputs, Readout, StateSpace, SteadyState};
+use aemstep::observer::{Observer, Outputs, Readout, StateSpace, SteadyState};
 use aemstep::{Damping, Linear, Stepper};
 use plotters::prelude::*;
+use start::{augmented_kalman, rows, start_joint};
 
 /// Time step (s).
 const H: f64 = 0.02;
@@ -98,10 +104,6 @@ fn wind(n: usize, seed: u64) -> Vec<f64> {
     }
     let rms = (out.iter().map(|v| v * v).sum::<f64>() / n as f64).sqrt();
     out.iter().map(|v| v * FORCE_RMS / rms).collect()
-}
-
-fn rows<const R: usize, const C: usize>(a: &SMatrix<f64, R, C>) -> [[f64; C]; R] {
-    core::array::from_fn(|i| core::array::from_fn(|j| a[(i, j)]))
 }
 
 /// Process noise on ξ (and x): white forces of σ = `SIGMA_F` on every floor.
@@ -396,27 +398,8 @@ fn acceleration_only(md: &mut String) {
     // The filters that still run: time-varying joint filter, augmented KF (time-varying),
     // dual KF (its two stages each have a steady gain).
     let tv = InputStateFilter::<f64, 10, 1, 3>::new(&model, &q, &r).unwrap();
-    let mut s = tv
-        .start(
-            &SVector::zeros(),
-            &(SMatrix::identity() * 1e-8),
-            &SVector::zeros(),
-            &SMatrix::from([[1e10]]),
-        )
-        .unwrap();
-    let kf = Kalman::<f64, 11, 0, 3>::new(
-        &aug.model,
-        &aug.measurement,
-        &SMatrix::from_fn(|i, j| aug.process_noise[i][j]),
-        &r,
-    )
-    .unwrap();
-    let p0 = SMatrix::<f64, 11, 11>::from_fn(|i, j| match (i == j, i < 10) {
-        (false, _) => 0.0,
-        (true, true) => 1e-8,
-        (true, false) => 1e10,
-    });
-    let mut ks = kf.start(&SVector::zeros(), &p0, &SVector::zeros()).unwrap();
+    let mut s = start_joint(&tv);
+    let (kf, mut ks) = augmented_kalman(&aug, &r);
     let dg = DualGains::new(&model, &q, &qw, &r).unwrap();
     let df = DualFilter::<f64, 10, 1, 3>::new(&model, &dg).unwrap();
     let mut de = df.start(&SVector::zeros(), &SVector::zeros()).unwrap();
@@ -580,27 +563,13 @@ fn plot(
         ),
     ] {
         let lim = series[0].1.iter().fold(0.0f64, |m, p| m.max(p.1.abs())) * 1.3;
-        let mut chart = ChartBuilder::on(area)
-            .caption(title, ("sans-serif", 18))
-            .margin(15)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(t0..t1, -lim..lim)?;
+        let mut chart = plot::chart(area, title, t0..t1, -lim..lim)?;
         chart.configure_mesh().x_desc("t (s)").y_desc(unit).draw()?;
         for (name, pts, col) in series {
             let style = col.stroke_width(if *name == "truth" { 3 } else { 1 });
-            chart
-                .draw_series(LineSeries::new(pts.clone(), style))?
-                .label(*name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            plot::line(&mut chart, *name, pts.clone(), style)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .draw()?;
+        plot::legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     }
     root.present()?;
     Ok(())

@@ -12,6 +12,8 @@
 
 #[path = "../../../scenes/modal/elcentro.rs"]
 mod elcentro;
+#[path = "../plot.rs"]
+mod plot;
 #[path = "../../../scenes/observer/scene.rs"]
 mod scene;
 
@@ -152,19 +154,12 @@ fn plot(
         } else {
             1.3 * peak
         };
-        let mut chart = ChartBuilder::on(area)
-            .caption(
-                if err {
-                    "Error against the truth"
-                } else {
-                    "Storey-1 drift, 5-storey building under El Centro (model: storey 1 10 % too stiff)"
-                },
-                ("sans-serif", 18),
-            )
-            .margin(15)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..t_end, -lim..lim)?;
+        let caption = if err {
+            "Error against the truth"
+        } else {
+            "Storey-1 drift, 5-storey building under El Centro (model: storey 1 10 % too stiff)"
+        };
+        let mut chart = plot::chart(area, caption, 0.0..t_end, -lim..lim)?;
         chart
             .configure_mesh()
             .x_desc("t (s)")
@@ -183,18 +178,9 @@ fn plot(
                 })
                 .collect();
             let style = col.stroke_width(if name.starts_with("truth") { 3 } else { 1 });
-            chart
-                .draw_series(LineSeries::new(pts, style))?
-                .label(name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            plot::line(&mut chart, name, pts, style)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .draw()?;
+        plot::legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     }
     root.present()?;
     Ok(())
