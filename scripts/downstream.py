@@ -313,11 +313,13 @@ def self_test(target_dir):
         # 2. A rustdoc block that compiles but fails when run.
         doc = next(b for b in blocks if b.path.startswith("src") and b.mode == "run"
                    and not any(re.search(r"\bfn\s+main\s*\(", l) for l in b.code))
-        for b, new in ((readme, "use nalgebra::Matrix3;"), (doc, '/// assert!(false, "broken by the self-test");')):
+        for b, new in ((readme, "use nalgebra::Matrix3;"), (doc, 'assert!(false, "broken by the self-test");')):
             path = os.path.join(copy, b.path)
             with open(path, encoding="utf-8") as f:
                 lines = f.read().split("\n")
-            indent = re.match(r"\s*", lines[b.line - 1]).group(0)
+            # The fence's own prefix: indentation, and in rustdoc `///` or `//!` (an outer
+            # doc line inside inner docs would break the crate, not the block).
+            indent = re.match(r"\s*(//[/!] ?)?", lines[b.line - 1]).group(0)
             lines.insert(b.line, indent + new)  # right after the opening fence
             with open(path, "w", encoding="utf-8") as f:
                 f.write("\n".join(lines))
