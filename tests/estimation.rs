@@ -514,7 +514,7 @@ const R_CONST: [[f64; 4]; 4] = [
 ];
 static FILTER: InputStateObserver<f32, 10, 1, 4> =
     match InputStateGains::solve(&MODEL, &Q_CONST, &R_CONST) {
-        Ok(g) => match InputStateObserver::<f32, 10, 1, 4>::from_parts(&MODEL, &g) {
+        Ok(g) => match InputStateObserver::<f32, 10, 1, 4>::from_parts_f32(&MODEL, &g) {
             Ok(f) => f,
             Err(e) => panic!("{}", e.as_str()),
         },

@@ -36,9 +36,9 @@ struct Run {
 
 fn run() -> Run {
     let f64o =
-        InputStateObserver::<f64, 10, 1, 4>::from_parts(&scene::MODEL, &scene::GAINS).unwrap();
+        InputStateObserver::<f64, 10, 1, 4>::from_parts_f64(&scene::MODEL, &scene::GAINS).unwrap();
     let f32o =
-        InputStateObserver::<f32, 10, 1, 4>::from_parts(&scene::MODEL, &scene::GAINS).unwrap();
+        InputStateObserver::<f32, 10, 1, 4>::from_parts_f32(&scene::MODEL, &scene::GAINS).unwrap();
     let r64 = Readout::<f64, 10, 1, 5>::from_parts_f64(&scene::DRIFT_OUT).unwrap();
     let r32 = Readout::<f32, 10, 1, 5>::from_parts_f32(&scene::DRIFT_OUT).unwrap();
     let mut e64: JointEstimate<f64, 10, 1> = f64o.start_at_rest();

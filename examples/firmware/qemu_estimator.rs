@@ -78,11 +78,11 @@ const fn ok<T: Copy>(r: Result<T, aemstep::Error>) -> T {
 
 /// The estimator: model and gains computed by the compiler into flash.
 static ESTIMATOR: InputStateObserver<f32, 10, 1, 4> = ok(
-    InputStateObserver::<f32, 10, 1, 4>::from_parts(&scene::MODEL, &scene::GAINS),
+    InputStateObserver::<f32, 10, 1, 4>::from_parts_f32(&scene::MODEL, &scene::GAINS),
 );
 /// The reference: the same estimator in `f64` (soft float).
 static ESTIMATOR_F64: InputStateObserver<f64, 10, 1, 4> = ok(
-    InputStateObserver::<f64, 10, 1, 4>::from_parts(&scene::MODEL, &scene::GAINS),
+    InputStateObserver::<f64, 10, 1, 4>::from_parts_f64(&scene::MODEL, &scene::GAINS),
 );
 /// Every drift from the physical state.
 static DRIFTS: Readout<f32, 10, 1, 5> =

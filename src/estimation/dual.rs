@@ -120,7 +120,7 @@ impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
 /// missing: `ξ̂_n = ξ⁻`, the input estimate held, counted.
 ///
 /// Cost of a step: `S² + S·I + 2S·O + 3O·I` multiply-adds, fixed. Size:
-/// `S² + 3S·I + 2S·O + 2O·I + 1` values of `T`. [`DualFilter::new`] and `from_parts`
+/// `S² + 3S·I + 2S·O + 2O·I + 1` values of `T`. [`DualFilter::new`] and `from_parts_f32`/`_f64`
 /// (`const fn`) are bit-identical.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DualFilter<T, const S: usize, const I: usize, const O: usize> {
@@ -330,12 +330,12 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
 }
 
 macro_rules! dual_const {
-    ($t:ident) => {
+    ($t:ident, $from_parts:ident) => {
         impl<const S: usize, const I: usize, const O: usize> DualFilter<$t, S, I, O> {
             /// `const fn` twin of [`DualFilter::new`]; bit-identical to it.
             ///
             /// Errors: as [`DualFilter::new`].
-            pub const fn from_parts(
+            pub const fn $from_parts(
                 model: &InputModel<S, I, O>,
                 gains: &DualGains<S, I, O>,
             ) -> Result<Self, Error> {
@@ -356,5 +356,5 @@ macro_rules! dual_const {
         }
     };
 }
-dual_const!(f32);
-dual_const!(f64);
+dual_const!(f32, from_parts_f32);
+dual_const!(f64, from_parts_f64);

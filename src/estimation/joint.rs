@@ -359,7 +359,7 @@ pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
 /// Cost of a step: `S² + S·I + 2S·O + I·O` multiply-adds, fixed (`S = 10`, `I = 1`,
 /// `O = 4`: 194); [`InputStateObserver::state`] adds `S·I`. Size:
 /// `S² + 3S·I + 2S·O + I·O + 1` values of `T`. Every operator is computed in `f64` and
-/// rounded once to `T`; [`InputStateObserver::new`] and `from_parts` (`const fn`: a
+/// rounded once to `T`; [`InputStateObserver::new`] and `from_parts_f32`/`_f64` (`const fn`: a
 /// `static` keeps the gains in flash) are bit-identical.
 ///
 /// ```
@@ -544,13 +544,13 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
 }
 
 macro_rules! joint_const {
-    ($t:ident) => {
+    ($t:ident, $from_parts:ident) => {
         impl<const S: usize, const I: usize, const O: usize> InputStateObserver<$t, S, I, O> {
             /// `const fn` twin of [`InputStateObserver::new`] (a `static` keeps the gains in
             /// flash); bit-identical to it.
             ///
             /// Errors: as [`InputStateObserver::new`].
-            pub const fn from_parts(
+            pub const fn $from_parts(
                 model: &InputModel<S, I, O>,
                 gains: &InputStateGains<S, I, O>,
             ) -> Result<Self, Error> {
@@ -571,8 +571,8 @@ macro_rules! joint_const {
         }
     };
 }
-joint_const!(f32);
-joint_const!(f64);
+joint_const!(f32, from_parts_f32);
+joint_const!(f64, from_parts_f64);
 
 /// The state of an [`InputStateFilter`]: the [`JointEstimate`], the a-posteriori
 /// covariances `P` (`S×S`, of `ξ`), `Pˣʷ` (`S×I`), `Pʷ` (`I×I`, of `ŵ`), and the gains

@@ -127,7 +127,7 @@ impl<T: Real, const S: usize, const I: usize, const L: usize> StepState
 ///
 /// Cost of a step: `S² + 2S·I + 2S·O + O·I + L·S·O` multiply-adds (the observer's plus
 /// `L·S·O`). Size: `S² + 2S·I + O·(S + I) + (L + 1)·S·O` values of `T`; the state
-/// `(L + 1)·(S + I)`. [`FixedLag::new`] and `from_parts` (`const fn`) are bit-identical.
+/// `(L + 1)·(S + I)`. [`FixedLag::new`] and `from_parts_f32`/`_f64` (`const fn`) are bit-identical.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FixedLag<T, const S: usize, const I: usize, const O: usize, const L: usize> {
     phi: [[T; S]; S],
@@ -305,7 +305,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize>
 }
 
 macro_rules! lag_const {
-    ($t:ident) => {
+    ($t:ident, $from_parts:ident) => {
         impl<const S: usize, const I: usize, const O: usize, const L: usize>
             FixedLag<$t, S, I, O, L>
         {
@@ -313,7 +313,7 @@ macro_rules! lag_const {
             /// the gains in flash); bit-identical to it.
             ///
             /// Errors: as [`FixedLag::new`].
-            pub const fn from_parts<const N: usize>(
+            pub const fn $from_parts<const N: usize>(
                 model: &StateSpace<N, S, I>,
                 meas: &Measurement<S, I, O>,
                 steady: &SteadyState<S, O>,
@@ -345,5 +345,5 @@ macro_rules! lag_const {
         }
     };
 }
-lag_const!(f32);
-lag_const!(f64);
+lag_const!(f32, from_parts_f32);
+lag_const!(f64, from_parts_f64);
