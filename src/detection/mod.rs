@@ -23,6 +23,12 @@
 //! - [`Detector`]: a [`Whitener`] and a [`ChiSquareTest`] together, one call a sample.
 //! - [`Cusum`]: Page's CUSUM on the same statistic, tuned to a covariance increase `λ`,
 //!   its threshold `ln(1/α)` bounding the false-alarm rate per sample by `α`.
+//! - With the load unknown, the joint input–state estimator's residual
+//!   ([`InputStateObserver::step_innovation`](crate::estimation::InputStateObserver::step_innovation))
+//!   is tested the same way: a [`Whitener`] of `R̃`
+//!   ([`InputStateGains::innovation_covariance`](crate::estimation::InputStateGains::innovation_covariance))
+//!   and a [`ChiSquareTest`] of `O − I` outputs (the estimated input takes `I` of the `O`
+//!   directions; `tests/detection_joint.rs` checks the `χ²_{O−I}` law).
 //! - [`ModelBank`]: `M` fixed-gain observers on the same measurements (e.g. the intact
 //!   building and one model per storey with reduced stiffness), each with its own
 //!   whitener; they are ranked by the Gaussian log-likelihood of their innovations over

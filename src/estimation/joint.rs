@@ -41,6 +41,12 @@ pub struct InputStateGains<const S: usize, const I: usize, const O: usize> {
     /// `Pʷ = (D̃ᵀ R̃⁻¹ D̃)⁻¹` (`I×I`): the error covariance of the input estimate (input
     /// units squared).
     pub input_covariance: [[f64; I]; I],
+    /// `R̃ = C P⁻ Cᵀ + R` (`O×O`, output units squared): the covariance of
+    /// `y_n − C ξ⁻ − D̃ w_n`. Whitened by it, the residual
+    /// [`InputStateObserver::step_innovation`] returns has `νᵀ R̃⁻¹ ν ~ χ²` with `O − I`
+    /// degrees of freedom: a [`Whitener`](crate::detection::Whitener) of `R̃` and a
+    /// [`ChiSquareTest`](crate::detection::ChiSquareTest) of `O − I` outputs test it.
+    pub innovation_covariance: [[f64; O]; O],
     /// Doubling iterations taken (`≤` [`STEADY_MAX_ITERATIONS`]).
     pub iterations: u32,
 }
@@ -235,6 +241,7 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
             state_gain: kx,
             input_gain: gm,
             input_covariance: pw,
+            innovation_covariance: rt,
             iterations: k,
         })
     }
@@ -395,6 +402,7 @@ pub struct InputStateObserver<T, const S: usize, const I: usize, const O: usize>
     c: [[T; S]; O],
     gain_x: [[T; O]; S],
     gain_w: [[T; O]; I],
+    d: [[T; I]; O],
     gamma1: [[T; I]; S],
     time_step: T,
 }
@@ -424,6 +432,7 @@ const fn observer_parts<const S: usize, const I: usize, const O: usize>(
         && finite_as(&model.b, max)
         && finite_as(&model.c, max)
         && finite_as(&model.gamma1, max)
+        && finite_as(&model.d, max)
         && finite_as(&l, max)
         && finite_as(&gains.input_gain, max))
     {
@@ -448,6 +457,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
             c: round_rows(&model.c),
             gain_x: round_rows(&l),
             gain_w: round_rows(&gains.input_gain),
+            d: round_rows(&model.d),
             gamma1: round_rows(&model.gamma1),
             time_step: T::from_f64_rounded(model.time_step),
         })
@@ -491,6 +501,26 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
     /// Fixed cost (type docs), no allocation, no panic.
     #[inline]
     pub fn step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) {
+        // The residual is dead code here: the compiler drops it (the step's cost is the
+        // type docs' count, measured in the firmware's cost table).
+        self.step_innovation(e, y);
+    }
+
+    /// [`InputStateObserver::step`], returning the residual `ν = y_n − C ξ⁻ − D̃ ŵ_n`
+    /// (output units): what is left of the measurement once the input estimated from it
+    /// is taken out — what a change detector tests ([`detection`](crate::detection)).
+    /// While the structure matches the model, `ν` is zero-mean and `νᵀ R̃⁻¹ ν ~ χ²_{O−I}`
+    /// whatever the input (`R̃` is [`InputStateGains::innovation_covariance`]; `I` of the
+    /// `O` directions are spent on the input). Non-finite where `y` is (a missing sample:
+    /// then `ν = y − C ξ⁻`, nothing corrected).
+    ///
+    /// Cost: [`InputStateObserver::step`] plus `O·I` multiply-adds.
+    #[inline(always)]
+    pub fn step_innovation(
+        &self,
+        e: &mut JointEstimate<T, S, I>,
+        y: &SVector<T, O>,
+    ) -> SVector<T, O> {
         let neg_zero = -T::zero();
         let xp: [T; S] = core::array::from_fn(|i| {
             let mut s = neg_zero;
@@ -527,11 +557,17 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
                 }
                 e.xi[i] = s;
             }
+            for (o, v) in innov.iter_mut().enumerate() {
+                for j in 0..I {
+                    *v -= self.d[o][j] * e.w[j];
+                }
+            }
         } else {
             e.xi = xp.into();
             e.missing = e.missing.wrapping_add(1);
         }
         e.n = e.n.wrapping_add(1);
+        innov.into()
     }
 
     /// [`InputStateObserver::step`], checked: the new estimate must be finite, else `e` is
@@ -540,6 +576,20 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
     /// Errors: [`Error::NonFiniteState`]. Cost: a step plus a copy and a scan.
     pub fn try_step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) -> Result<(), Error> {
         commit_if_finite(e, |next| self.step(next, y))
+    }
+
+    /// [`InputStateObserver::step_innovation`], checked as [`InputStateObserver::try_step`]:
+    /// on an error `e` is left bit-identical and no residual is returned.
+    ///
+    /// Errors: [`Error::NonFiniteState`]. Cost: a step plus a copy and a scan.
+    pub fn try_step_innovation(
+        &self,
+        e: &mut JointEstimate<T, S, I>,
+        y: &SVector<T, O>,
+    ) -> Result<SVector<T, O>, Error> {
+        let mut nu = SVector::zeros();
+        commit_if_finite(e, |next| nu = self.step_innovation(next, y))?;
+        Ok(nu)
     }
 }
 
@@ -564,6 +614,7 @@ macro_rules! joint_const {
                     c: linalg::const_round!($t, rows model.c),
                     gain_x: linalg::const_round!($t, rows l),
                     gain_w: linalg::const_round!($t, rows gains.input_gain),
+                    d: linalg::const_round!($t, rows model.d),
                     gamma1: linalg::const_round!($t, rows model.gamma1),
                     time_step: model.time_step as $t,
                 })

@@ -20,16 +20,21 @@
 mod chi2;
 #[path = "../../../scenes/modal/elcentro.rs"]
 mod elcentro;
+#[path = "../../../scenes/estimator/scene.rs"]
+mod estimator;
 #[path = "../../../scenes/detection/gauss.rs"]
 mod gauss;
 #[path = "../plot.rs"]
 mod plot;
 #[path = "../../../scenes/detection/scene.rs"]
 mod scene;
+#[path = "../../../scenes/detection/unknown_load.rs"]
+mod unknown_load;
 
 use std::fmt::Write as _;
 
 use aemstep::detection::{ChiSquareTest, Cusum, CusumState, Detector, ModelBank, Whitener, Window};
+use aemstep::estimation::InputStateObserver;
 use aemstep::nalgebra::SVector;
 use aemstep::observer::Observer;
 use plotters::prelude::*;
@@ -230,6 +235,83 @@ fn intact_runs(sc: &Scene, tests: &[ChiSquareTest<W>; ALPHAS.len()]) -> Intact {
 }
 
 /// min / median / max of the values that are `Some`, and how many are.
+/// The load-unknown section: storey-1 losses tested on the joint estimator's residual.
+const LOSSES: [f64; 3] = [0.1, 0.3, 0.5];
+/// Its window (5 s), false-alarm probability, seeds, damage step and start-up skipped.
+const W_UNKNOWN: usize = 250;
+const ALPHA_UNKNOWN: f64 = 1e-6;
+const SEEDS_UNKNOWN: u64 = 12;
+const DAMAGE_STEP: usize = 1000;
+const START_UP: usize = 250;
+const STEPS_UNKNOWN: usize = 3000;
+
+/// One storey-1 loss with the load unknown: mean `νᵀR̃⁻¹ν` before (5–20 s) and after
+/// (20–60 s) the damage over every seed, the detection delay of each seed (s; `None`:
+/// not detected by 60 s), and the alarms raised before the damage.
+struct UnknownLoad {
+    loss: f64,
+    mean_before: f64,
+    mean_after: f64,
+    delays: Vec<Option<f64>>,
+    early_alarms: usize,
+}
+
+fn unknown_load(loss: f64) -> UnknownLoad {
+    let f = InputStateObserver::<f64, 10, 1, 4>::new(&estimator::MODEL, &estimator::GAINS)
+        .expect("estimator");
+    let wh = Whitener::<f64, 4>::new(&estimator::GAINS.innovation_covariance).expect("R̃");
+    let det = Detector::<f64, 4, W_UNKNOWN>::new(
+        wh,
+        ChiSquareTest::new(unknown_load::DOF, ALPHA_UNKNOWN).expect("test"),
+    );
+    let hurt = unknown_load::damaged(1.0 - loss);
+    let (mut before, mut after, mut early) = (0.0, 0.0, 0);
+    let mut delays = Vec::new();
+    for seed in 0..SEEDS_UNKNOWN {
+        let mut truth = unknown_load::Truth::new(100 + seed);
+        let mut e = f.start_at_rest();
+        let mut win = Window::<W_UNKNOWN>::new();
+        let mut first = None;
+        for n in 1..=STEPS_UNKNOWN {
+            if n == DAMAGE_STEP + 1 {
+                truth.switch(&estimator::MODEL, &hurt);
+            }
+            let model = if n > DAMAGE_STEP {
+                &hurt
+            } else {
+                &estimator::MODEL
+            };
+            let y = truth.next(model);
+            let nu = f.step_innovation(&mut e, &y);
+            if n <= START_UP {
+                continue;
+            }
+            let q = wh.nis(&nu);
+            if n <= DAMAGE_STEP {
+                before += q;
+            } else {
+                after += q;
+            }
+            if det.update(&mut win, &nu) {
+                if n <= DAMAGE_STEP {
+                    early += 1;
+                } else if first.is_none() {
+                    first = Some((n - DAMAGE_STEP) as f64 * H);
+                }
+            }
+        }
+        delays.push(first);
+    }
+    let seeds = SEEDS_UNKNOWN as f64;
+    UnknownLoad {
+        loss,
+        mean_before: before / (seeds * (DAMAGE_STEP - START_UP) as f64),
+        mean_after: after / (seeds * (STEPS_UNKNOWN - DAMAGE_STEP) as f64),
+        delays,
+        early_alarms: early,
+    }
+}
+
 fn summary(v: &[Option<f64>]) -> (f64, f64, f64, usize) {
     let mut s: Vec<f64> = v.iter().flatten().copied().collect();
     s.sort_by(f64::total_cmp);
@@ -677,6 +759,87 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Table 3: false alarms.
     let hours = intact.trials as f64 / 3600.0;
+    writeln!(md, "### With the load unknown")?;
+    writeln!(md)?;
+    writeln!(
+        md,
+        "The building of [estimation](estimation.md) instead: an unknown roof force (200 kN static plus 30 kN RMS"
+    )?;
+    writeln!(
+        md,
+        "low-passed noise), accelerations at floors 1, 3, 5 and the roof displacement, the process and sensor noise"
+    )?;
+    writeln!(
+        md,
+        "the joint estimator's gains were solved for (`scenes/detection/unknown_load.rs`). The detector tests the"
+    )?;
+    writeln!(
+        md,
+        "joint estimator's residual (`InputStateObserver::step_innovation`), whitened by `R̃`: {} of the 4 sensor",
+        unknown_load::DOF
+    )?;
+    writeln!(
+        md,
+        "directions are left once the force is estimated, so the test has {} degrees of freedom a sample. A",
+        unknown_load::DOF
+    )?;
+    writeln!(
+        md,
+        "{} s window at α = {ALPHA_UNKNOWN:e}; storey 1 softened at 20 s; {SEEDS_UNKNOWN} seeds; the first {} s (the estimator's",
+        W_UNKNOWN as f64 * H,
+        START_UP as f64 * H
+    )?;
+    writeln!(md, "start-up) not tested.")?;
+    writeln!(md)?;
+    writeln!(
+        md,
+        "| storey-1 loss | mean νᵀR̃⁻¹ν intact | after the damage | detected | delay min / median / max (s) | alarms before the damage |"
+    )?;
+    writeln!(md, "|---:|---:|---:|---:|---|---:|")?;
+    let rows: Vec<UnknownLoad> = LOSSES.iter().map(|&l| unknown_load(l)).collect();
+    for u in &rows {
+        let (lo, med, hi, n) = summary(&u.delays);
+        let delay = if n == 0 {
+            "—".to_string()
+        } else {
+            format!("{lo:.2} / {med:.2} / {hi:.2}")
+        };
+        writeln!(
+            md,
+            "| {:.0} % | {:.3} | {:.3} | {n} of {} | {delay} | {} |",
+            100.0 * u.loss,
+            u.mean_before,
+            u.mean_after,
+            u.delays.len(),
+            u.early_alarms
+        )?;
+    }
+    writeln!(md)?;
+    writeln!(
+        md,
+        "Estimating the force spends one sensor direction on it, and the force absorbs much of what a softer storey"
+    )?;
+    writeln!(
+        md,
+        "changes in the measurements: a 10 % loss moves the mean statistic by {:.1} %, and only {} of {} seeds are",
+        100.0 * (rows[0].mean_after / rows[0].mean_before - 1.0),
+        summary(&rows[0].delays).3,
+        rows[0].delays.len()
+    )?;
+    writeln!(
+        md,
+        "caught (in the first seconds, while the building, under its static load, moves to its new equilibrium);"
+    )?;
+    writeln!(
+        md,
+        "30 % and more are caught at once. With the ground measured (above) every seed's 10 % loss is found. The"
+    )?;
+    writeln!(
+        md,
+        "statistic's distribution with the load unknown is checked in `tests/detection_joint.rs` (mean, covariance"
+    )?;
+    writeln!(md, "and whiteness of the residual against χ² theory).")?;
+    writeln!(md)?;
     writeln!(md, "### False alarms on the intact structure")?;
     writeln!(md)?;
     writeln!(
