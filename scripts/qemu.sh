@@ -270,7 +270,7 @@ for ty in f32 f64; do
     echo "ok: $ty both $host_bits"
 done
 host_sum=$(cargo test -q --release --test firmware_estimator -- --nocapture --exact \
-    detector_is_quiet_on_the_intact_building_and_sees_a_withheld_force 2>&1 |
+    detector_is_quiet_on_the_intact_building_and_sees_a_faulty_sensor 2>&1 |
     sed -n 's/^host detector window sum fixed = //p')
 target_sum=$(sed -n 's/^target detector window sum fixed = //p' "$OUT/qemu_estimator-qemu.log")
 [[ -n $host_sum && $host_sum == "$target_sum" ]] ||
@@ -404,9 +404,9 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo
     echo "One step of the fixed-gain joint input–state estimator (Gillijns–De Moor: predict, estimate the"
     echo "unknown roof force, correct with 3 accelerometers and the roof displacement), \`f32\`:"
-    echo "\`InputStateObserver<f32, 10, 1, 4>\` (10 states, 1 unknown input, 4 sensors). Beside it, the χ² detector:"
-    echo "one step of the known-input \`Observer<f32, 10, 1, 4>\` with its innovation, whitened and pushed into a"
-    echo "50-sample \`Window\` (\`Detector<f32, 4, 50>\`; the window's fixed-point terms go through \`f64\`, soft float here)."
+    echo "\`InputStateObserver<f32, 10, 1, 4>\` (10 states, 1 unknown input, 4 sensors). Second row: the same step"
+    echo "returning its residual (\`step_innovation\`), whitened and pushed into the 50-sample \`Window\` of the χ²"
+    echo "detector (\`Detector<f32, 4, 50>\`, 3 degrees of freedom a sample; its fixed-point terms rounded in \`f32\`)."
     echo
     echo "| estimator | instructions / step | multiply-adds | instructions / multiply-add |"
     echo "|---|---:|---:|---:|"

@@ -2,10 +2,47 @@
 
 use nalgebra::{RealField, SVector};
 
-mod sealed {
-    pub trait Sealed {}
-    impl Sealed for f32 {}
-    impl Sealed for f64 {}
+pub(crate) mod sealed {
+    /// Seals [`Real`](super::Real), and carries what only the crate calls.
+    pub trait Sealed: Copy {
+        /// `⌊x·2^bits + ½⌋` of a finite `x ≥ 0` as an integer (the fixed-point term of a
+        /// [`Window`](crate::detection::Window)), saturating at `u64::MAX` (`+∞`, huge
+        /// `x`); `0` for `x < ½·2^−bits`; `None` for NaN. `bits ≤ 24`. Both types give
+        /// the value `f64` arithmetic gives (exact: `x·2^bits + ½` is exact in `f64` for
+        /// an `f32` `x`); `f32` computes it in `f32` (on a Cortex-M4F, hardware float
+        /// instead of the `f64` library routines).
+        fn fixed_round(self, bits: u32) -> Option<u64>;
+    }
+    impl Sealed for f32 {
+        #[inline(always)]
+        fn fixed_round(self, bits: u32) -> Option<u64> {
+            if self.is_nan() {
+                return None;
+            }
+            // Exact: a power-of-two scaling (no overflow below 2^(128−24)).
+            let x = self * (1u32 << bits) as f32;
+            if x < 16_777_216.0 {
+                // 0 ≤ x < 2²⁴ (a negative saturates to 0, as in `f64`): the integer part
+                // and the fraction are exact, so this is ⌊x + ½⌋ exactly.
+                let t = x as u32;
+                let frac = x - t as f32;
+                Some(t as u64 + u64::from(frac >= 0.5))
+            } else {
+                // x ≥ 2²⁴ is an integer in f32 already (or +∞: saturates).
+                Some(x as u64)
+            }
+        }
+    }
+    impl Sealed for f64 {
+        #[inline(always)]
+        fn fixed_round(self, bits: u32) -> Option<u64> {
+            if self.is_nan() {
+                return None;
+            }
+            // `as` saturates (a negative to 0, above 2⁶⁴ to `u64::MAX`).
+            Some((self * (1u64 << bits) as f64 + 0.5) as u64)
+        }
+    }
 }
 
 /// A floating-point scalar the kernel can step in: implemented for `f32` and `f64` only.

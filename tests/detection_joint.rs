@@ -192,3 +192,51 @@ fn a_missing_sample_gives_a_non_finite_residual_and_is_skipped() {
     assert_eq!(r, Err(aemstep::Error::NonFiniteState));
     assert_eq!(e2, snapshot);
 }
+
+/// `Detector<f32, …>::update` rounds its terms to fixed point in `f32`; the window must
+/// hold exactly what `Window::push` of the same term widened to `f64` holds. Half the
+/// `f32` values in `[½, 1)` scale to a tie (`x.5`), so random terms test the rounding.
+#[test]
+fn the_f32_detectors_terms_are_the_f64_windows_terms() {
+    let det = Detector::<f32, 1, 7>::new(
+        Whitener::<f32, 1>::new(&[[1.0]]).unwrap(),
+        ChiSquareTest::<7>::new(1, 1e-3).unwrap(),
+    );
+    let (mut a, mut b) = (Window::<7>::new(), Window::<7>::new());
+    let mut g = gauss::Gauss::new(5);
+    let mut specials = vec![0.0f32, -0.0, 1e-30, 2.9e-8, 3.0e-8, 0.5, 0.70710677, 1.0];
+    specials.extend([
+        4096.0,
+        4096.001,
+        1e12,
+        1e19,
+        f32::MAX.sqrt(),
+        f32::MAX,
+        f32::INFINITY,
+    ]);
+    specials.extend([
+        f32::NAN,
+        f32::MIN_POSITIVE,
+        2.0f32.powi(-12),
+        2.0f32.powi(-13),
+    ]);
+    let mut n = 0;
+    for k in 0..400_000 {
+        let nu = if k < specials.len() {
+            specials[k]
+        } else {
+            // Magnitudes from 1e-6 to 1e6.
+            (g.next() * 10f64.powf(6.0 * (2.0 * (k % 1000) as f64 / 1000.0 - 1.0))) as f32
+        };
+        let v = SVector::<f32, 1>::new(nu);
+        det.update(&mut a, &v);
+        b.push(det.whitener.nis(&v) as f64);
+        assert_eq!(
+            (a.sum_fixed(), a.skipped(), a.len()),
+            (b.sum_fixed(), b.skipped(), b.len()),
+            "term of ν = {nu:e}"
+        );
+        n += 1;
+    }
+    assert_eq!(n, 400_000);
+}

@@ -79,6 +79,7 @@ use nalgebra::SVector;
 use crate::linalg::cholesky::{cholesky, lower_solve};
 use crate::linalg::{Mat, add_scaled, all_finite, finite_as, identity, mul, round_rows, transpose};
 use crate::observer::{Measurement, SteadyState};
+use crate::scalar::sealed::Sealed;
 use crate::{Error, Real};
 
 /// Fractional bits of the fixed-point terms of a [`Window`]: a term `q` is held as the
@@ -272,20 +273,20 @@ impl<const W: usize> Window<W> {
     /// the cap. A window of `W = 0` holds nothing. Cost `O(1)`.
     #[inline]
     pub fn push(&mut self, q: f64) {
-        if q.is_nan() {
+        self.push_fixed(Sealed::fixed_round(q, NIS_FRACTION_BITS));
+    }
+
+    /// Push a term already in fixed point (`None`: a NaN, skipped and counted); capped.
+    #[inline]
+    fn push_fixed(&mut self, t: Option<u64>) {
+        let Some(t) = t else {
             self.skipped = self.skipped.wrapping_add(1);
             return;
-        }
+        };
         if W == 0 {
             return;
         }
-        let x = q * NIS_SCALE + 0.5;
-        // `as` saturates (and maps a negative to 0); the cap keeps the sum below 2⁶⁴.
-        let t = if x < Self::CAP as f64 {
-            x as u64
-        } else {
-            Self::CAP
-        };
+        // The cap keeps the sum below 2⁶⁴.
         let t = if t > Self::CAP { Self::CAP } else { t };
         // `head < W` always; said so the compiler drops the bounds checks (no panic path
         // in the step, `scripts/qemu.sh`'s call-graph check).
@@ -417,7 +418,11 @@ impl<T: Real, const O: usize, const W: usize> Detector<T, O, W> {
     /// `O(O+1)/2` multiply-adds and `O(1)`.
     #[inline]
     pub fn update(&self, window: &mut Window<W>, nu: &SVector<T, O>) -> bool {
-        window.push(self.whitener.nis(nu).as_f64());
+        // The same term as `push(nis.as_f64())`, rounded in `T` (no `f64` on an `f32` core).
+        window.push_fixed(Sealed::fixed_round(
+            self.whitener.nis(nu),
+            NIS_FRACTION_BITS,
+        ));
         self.test.alarm(window)
     }
 }

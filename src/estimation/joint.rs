@@ -7,7 +7,7 @@ use nalgebra::{SMatrix, SVector};
 use super::InputModel;
 use crate::linalg::{self, Mat, add_scaled, all_finite, finite_as, identity, max_abs, mul};
 use crate::linalg::{round_rows, rows_f64, transpose};
-use crate::observer::{A_SMALL, balance, inf_norm, is_covariance, lu_of, symmetrize};
+use crate::observer::{A_SMALL, balance, doubling, inf_norm, is_covariance, lu_of, symmetrize};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
 
@@ -175,40 +175,15 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
             -1.0,
             &mul(&rd, &mul(&f0inv, &transpose(&rd))),
         ));
-        let mut g = symmetrize(&mul(&transpose(&model.c), &mul(&pi0, &model.c)));
+        let g = symmetrize(&mul(&transpose(&model.c), &mul(&pi0, &model.c)));
         if !(all_finite(&abar) && all_finite(&qbar) && all_finite(&g)) {
             return Err(Error::OperatorOverflow);
         }
         // The doubling algorithm (as `SteadyState`): A₀ = Āᵀ, G₀ = G, X₀ = Q̄.
-        let id: Mat<S, S> = identity();
-        let mut a = transpose(&abar);
-        let mut x = qbar;
-        let mut k = 0;
-        let mut converged = false;
-        while k < STEADY_MAX_ITERATIONS {
-            k += 1;
-            let w = add_scaled(&id, 1.0, &mul(&g, &x));
-            let lu = match lu_of(&w) {
-                Some(lu) => lu,
-                None => return Err(Error::InputNotIdentifiable),
-            };
-            let wa = lu.solve(&a);
-            let wg = lu.solve(&g);
-            let x1 = symmetrize(&add_scaled(&x, 1.0, &mul(&transpose(&a), &mul(&x, &wa))));
-            let g1 = symmetrize(&add_scaled(&g, 1.0, &mul(&a, &mul(&wg, &transpose(&a)))));
-            let a1 = mul(&a, &wa);
-            if !(all_finite(&x1) && all_finite(&g1) && all_finite(&a1)) {
-                return Err(Error::InputNotIdentifiable);
-            }
-            let diff = max_abs(&add_scaled(&x1, -1.0, &x));
-            x = x1;
-            g = g1;
-            a = a1;
-            if diff <= 4.0 * f64::EPSILON * max_abs(&x) && inf_norm(&a) <= A_SMALL {
-                converged = true;
-                break;
-            }
-        }
+        let (x, k, converged) = match doubling(transpose(&abar), g, qbar, STEADY_MAX_ITERATIONS) {
+            Some(v) => v,
+            None => return Err(Error::InputNotIdentifiable),
+        };
         if !(converged && is_covariance(&x, false)) {
             return Err(Error::InputNotIdentifiable);
         }

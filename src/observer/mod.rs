@@ -37,7 +37,7 @@ mod state_space;
 pub use fixed::{Estimate, Observer, Readout};
 pub use kalman::{Kalman, KalmanState};
 // For the joint input–state estimators (`crate::estimation`).
-pub(crate) use riccati::{A_SMALL, balance, inf_norm, is_covariance, symmetrize};
+pub(crate) use riccati::{A_SMALL, balance, doubling, inf_norm, is_covariance, symmetrize};
 pub use riccati::{RICCATI_MAX_ITERATIONS, RICCATI_RESIDUAL_UNITS, SteadyState};
 pub(crate) use state_space::lu_of;
 pub use state_space::{Measurement, Outputs, StateSpace};

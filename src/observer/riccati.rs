@@ -146,6 +146,53 @@ const RICCATI_RESIDUAL_REFINE: f64 = 4.0;
 /// come are quadratic in it.
 pub(crate) const A_SMALL: f64 = 1.4901161193847656e-8;
 
+/// The doubling algorithm for the filter Riccati equation `X = Aᵀ X A − …` in the form
+/// `A₀ = Aᵀ`, `G₀ = G`, `X₀ = X`: `W = I + G X`, `X ← X + Aᵀ X W⁻¹ A`,
+/// `G ← G + A W⁻¹ G Aᵀ`, `A ← A W⁻¹ A`, at most `max` times. Returns `(X, iterations,
+/// converged)`, or `None` when `W` is singular or an iterate is not finite (each caller
+/// names that failure its own way: no steady state of a Kalman filter, an unidentifiable
+/// input of the joint filter).
+///
+/// Converged when X no longer moves (the update is below rounding of X) and A_k, which the
+/// updates of X are quadratic in (`A_k ≈ (Φ − K H)ᵀ^(2^k)`), has become small: with a
+/// closed-loop mode near the unit circle X can stand still for a few iterations while its
+/// slow part has not yet accumulated (P stopped at iteration 2 with errors of 6e-14
+/// relative, and its gain's observer had a spectral radius of 1.000008; found by fuzzing).
+/// Below 2^-26 the remaining updates are below ε ‖X‖.
+pub(crate) const fn doubling<const S: usize>(
+    mut a: Mat<S, S>,
+    mut g: Mat<S, S>,
+    mut x: Mat<S, S>,
+    max: u32,
+) -> Option<(Mat<S, S>, u32, bool)> {
+    let id: Mat<S, S> = identity();
+    let mut k = 0;
+    while k < max {
+        k += 1;
+        let w = add_scaled(&id, 1.0, &mul(&g, &x));
+        let lu = match lu_of(&w) {
+            Some(lu) => lu,
+            None => return None,
+        };
+        let wa = lu.solve(&a);
+        let wg = lu.solve(&g);
+        let x1 = symmetrize(&add_scaled(&x, 1.0, &mul(&transpose(&a), &mul(&x, &wa))));
+        let g1 = symmetrize(&add_scaled(&g, 1.0, &mul(&a, &mul(&wg, &transpose(&a)))));
+        let a1 = mul(&a, &wa);
+        if !(all_finite(&x1) && all_finite(&g1) && all_finite(&a1)) {
+            return None;
+        }
+        let diff = max_abs(&add_scaled(&x1, -1.0, &x));
+        x = x1;
+        g = g1;
+        a = a1;
+        if diff <= 4.0 * f64::EPSILON * max_abs(&x) && inf_norm(&a) <= A_SMALL {
+            return Some((x, k, true));
+        }
+    }
+    Some((x, k, false))
+}
+
 /// `|a|` entry by entry.
 const fn abs_of<const R: usize, const C: usize>(a: &Mat<R, C>) -> Mat<R, C> {
     let mut b = *a;
@@ -408,43 +455,16 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         if !all_finite(h) {
             return Err(Error::NonFiniteInput);
         }
-        let id: Mat<S, S> = identity();
-        let mut a = transpose(&model.phi);
-        let mut g = symmetrize(&mul(&transpose(h), &lu_r.solve(h)));
-        let mut x = symmetrize(q);
-        let mut k = 0;
-        let mut converged = false;
-        while k < RICCATI_MAX_ITERATIONS {
-            k += 1;
-            let w = add_scaled(&id, 1.0, &mul(&g, &x));
-            let lu = match lu_of(&w) {
-                Some(lu) => lu,
-                None => return Err(Error::RiccatiNotConverged),
-            };
-            let wa = lu.solve(&a);
-            let wg = lu.solve(&g);
-            let x1 = symmetrize(&add_scaled(&x, 1.0, &mul(&transpose(&a), &mul(&x, &wa))));
-            let g1 = symmetrize(&add_scaled(&g, 1.0, &mul(&a, &mul(&wg, &transpose(&a)))));
-            let a1 = mul(&a, &wa);
-            if !(all_finite(&x1) && all_finite(&g1) && all_finite(&a1)) {
-                return Err(Error::RiccatiNotConverged);
-            }
-            // Converged when X no longer moves (the update is below rounding of X) and A_k,
-            // which the updates of X are quadratic in (`A_k ≈ (Φ − K H)ᵀ^(2^k)`), has become
-            // small: with a closed-loop mode near the unit circle X can stand still for a
-            // few iterations while its slow part has not yet accumulated (P stopped at
-            // iteration 2 with errors of 6e-14 relative, and its gain's observer had a
-            // spectral radius of 1.000008; found by fuzzing). Below 2^-26 the remaining
-            // updates are below ε ‖X‖.
-            let diff = max_abs(&add_scaled(&x1, -1.0, &x));
-            x = x1;
-            g = g1;
-            a = a1;
-            if diff <= 4.0 * f64::EPSILON * max_abs(&x) && inf_norm(&a) <= A_SMALL {
-                converged = true;
-                break;
-            }
-        }
+        let g = symmetrize(&mul(&transpose(h), &lu_r.solve(h)));
+        let (x, k, converged) = match doubling(
+            transpose(&model.phi),
+            g,
+            symmetrize(q),
+            RICCATI_MAX_ITERATIONS,
+        ) {
+            Some(v) => v,
+            None => return Err(Error::RiccatiNotConverged),
+        };
         // A "converged" iterate that is not a covariance is no solution: for a model with
         // an unobservable marginal mode (two free masses, only their sum measured) the
         // doubling stopped at a P with diagonal entries of −4e10 (found by fuzzing).
