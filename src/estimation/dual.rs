@@ -431,6 +431,38 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilterSt
 /// small firmware models; the [`DualFilter`] with the steady [`DualGains`] costs the last
 /// term only. Size: `S² + S·I + 2S·O + O·I + I² + O² + 1` values of `T` (and `S·I` more),
 /// no allocation.
+///
+/// ```
+/// use aemstep::estimation::{DualGains, DualKalmanFilter, InputModel};
+/// use aemstep::models;
+/// use aemstep::observer::{Outputs, StateSpace};
+/// use aemstep::nalgebra::{SMatrix, SVector};
+/// use aemstep::vector;
+///
+/// // The 5-storey building, an unknown force at the roof (N); absolute accelerations of
+/// // floors 1, 3, 5 (m/s²) and the roof displacement (m) measured.
+/// let (m, c, k) = models::five_storey_building();
+/// let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
+/// let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02)?;
+/// let mut out = Outputs::<5, 1, 4>::zero();
+/// out.a = [[1.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 1.0], [0.0; 5]];
+/// out.u[3] = [0.0, 0.0, 0.0, 0.0, 1.0];
+/// let model = InputModel::from_parts(&ss, &ss.outputs(&out)?)?;
+/// let q = SMatrix::<f64, 10, 10>::identity() * 1e-14;
+/// let qw = SMatrix::<f64, 1, 1>::from_element(1e6); // the random walk: σ = 1 kN per step
+/// let r = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e-4, 1e-4, 1e-4, 1e-8]);
+/// let f = DualKalmanFilter::<f64, 10, 1, 4>::new(&model, &q, &qw, &r)?;
+/// let p0 = SMatrix::<f64, 10, 10>::identity() * 1e-8;
+/// let mut s = f.start(&SVector::zeros(), &p0, &SVector::zeros(), &SMatrix::from_element(1e10))?;
+/// f.try_step(&mut s, &vector![0.01, 0.02, 0.03, 1e-4])?;
+/// f.try_step(&mut s, &vector![f64::NAN, 0.02, 0.03, 1e-4])?; // missing: predicted
+/// assert_eq!((s.estimate().steps(), s.estimate().missing()), (2, 1));
+/// assert!(s.estimate().input()[0].is_finite()); // N
+/// // The gains tend to the steady ones the fixed-gain `DualFilter` uses.
+/// let steady = DualGains::new(&model, &q, &qw, &r)?;
+/// assert!(steady.input.gain[0].iter().all(|g| g.is_finite()));
+/// # Ok::<(), aemstep::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DualKalmanFilter<T, const S: usize, const I: usize, const O: usize> {
     a: SMatrix<T, S, S>,
