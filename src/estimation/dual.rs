@@ -425,12 +425,13 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilterSt
 /// `P_n = P⁻`, `ŵ_n = ŵ_{n−1}` with `Pʷ_n = Pʷ⁻`: the random walk's prediction), counted.
 /// Only a checked step: a failed step changes nothing.
 ///
-/// Cost of a step: about `2S³ + 2S²·O + S·O² + O³/3` multiply-adds for the state stage
-/// and `O·I² + 2O²·I + O³/3` for the input stage, plus the fixed filter's
-/// `S² + S·I + 2S·O + 3O·I` (`≈ 3 200` for `S = 10`, `I = 1`, `O = 4`): for the host and
+/// Cost of a step: about `2S³ + 2S²·O + 2S·O² + O³/3` multiply-adds for the state stage
+/// and `2O·I² + 2O²·I + O³/3` for the input stage, plus the fixed filter's
+/// `S² + S·I + 2S·O + 3O·I` (`≈ 3 400` for `S = 10`, `I = 1`, `O = 4`): for the host and
 /// small firmware models; the [`DualFilter`] with the steady [`DualGains`] costs the last
-/// term only. Size: `S² + S·I + 2S·O + O·I + I² + O² + 1` values of `T` (and `S·I` more),
-/// no allocation.
+/// term only. Size: `2S² + 2S·I + S·O + O·I + I² + O² + 1` values of `T`; its state
+/// ([`DualKalmanFilterState`]) `S² + S + I² + I + S·O + I·O` values and two `u64`. No
+/// allocation.
 ///
 /// ```
 /// use aemstep::estimation::{DualGains, DualKalmanFilter, InputModel};
