@@ -13,6 +13,7 @@ use defmt::{Format, Formatter, write};
 use crate::estimation::smoother::{FixedLag, FixedLagState};
 use crate::estimation::{
     InputStateFilter, InputStateFilterState, InputStateObserver, JointEstimate, dual::DualFilter,
+    dual::DualKalmanFilter, dual::DualKalmanFilterState,
 };
 use crate::hysteresis::{EnergyAccount, Law, ShearBuilding, Trial};
 use crate::observer::{
@@ -389,6 +390,35 @@ impl<T: Real + Format, const S: usize, const I: usize, const O: usize> Format
         write!(
             f,
             "DualFilter {{ S: {=usize}, I: {=usize}, O: {=usize}, h: {} }}",
+            S,
+            I,
+            O,
+            self.time_step()
+        )
+    }
+}
+
+impl<T: Real + Format, const S: usize, const I: usize, const O: usize> Format
+    for DualKalmanFilterState<T, S, I, O>
+{
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "DualKalmanFilterState {{ estimate: {}, covariance (columns): {}, input_covariance (columns): {} }}",
+            self.estimate(),
+            self.covariance().as_slice(),
+            self.input_covariance().as_slice()
+        )
+    }
+}
+
+impl<T: Real + Format, const S: usize, const I: usize, const O: usize> Format
+    for DualKalmanFilter<T, S, I, O>
+{
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "DualKalmanFilter {{ S: {=usize}, I: {=usize}, O: {=usize}, h: {} }}",
             S,
             I,
             O,

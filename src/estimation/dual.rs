@@ -1,6 +1,7 @@
 //! The dual Kalman filter (Eftekhar Azam, Chatzi & Papadimitriou 2015): two Kalman
-//! filters in sequence each step, one for the input (a random walk), one for the state,
-//! each with its own steady gain.
+//! filters in sequence each step, one for the input (a random walk), one for the state —
+//! with fixed (steady) gains ([`DualGains`], [`DualFilter`]) or time-varying, the
+//! covariances propagated as in the paper ([`DualKalmanFilter`]).
 //!
 //! On the standard form of [`InputModel`] (`ξ_n = A ξ_{n−1} + B w_{n−1}`,
 //! `y_n = C ξ_n + D̃ w_n`) a step is
@@ -30,7 +31,7 @@ use nalgebra::{SMatrix, SVector};
 use super::InputModel;
 use super::joint::{JointEstimate, joint_start, shift};
 use crate::linalg::{self, all_finite, finite_as, identity, round_rows};
-use crate::observer::{Measurement, StateSpace, SteadyState};
+use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real};
 
@@ -358,3 +359,299 @@ macro_rules! dual_const {
 }
 dual_const!(f32, from_parts_f32);
 dual_const!(f64, from_parts_f64);
+
+/// The state of a [`DualKalmanFilter`]: the [`JointEstimate`], the a-posteriori
+/// covariances `P` (`S×S`, of `ξ̂_n`, units of `x` squared) and `Pʷ` (`I×I`, of `ŵ_n`,
+/// input units squared), and the gains `G_x`, `G_w` of the last corrected step. Plain
+/// data.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualKalmanFilterState<T, const S: usize, const I: usize, const O: usize> {
+    estimate: JointEstimate<T, S, I>,
+    p: SMatrix<T, S, S>,
+    pw: SMatrix<T, I, I>,
+    gain_x: SMatrix<T, S, O>,
+    gain_w: SMatrix<T, I, O>,
+}
+
+impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilterState<T, S, I, O> {
+    /// The estimate `ξ̂_n`, `ŵ_n`, steps and missing measurements.
+    pub fn estimate(&self) -> &JointEstimate<T, S, I> {
+        &self.estimate
+    }
+    /// `P_n`, the a-posteriori error covariance of `ξ̂_n` as the state stage computes it
+    /// (units of `x` squared).
+    pub fn covariance(&self) -> &SMatrix<T, S, S> {
+        &self.p
+    }
+    /// `Pʷ_n`, the a-posteriori error covariance of `ŵ_n` as the input stage computes it
+    /// (input units squared).
+    pub fn input_covariance(&self) -> &SMatrix<T, I, I> {
+        &self.pw
+    }
+    /// The state stage's gain `G_x` (`S×O`) of the last corrected step (zero before the
+    /// first); converges to [`DualGains::state`]'s `gain`.
+    pub fn state_gain(&self) -> &SMatrix<T, S, O> {
+        &self.gain_x
+    }
+    /// The input stage's gain `G_w` (`I×O`) of the last corrected step (zero before the
+    /// first); converges to [`DualGains::input`]'s `gain`.
+    pub fn input_gain(&self) -> &SMatrix<T, I, O> {
+        &self.gain_w
+    }
+}
+
+/// The time-varying dual Kalman filter of Eftekhar Azam, Chatzi & Papadimitriou (2015):
+/// the step of the [module docs](self) with both stages' covariances propagated, as the
+/// paper writes it:
+///
+/// ```text
+/// input stage:  Pʷ⁻ = Pʷ_{n−1} + Q_w        G_w = Pʷ⁻ D̃ᵀ (D̃ Pʷ⁻ D̃ᵀ + R)⁻¹
+///               ŵ_n = ŵ_{n−1} + G_w (y_n − C ξ⁻ − D̃ ŵ_{n−1})     Pʷ_n = Pʷ⁻ − G_w D̃ Pʷ⁻
+/// state stage:  P⁻ = A P_{n−1} Aᵀ + Q          G_x = P⁻ Cᵀ (C P⁻ Cᵀ + R)⁻¹
+///               ξ̂_n = ξ⁻ + G_x (y_n − C ξ⁻ − D̃ ŵ_n)              P_n = P⁻ − G_x C P⁻
+/// ```
+///
+/// with `ξ⁻ = A ξ̂_{n−1} + B ŵ_{n−1}`. As in the paper, each stage's innovation
+/// covariance holds only its own uncertainty and `R`: the input stage's leaves out
+/// `C P⁻ Cᵀ` (the state's error in its innovation), the state stage's leaves out
+/// `D̃ Pʷ D̃ᵀ`, and `P⁻` leaves out `B Pʷ Bᵀ`. The two recursions are therefore
+/// independent of the data and of each other, and each is the Riccati recursion whose
+/// limit [`DualGains`] solves: `Pʷ⁻ → DualGains::input.covariance`,
+/// `P⁻ → DualGains::state.covariance`, the gains to theirs (`tests/estimation_dual.rs`).
+/// The covariances are those of the stages' models, not the errors of the coupled
+/// filter.
+///
+/// A measurement with a non-finite entry is missing: predict only (`ξ̂_n = ξ⁻`,
+/// `P_n = P⁻`, `ŵ_n = ŵ_{n−1}` with `Pʷ_n = Pʷ⁻`: the random walk's prediction), counted.
+/// Only a checked step: a failed step changes nothing.
+///
+/// Cost of a step: about `2S³ + 2S²·O + 2S·O² + O³/3` multiply-adds for the state stage
+/// and `2O·I² + 2O²·I + O³/3` for the input stage, plus the fixed filter's
+/// `S² + S·I + 2S·O + 3O·I` (`≈ 3 400` for `S = 10`, `I = 1`, `O = 4`): for the host and
+/// small firmware models; the [`DualFilter`] with the steady [`DualGains`] costs the last
+/// term only. Size: `2S² + 2S·I + S·O + O·I + I² + O² + 1` values of `T`; its state
+/// ([`DualKalmanFilterState`]) `S² + S + I² + I + S·O + I·O` values and two `u64`. No
+/// allocation.
+///
+/// ```
+/// use aemstep::estimation::{DualGains, DualKalmanFilter, InputModel};
+/// use aemstep::models;
+/// use aemstep::observer::{Outputs, StateSpace};
+/// use aemstep::nalgebra::{SMatrix, SVector};
+/// use aemstep::vector;
+///
+/// // The 5-storey building, an unknown force at the roof (N); absolute accelerations of
+/// // floors 1, 3, 5 (m/s²) and the roof displacement (m) measured.
+/// let (m, c, k) = models::five_storey_building();
+/// let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
+/// let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02)?;
+/// let mut out = Outputs::<5, 1, 4>::zero();
+/// out.a = [[1.0, 0.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 1.0], [0.0; 5]];
+/// out.u[3] = [0.0, 0.0, 0.0, 0.0, 1.0];
+/// let model = InputModel::from_parts(&ss, &ss.outputs(&out)?)?;
+/// let q = SMatrix::<f64, 10, 10>::identity() * 1e-14;
+/// let qw = SMatrix::<f64, 1, 1>::from_element(1e6); // the random walk: σ = 1 kN per step
+/// let r = SMatrix::<f64, 4, 4>::from_diagonal(&vector![1e-4, 1e-4, 1e-4, 1e-8]);
+/// let f = DualKalmanFilter::<f64, 10, 1, 4>::new(&model, &q, &qw, &r)?;
+/// let p0 = SMatrix::<f64, 10, 10>::identity() * 1e-8;
+/// let mut s = f.start(&SVector::zeros(), &p0, &SVector::zeros(), &SMatrix::from_element(1e10))?;
+/// f.try_step(&mut s, &vector![0.01, 0.02, 0.03, 1e-4])?;
+/// f.try_step(&mut s, &vector![f64::NAN, 0.02, 0.03, 1e-4])?; // missing: predicted
+/// assert_eq!((s.estimate().steps(), s.estimate().missing()), (2, 1));
+/// assert!(s.estimate().input()[0].is_finite()); // N
+/// // The gains tend to the steady ones the fixed-gain `DualFilter` uses.
+/// let steady = DualGains::new(&model, &q, &qw, &r)?;
+/// assert!(steady.input.gain[0].iter().all(|g| g.is_finite()));
+/// # Ok::<(), aemstep::Error>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualKalmanFilter<T, const S: usize, const I: usize, const O: usize> {
+    a: SMatrix<T, S, S>,
+    b: SMatrix<T, S, I>,
+    c: SMatrix<T, O, S>,
+    d: SMatrix<T, O, I>,
+    gamma1: [[T; I]; S],
+    q: SMatrix<T, S, S>,
+    qw: SMatrix<T, I, I>,
+    r: SMatrix<T, O, O>,
+    time_step: T,
+}
+
+/// `(a + aᵀ)/2`.
+fn sym<T: Real, const N: usize>(a: &SMatrix<T, N, N>) -> SMatrix<T, N, N> {
+    (a + a.transpose()) * T::from_f64_rounded(0.5)
+}
+
+/// `a` as a `T` matrix, each entry rounded once.
+fn to_t<T: Real, const R: usize, const C: usize>(a: &[[f64; C]; R]) -> SMatrix<T, R, C> {
+    SMatrix::from_fn(|i, j| T::from_f64_rounded(a[i][j]))
+}
+
+impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T, S, I, O> {
+    /// The filter of `model` with process noise `q` (`S×S` on `ξ`, symmetric positive
+    /// semidefinite, units of `x` squared per step), the random walk's covariance `qw`
+    /// (`I×I`, symmetric positive semidefinite, input units squared per step) and
+    /// measurement noise `r` (`O×O`, symmetric positive definite), in `f64`, rounded once
+    /// to `T`. The identifiability of the input is not checked (the stages need none:
+    /// `R` keeps both innovation covariances definite); [`DualGains::solve`] checks that
+    /// the recursion has a limit.
+    ///
+    /// Errors: [`Error::InvalidCovariance`], [`Error::NonFiniteInput`],
+    /// [`Error::InvalidTimeStep`] (the model's `time_step` in `T`),
+    /// [`Error::OperatorOverflow`]. Cost: `O(S² + O³)`.
+    pub fn new(
+        model: &InputModel<S, I, O>,
+        q: &SMatrix<f64, S, S>,
+        qw: &SMatrix<f64, I, I>,
+        r: &SMatrix<f64, O, O>,
+    ) -> Result<Self, Error> {
+        let (qr, qwr, rr) = (
+            linalg::rows_f64(q),
+            linalg::rows_f64(qw),
+            linalg::rows_f64(r),
+        );
+        if !(is_covariance(&qr, false) && is_covariance(&qwr, false) && is_covariance(&rr, true)) {
+            return Err(Error::InvalidCovariance);
+        }
+        if !(all_finite(&model.a)
+            && all_finite(&model.b)
+            && all_finite(&model.c)
+            && all_finite(&model.d)
+            && all_finite(&model.gamma1))
+        {
+            return Err(Error::NonFiniteInput);
+        }
+        crate::kinematics::check_time_step_as(model.time_step, T::MAX)?;
+        let fits = finite_as(&model.a, T::MAX)
+            && finite_as(&model.b, T::MAX)
+            && finite_as(&model.c, T::MAX)
+            && finite_as(&model.d, T::MAX)
+            && finite_as(&model.gamma1, T::MAX)
+            && finite_as(&qr, T::MAX)
+            && finite_as(&qwr, T::MAX)
+            && finite_as(&rr, T::MAX);
+        if !fits {
+            return Err(Error::OperatorOverflow);
+        }
+        Ok(Self {
+            a: to_t(&model.a),
+            b: to_t(&model.b),
+            c: to_t(&model.c),
+            d: to_t(&model.d),
+            gamma1: round_rows(&model.gamma1),
+            q: to_t(&qr),
+            qw: to_t(&qwr),
+            r: to_t(&rr),
+            time_step: T::from_f64_rounded(model.time_step),
+        })
+    }
+
+    /// The time step `h` (s).
+    pub fn time_step(&self) -> T {
+        self.time_step
+    }
+
+    /// The filter at `t = 0`: physical state `x0` with covariance `p0` (taken as the
+    /// covariance of `ξ̂_0`, units of `x` squared), input `w0` with covariance `pw0` (input
+    /// units squared); `ξ̂_0 = x0 − Γ₁ w0`.
+    ///
+    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidCovariance`] (`p0`, `pw0` not
+    /// symmetric positive semidefinite). Cost: `O(S³)`.
+    pub fn start(
+        &self,
+        x0: &SVector<T, S>,
+        p0: &SMatrix<T, S, S>,
+        w0: &SVector<T, I>,
+        pw0: &SMatrix<T, I, I>,
+    ) -> Result<DualKalmanFilterState<T, S, I, O>, Error> {
+        let estimate = joint_start(&self.gamma1, x0, w0)?;
+        let (pr, pwr) = (linalg::rows_f64(p0), linalg::rows_f64(pw0));
+        if !(is_covariance(&pr, false) && is_covariance(&pwr, false)) {
+            return Err(Error::InvalidCovariance);
+        }
+        Ok(DualKalmanFilterState {
+            estimate,
+            p: *p0,
+            pw: *pw0,
+            gain_x: SMatrix::zeros(),
+            gain_w: SMatrix::zeros(),
+        })
+    }
+
+    /// The a-priori covariances of the next step, `(P⁻, Pʷ⁻) = (A P Aᵀ + Q, Pʷ + Q_w)`
+    /// (what converge to [`DualGains`]' `state.covariance` and `input.covariance`).
+    /// Cost: `2S³`.
+    pub fn predicted_covariances(
+        &self,
+        s: &DualKalmanFilterState<T, S, I, O>,
+    ) -> (SMatrix<T, S, S>, SMatrix<T, I, I>) {
+        (
+            sym(&(self.a * s.p * self.a.transpose() + self.q)),
+            sym(&(s.pw + self.qw)),
+        )
+    }
+
+    /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I`.
+    pub fn state(&self, s: &DualKalmanFilterState<T, S, I, O>) -> SVector<T, S> {
+        shift(&self.gamma1, &s.estimate.xi, &s.estimate.w, T::one())
+    }
+
+    /// One filter step with the measurement `y` (`y_n`; a non-finite entry: missing).
+    ///
+    /// Errors, `s` left bit-identical: [`Error::InvalidCovariance`] (`D̃ Pʷ⁻ D̃ᵀ + R` or
+    /// `C P⁻ Cᵀ + R` not positive definite to working precision),
+    /// [`Error::NonFiniteState`] (a non-finite estimate, covariance or gain). No
+    /// allocation, no panic; cost in the type docs.
+    pub fn try_step(
+        &self,
+        s: &mut DualKalmanFilterState<T, S, I, O>,
+        y: &SVector<T, O>,
+    ) -> Result<(), Error> {
+        let e = &s.estimate;
+        let xp = self.a * e.xi + self.b * e.w;
+        let (pm, pwm) = self.predicted_covariances(s);
+        let mut next = *s;
+        if y.iter().all(|v| v.is_finite()) {
+            // ν₀ = y − C ξ⁻.
+            let nu0 = y - self.c * xp;
+            // Input stage: the random walk measured through D̃.
+            let dp = self.d * pwm;
+            let sw = sym(&(dp * self.d.transpose() + self.r));
+            let cw = sw.cholesky().ok_or(Error::InvalidCovariance)?;
+            let gw = cw.solve(&dp).transpose();
+            let w = e.w + gw * (nu0 - self.d * e.w);
+            // State stage, with the new ŵ_n.
+            let cp = self.c * pm;
+            let sx = sym(&(cp * self.c.transpose() + self.r));
+            let cx = sx.cholesky().ok_or(Error::InvalidCovariance)?;
+            let gx = cx.solve(&cp).transpose();
+            next.estimate.xi = xp + gx * (nu0 - self.d * w);
+            next.estimate.w = w;
+            next.pw = sym(&(pwm - gw * dp));
+            next.p = sym(&(pm - gx * cp));
+            next.gain_w = gw;
+            next.gain_x = gx;
+        } else {
+            next.estimate.xi = xp;
+            next.p = pm;
+            next.pw = pwm;
+            next.estimate.missing = next.estimate.missing.wrapping_add(1);
+        }
+        next.estimate.n = next.estimate.n.wrapping_add(1);
+        let finite = next
+            .estimate
+            .xi
+            .iter()
+            .chain(next.estimate.w.iter())
+            .chain(next.p.iter())
+            .chain(next.pw.iter())
+            .chain(next.gain_x.iter())
+            .chain(next.gain_w.iter())
+            .all(|v| v.is_finite());
+        if !finite {
+            return Err(Error::NonFiniteState);
+        }
+        *s = next;
+        Ok(())
+    }
+}

@@ -17,7 +17,8 @@
 //! - [`smoother`]: a fixed-lag smoother with steady gains on any observer model (on the
 //!   augmented one it smooths the force too), `L` samples late.
 //! - [`dual`]: the dual Kalman filter (Eftekhar Azam et al. 2015), an input and a state
-//!   filter in sequence, each with a steady gain from [`SteadyState`](crate::observer::SteadyState).
+//!   filter in sequence, each with a steady gain from [`SteadyState`](crate::observer::SteadyState)
+//!   ([`DualFilter`]) or with its covariance propagated ([`DualKalmanFilter`], host).
 //!
 //! # The model the filters use
 //!
@@ -118,6 +119,7 @@ pub mod dual;
 mod joint;
 pub mod smoother;
 
+pub use dual::{DualFilter, DualGains, DualKalmanFilter, DualKalmanFilterState};
 pub use joint::{InputStateFilter, InputStateFilterState, InputStateGains, InputStateObserver};
 pub use joint::{JointEstimate, STEADY_MAX_ITERATIONS, ZERO_SQUARINGS};
 
