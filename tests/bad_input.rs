@@ -1136,3 +1136,45 @@ fn bouc_wen_huge_exponent_root_is_the_smallest_residual() {
         h = t.history;
     }
 }
+
+/// `InputModel::zero_dynamics` returned `Ā = A − B M₀ C` unchecked: with `B`, `C` of
+/// 1e300 it is `−∞` and was `Ok` (found by the `estimation` fuzz target,
+/// `fuzz/regressions/estimation/zero-dynamics-not-finite-is-operator-overflow`). Now
+/// `OperatorOverflow`, as its docs say.
+#[test]
+fn zero_dynamics_not_finite_is_operator_overflow() {
+    use aemstep::estimation::InputModel;
+    let model = InputModel::<2, 1, 1> {
+        a: [[1.0, 0.0], [0.0, 1.0]],
+        b: [[1e300], [1e300]],
+        c: [[1e300, 0.0]],
+        d: [[1.0]],
+        gamma1: [[0.0], [0.0]],
+        time_step: 0.01,
+    };
+    assert_eq!(
+        model.zero_dynamics(&SMatrix::<f64, 1, 1>::identity()).err(),
+        Some(Error::OperatorOverflow)
+    );
+}
+
+/// `Whitener::nis` of a finite innovation whose whitened terms overflow (`∞ − ∞`) was NaN,
+/// which a `Window` skips as a missing sample: the largest innovations were never an alarm
+/// (found by the `detection` fuzz target,
+/// `fuzz/regressions/detection/nis-of-finite-innovation-overflowing-is-infinite`). Now `+∞`,
+/// an alarm; a NaN innovation stays NaN (missing).
+#[test]
+fn nis_of_finite_innovation_overflowing_is_infinite() {
+    use aemstep::detection::{ChiSquareTest, Detector, Whitener, Window};
+    let s = [[1.0, 0.99], [0.99, 1.0]];
+    let w64 = Whitener::<f64, 2>::new(&s).unwrap();
+    let nu = vector![f64::MAX / 2.0, f64::MAX / 2.0];
+    assert_eq!(w64.nis(&nu), f64::INFINITY);
+    assert!(w64.nis(&vector![f64::NAN, 0.0]).is_nan());
+    let w32 = Whitener::<f32, 2>::new(&s).unwrap();
+    assert_eq!(w32.nis(&vector![f32::MAX / 2.0, f32::MAX / 2.0]), f32::INFINITY);
+    let det = Detector::new(w64, ChiSquareTest::<1>::new(2, 1e-3).unwrap());
+    let mut win = Window::<1>::new();
+    assert!(det.update(&mut win, &nu), "an overflowing innovation is an alarm");
+    assert_eq!(win.skipped(), 0);
+}

@@ -174,7 +174,9 @@ impl<T: Real, const O: usize> Whitener<T, O> {
     }
 
     /// `q = νᵀ S⁻¹ ν` of an innovation `ν` (output units): dimensionless, `≥ 0`; NaN if
-    /// `ν` has a NaN (a missing sample). Cost: `O(O+1)/2` multiply-adds.
+    /// `ν` has a NaN (a missing sample); `+∞` where a finite `ν` overflows `T` (its
+    /// whitened terms `∞ − ∞`: an alarm, not a missing sample). Cost: `O(O+1)/2`
+    /// multiply-adds.
     #[inline]
     pub fn nis(&self, nu: &SVector<T, O>) -> T {
         let mut q = T::zero();
@@ -184,6 +186,9 @@ impl<T: Real, const O: usize> Whitener<T, O> {
                 z += self.cinv[i][j] * nu[j];
             }
             q += z * z;
+        }
+        if q.as_f64().is_nan() && nu.iter().all(|v| v.is_finite()) {
+            return T::from_f64_rounded(f64::INFINITY);
         }
         q
     }
