@@ -1178,3 +1178,28 @@ fn nis_of_finite_innovation_overflowing_is_infinite() {
     assert!(det.update(&mut win, &nu), "an overflowing innovation is an alarm");
     assert_eq!(win.skipped(), 0);
 }
+
+/// `innovation_covariance` checked `S = H P Hᵀ + R` finite before symmetrizing it, and
+/// `(S + Sᵀ)/2` of entries near `f64::MAX` overflows: `R = f64::MAX` gave `Ok([[∞]])`
+/// (found by the `detection` fuzz target,
+/// `fuzz/regressions/detection/innovation-covariance-symmetrized-near-max-overflows`). Now
+/// `OperatorOverflow`.
+#[test]
+fn innovation_covariance_symmetrized_near_max_overflows() {
+    use aemstep::detection::innovation_covariance;
+    use aemstep::observer::{Measurement, SteadyState};
+    let kf = SteadyState::<2, 1> {
+        covariance: [[1.0, 0.0], [0.0, 1.0]],
+        gain: [[0.0], [0.0]],
+        iterations: 1,
+    };
+    let meas = Measurement::<2, 1, 1> {
+        h: [[0.0, 0.0]],
+        d: [[1.0]],
+    };
+    assert_eq!(
+        innovation_covariance(&kf, &meas, &[[f64::MAX]]).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert_eq!(innovation_covariance(&kf, &meas, &[[2.0]]), Ok([[2.0]]));
+}

@@ -110,6 +110,10 @@ pub const fn innovation_covariance<const S: usize, const I: usize, const O: usiz
         }
         i += 1;
     }
+    // (The sum of two entries near `f64::MAX` overflows where each is finite.)
+    if !all_finite(&out) {
+        return Err(Error::OperatorOverflow);
+    }
     Ok(out)
 }
 
