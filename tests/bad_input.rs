@@ -1172,10 +1172,16 @@ fn nis_of_finite_innovation_overflowing_is_infinite() {
     assert_eq!(w64.nis(&nu), f64::INFINITY);
     assert!(w64.nis(&vector![f64::NAN, 0.0]).is_nan());
     let w32 = Whitener::<f32, 2>::new(&s).unwrap();
-    assert_eq!(w32.nis(&vector![f32::MAX / 2.0, f32::MAX / 2.0]), f32::INFINITY);
+    assert_eq!(
+        w32.nis(&vector![f32::MAX / 2.0, f32::MAX / 2.0]),
+        f32::INFINITY
+    );
     let det = Detector::new(w64, ChiSquareTest::<1>::new(2, 1e-3).unwrap());
     let mut win = Window::<1>::new();
-    assert!(det.update(&mut win, &nu), "an overflowing innovation is an alarm");
+    assert!(
+        det.update(&mut win, &nu),
+        "an overflowing innovation is an alarm"
+    );
     assert_eq!(win.skipped(), 0);
 }
 
