@@ -36,8 +36,10 @@ def fuzz_section(path):
         hysteresis="`Bilinear`, `BoucWen`, `Friction`, `Parallel` (trials along a path), `ShearBuilding`, its `Nonlinear` steps with history",
         observer="`StateSpace` (aem, from_rows_aem, exact, modal; wrong S), outputs, `SteadyState`, `Observer` (new, from_parts_f32/_f64), `Kalman`, `Readout`",
         spectrum="`Bank` (new, with: both schemes, every sub-step rule), `RotD`, `batch::spectra`",
+        estimation="`InputModel` (from_parts, zero_dynamics), `InputStateGains` (solve, new), `InputStateObserver` (new, from_parts_f32/_f64), `InputStateFilter`, `DualGains`, `DualFilter` (new, from_parts_f32/_f64), `AugmentedModel`, `FixedLag` (new, from_parts_f32/_f64); S = 2, 4, O = 1 … 3",
+        detection="`chi_square_quantile`, `normal_quantile`, `innovation_covariance`, `Whitener` (new, from_rows_f32/_f64), `Window`, `ChiSquareTest`, `Detector`, `Cusum`, `ModelBank`, `Observer::step_innovation`, `Kalman::try_step_innovation`",
     )
-    order = ["linear_family", "modal", "nonlinear", "hysteresis", "observer", "spectrum"]
+    order = ["linear_family", "modal", "nonlinear", "hysteresis", "observer", "spectrum", "estimation", "detection"]
     missing = [t for t in order if t not in runs]
     if missing:
         raise SystemExit(f"FAILED: fuzz/stats.txt has no run of {missing}")
@@ -114,6 +116,13 @@ Library fixes (each `Ok` with garbage, or a wrong error, before):
   reported after the periods and damping ratios are checked. The AEM's sub-step map, formed by stepping unit
   inputs, cancelled terms of size `(ωh)²/4` (at `ωh ≈ 5e14` a bank stepped 10 m/s² to a
   displacement of 1e98): now in closed form.
+- Estimation and detection (targets `estimation`, `detection`): `InputModel::zero_dynamics`
+  returned `Ā = A − B M₀ C` unchecked (`−∞` for `B`, `C` of 1e300): now
+  `OperatorOverflow`; `innovation_covariance` checked `S` finite before symmetrizing it,
+  and `(S + Sᵀ)/2` of entries near `f64::MAX` overflowed to `Ok(∞)`: now
+  `OperatorOverflow`; `Whitener::nis` of a finite innovation whose whitened terms overflow
+  (`∞ − ∞`) was NaN, which a `Window` skips as a missing sample, so the largest
+  innovations never alarmed: now `+∞`, an alarm.
 - Hysteretic laws and buildings whose coefficients overflow `f32` (`k = 1.6e293`), or
   whose products do (friction's `f_s/v_r` with `v_r = 1.25e-308`: a NaN damping):
   `OperatorOverflow`.

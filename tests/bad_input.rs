@@ -1136,3 +1136,76 @@ fn bouc_wen_huge_exponent_root_is_the_smallest_residual() {
         h = t.history;
     }
 }
+
+/// `InputModel::zero_dynamics` returned `Ā = A − B M₀ C` unchecked: with `B`, `C` of
+/// 1e300 it is `−∞` and was `Ok` (found by the `estimation` fuzz target,
+/// `fuzz/regressions/estimation/zero-dynamics-not-finite-is-operator-overflow`). Now
+/// `OperatorOverflow`, as its docs say.
+#[test]
+fn zero_dynamics_not_finite_is_operator_overflow() {
+    use aemstep::estimation::InputModel;
+    let model = InputModel::<2, 1, 1> {
+        a: [[1.0, 0.0], [0.0, 1.0]],
+        b: [[1e300], [1e300]],
+        c: [[1e300, 0.0]],
+        d: [[1.0]],
+        gamma1: [[0.0], [0.0]],
+        time_step: 0.01,
+    };
+    assert_eq!(
+        model.zero_dynamics(&SMatrix::<f64, 1, 1>::identity()).err(),
+        Some(Error::OperatorOverflow)
+    );
+}
+
+/// `Whitener::nis` of a finite innovation whose whitened terms overflow (`∞ − ∞`) was NaN,
+/// which a `Window` skips as a missing sample: the largest innovations were never an alarm
+/// (found by the `detection` fuzz target,
+/// `fuzz/regressions/detection/nis-of-finite-innovation-overflowing-is-infinite`). Now `+∞`,
+/// an alarm; a NaN innovation stays NaN (missing).
+#[test]
+fn nis_of_finite_innovation_overflowing_is_infinite() {
+    use aemstep::detection::{ChiSquareTest, Detector, Whitener, Window};
+    let s = [[1.0, 0.99], [0.99, 1.0]];
+    let w64 = Whitener::<f64, 2>::new(&s).unwrap();
+    let nu = vector![f64::MAX / 2.0, f64::MAX / 2.0];
+    assert_eq!(w64.nis(&nu), f64::INFINITY);
+    assert!(w64.nis(&vector![f64::NAN, 0.0]).is_nan());
+    let w32 = Whitener::<f32, 2>::new(&s).unwrap();
+    assert_eq!(
+        w32.nis(&vector![f32::MAX / 2.0, f32::MAX / 2.0]),
+        f32::INFINITY
+    );
+    let det = Detector::new(w64, ChiSquareTest::<1>::new(2, 1e-3).unwrap());
+    let mut win = Window::<1>::new();
+    assert!(
+        det.update(&mut win, &nu),
+        "an overflowing innovation is an alarm"
+    );
+    assert_eq!(win.skipped(), 0);
+}
+
+/// `innovation_covariance` checked `S = H P Hᵀ + R` finite before symmetrizing it, and
+/// `(S + Sᵀ)/2` of entries near `f64::MAX` overflows: `R = f64::MAX` gave `Ok([[∞]])`
+/// (found by the `detection` fuzz target,
+/// `fuzz/regressions/detection/innovation-covariance-symmetrized-near-max-overflows`). Now
+/// `OperatorOverflow`.
+#[test]
+fn innovation_covariance_symmetrized_near_max_overflows() {
+    use aemstep::detection::innovation_covariance;
+    use aemstep::observer::{Measurement, SteadyState};
+    let kf = SteadyState::<2, 1> {
+        covariance: [[1.0, 0.0], [0.0, 1.0]],
+        gain: [[0.0], [0.0]],
+        iterations: 1,
+    };
+    let meas = Measurement::<2, 1, 1> {
+        h: [[0.0, 0.0]],
+        d: [[1.0]],
+    };
+    assert_eq!(
+        innovation_covariance(&kf, &meas, &[[f64::MAX]]).err(),
+        Some(Error::OperatorOverflow)
+    );
+    assert_eq!(innovation_covariance(&kf, &meas, &[[2.0]]), Ok([[2.0]]));
+}

@@ -117,6 +117,10 @@ pub const fn innovation_covariance<const S: usize, const I: usize, const O: usiz
         }
         i += 1;
     }
+    // (The sum of two entries near `f64::MAX` overflows where each is finite.)
+    if !all_finite(&out) {
+        return Err(Error::OperatorOverflow);
+    }
     Ok(out)
 }
 
@@ -181,7 +185,9 @@ impl<T: Real, const O: usize> Whitener<T, O> {
     }
 
     /// `q = νᵀ S⁻¹ ν` of an innovation `ν` (output units): dimensionless, `≥ 0`; NaN if
-    /// `ν` has a NaN (a missing sample). Cost: `O(O+1)/2` multiply-adds.
+    /// `ν` has a NaN (a missing sample); `+∞` where a finite `ν` overflows `T` (its
+    /// whitened terms `∞ − ∞`: an alarm, not a missing sample). Cost: `O(O+1)/2`
+    /// multiply-adds.
     #[inline]
     pub fn nis(&self, nu: &SVector<T, O>) -> T {
         let mut q = T::zero();
@@ -191,6 +197,9 @@ impl<T: Real, const O: usize> Whitener<T, O> {
                 z += self.cinv[i][j] * nu[j];
             }
             q += z * z;
+        }
+        if q.as_f64().is_nan() && nu.iter().all(|v| v.is_finite()) {
+            return T::from_f64_rounded(f64::INFINITY);
         }
         q
     }

@@ -225,7 +225,8 @@ impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
     /// state ([module docs](self)).
     ///
     /// Errors: [`Error::InvalidCovariance`] (`r`), [`Error::InputNotIdentifiable`] (the
-    /// rank of `D̃`), [`Error::OperatorOverflow`]. Cost: `O(S²·O + O³)` flops.
+    /// rank of `D̃`), [`Error::OperatorOverflow`] (`Ā` not finite). Cost: `O(S²·O + O³)`
+    /// flops.
     pub fn zero_dynamics(&self, r: &SMatrix<f64, O, O>) -> Result<SMatrix<f64, S, S>, Error> {
         let rr: Mat<O, O> = core::array::from_fn(|i| core::array::from_fn(|j| r[(i, j)]));
         let (f0, rd) = self.weighted_feedthrough(&rr)?;
@@ -234,6 +235,9 @@ impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
             None => return Err(Error::InputNotIdentifiable),
         };
         let abar = add_scaled(&self.a, -1.0, &mul(&self.b, &mul(&m0, &self.c)));
+        if !all_finite(&abar) {
+            return Err(Error::OperatorOverflow);
+        }
         Ok(SMatrix::from_fn(|i, j| abar[i][j]))
     }
 

@@ -803,3 +803,24 @@ pub(super) fn damping_data<const N: usize>(d: &Damping<N>) -> Vec<f64> {
         Damping::Matrix(c) => c.iter().flatten().copied().collect(),
     }
 }
+
+/// A covariance: `σ² I`, `L Lᵀ` of ordinary entries, singular, non-symmetric, negative, or
+/// any entries.
+pub(super) fn covariance<const N: usize>(b: &mut Bytes) -> SMatrix<f64, N, N> {
+    let a = match b.pick(6) {
+        0 | 1 => SMatrix::identity() * 10f64.powf(-6.0 + 6.0 * b.unit()),
+        2 => {
+            let l = SMatrix::<f64, N, N>::from_fn(|_, _| b.ordinary());
+            let s = l * l.transpose();
+            (s + s.transpose()) * 0.5
+        }
+        3 => {
+            let v = b.small_vector::<N>();
+            v * v.transpose()
+        }
+        4 => b.square(),
+        _ => SMatrix::identity() * b.value(),
+    };
+    b.note_all(a.as_slice());
+    a
+}

@@ -12,7 +12,7 @@
 //! `common.rs` the decoder (`Bytes`), the counters, the independent references and the
 //! checks several targets share; each fuzz target `fuzz_targets/<t>.rs` has its checks in
 //! `<t>.rs` here (`linear_family`, `modal`, `nonlinear`, `hysteresis`, `observer`,
-//! `spectrum`), each starting with a line saying what it checks.
+//! `spectrum`, `estimation`, `detection`), each starting with a line saying what it checks.
 //!
 //! Properties (as `tests/properties.rs`, over much more varied data):
 //! - never a panic (a panic aborts the fuzzer: a crash);
@@ -48,6 +48,8 @@ macro_rules! check {
 }
 
 mod common;
+mod detection;
+mod estimation;
 mod hysteresis;
 mod linear_family;
 mod modal;
@@ -59,6 +61,8 @@ mod spectrum;
 // re-exports all of it); the replay test uses only `run` and `TARGETS`.
 #[allow(unused_imports)]
 pub use common::{Bytes, SpdInfo, System, context, count, count_lines, counts, spd_info};
+pub use detection::detection;
+pub use estimation::estimation;
 pub use hysteresis::hysteresis;
 pub use linear_family::linear_family;
 pub use modal::modal;
@@ -67,13 +71,15 @@ pub use observer::observer;
 pub use spectrum::spectrum;
 
 /// The fuzz targets, in the order of the docs table.
-pub const TARGETS: [&str; 6] = [
+pub const TARGETS: [&str; 8] = [
     "linear_family",
     "modal",
     "nonlinear",
     "hysteresis",
     "observer",
     "spectrum",
+    "estimation",
+    "detection",
 ];
 
 /// Run the checks of `target` on one input. Panics when a property breaks.
@@ -85,6 +91,8 @@ pub fn run(target: &str, data: &[u8]) {
         "hysteresis" => hysteresis(data),
         "observer" => observer(data),
         "spectrum" => spectrum(data),
+        "estimation" => estimation(data),
+        "detection" => detection(data),
         _ => panic!("unknown fuzz target {target}"),
     }
 }

@@ -273,27 +273,6 @@ fn state_space_finite<const N: usize, const S: usize, const I: usize>(
         .all(|x| x.is_finite())
 }
 
-/// A covariance: `σ² I`, `L Lᵀ` of ordinary entries, singular, non-symmetric, negative, or
-/// any entries.
-fn covariance<const N: usize>(b: &mut Bytes) -> SMatrix<f64, N, N> {
-    let a = match b.pick(6) {
-        0 | 1 => SMatrix::identity() * 10f64.powf(-6.0 + 6.0 * b.unit()),
-        2 => {
-            let l = SMatrix::<f64, N, N>::from_fn(|_, _| b.ordinary());
-            let s = l * l.transpose();
-            (s + s.transpose()) * 0.5
-        }
-        3 => {
-            let v = b.small_vector::<N>();
-            v * v.transpose()
-        }
-        4 => b.square(),
-        _ => SMatrix::identity() * b.value(),
-    };
-    b.note_all(a.as_slice());
-    a
-}
-
 /// Finite, exactly symmetric, and positive (semi)definite with a margin (eigenvalues of the
 /// scaled matrix above `1e-8` for definite, above `-1e-8`… for semidefinite): a clear
 /// covariance by an independent test.
