@@ -198,7 +198,8 @@ impl<T: Real, const O: usize> Whitener<T, O> {
             }
             q += z * z;
         }
-        if q.as_f64().is_nan() && nu.iter().all(|v| v.is_finite()) {
+        // NaN (a sum of squares is otherwise ≥ 0), compared in `T` (no widening to `f64`).
+        if q.partial_cmp(&T::zero()).is_none() && nu.iter().all(|v| v.is_finite()) {
             return T::from_f64_rounded(f64::INFINITY);
         }
         q

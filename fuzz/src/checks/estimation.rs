@@ -1,6 +1,6 @@
 //! Fuzz target `estimation` (`fuzz_targets/estimation.rs`): checks InputModel (from_parts,
 //! zero_dynamics), InputStateGains (solve, new), InputStateObserver (new,
-//! from_parts_f32/_f64), InputStateFilter, DualGains (solve, new), DualFilter (new,
+//! from_parts_f32/_f64), InputStateFilter, DualGains (solve, new), DualKalmanFilter, DualFilter (new,
 //! from_parts_f32/_f64), AugmentedModel (from_parts, steady_state) and FixedLag (new,
 //! from_parts_f32/_f64; on the model and on the augmented model); S = 2, 4, I = 1,
 //! O = 1 … 3; f32, f64.
@@ -10,7 +10,7 @@
 use std::fmt::Debug;
 
 use aemstep::estimation::augmented::AugmentedModel;
-use aemstep::estimation::dual::{DualFilter, DualGains};
+use aemstep::estimation::dual::{DualFilter, DualGains, DualKalmanFilter};
 use aemstep::estimation::smoother::{FixedLag, FixedLagState};
 use aemstep::estimation::{
     InputModel, InputStateFilter, InputStateGains, InputStateObserver, JointEstimate,
@@ -391,6 +391,42 @@ fn sized<const N: usize, const S: usize, const Z: usize, const O: usize>(b: &mut
         }
     }
 
+    // The time-varying dual filter: the same covariances' verdict as DualGains where it is
+    // about them, and the checked-step contract.
+    let tv64 = DualKalmanFilter::<f64, S, 1, O>::new(&model, &q, &qw, &r);
+    let tv32 = DualKalmanFilter::<f32, S, 1, O>::new(&model, &q, &qw, &r);
+    outcome(ES, &tv64);
+    outcome(ES, &tv32);
+    // (It tests its covariances first, before the time step in `T`.)
+    if err(&tv64) == Some(Error::InvalidCovariance) {
+        check!(
+            err(&tv32) == Some(Error::InvalidCovariance),
+            "{ES}: DualKalmanFilter: f64 gave InvalidCovariance, f32 {:?}",
+            err(&tv32)
+        );
+    } else {
+        twins(
+            ES,
+            model.time_step,
+            "DualKalmanFilter",
+            err(&tv64),
+            err(&tv32),
+        );
+    }
+    if q_bad || r_bad || clearly_not_cov(&qw, false) {
+        check!(
+            err(&tv64) == Some(Error::InvalidCovariance),
+            "{ES}: DualKalmanFilter with a bad covariance gave {:?}",
+            err(&tv64)
+        );
+    }
+    if let Ok(f) = &tv64 {
+        dual_time_varying(f, &x0, &w0, &ys);
+    }
+    if let Ok(f) = &tv32 {
+        dual_time_varying(f, &x0, &w0, &ys);
+    }
+
     // The augmented model, its steady state and the fixed-lag smoother on it.
     check!(
         err(&AugmentedModel::<S, 1, S, O>::from_parts(
@@ -661,6 +697,87 @@ fn time_varying<T: Real, const S: usize, const O: usize>(
                 check!(
                     err == Error::NonFiniteState || (err == Error::InvalidCovariance && finite(&y)),
                     "{ES}: InputStateFilter step gave {err:?}"
+                );
+            }
+        }
+    }
+}
+
+/// `DualKalmanFilter`: starts (typed errors for non-finite data and covariances), then the
+/// checked steps: `Ok` ⇒ finite, one more step, a missing sample counted with the input
+/// held; `Err` ⇒ the state bit-identical.
+fn dual_time_varying<T: Real, const S: usize, const O: usize>(
+    f: &DualKalmanFilter<T, S, 1, O>,
+    x0: &SVector<f64, S>,
+    w0: &SVector<f64, 1>,
+    ys: &[SVector<f64, O>],
+) {
+    check!(debug_finite(f), "{ES}: DualKalmanFilter Ok, not finite");
+    let (x, w) = (to_t::<T, S, 1>(x0), to_t::<T, 1, 1>(w0));
+    let (p, pw) = (
+        SMatrix::<T, S, S>::identity(),
+        SMatrix::<T, 1, 1>::identity(),
+    );
+    let st = f.start(&x, &p, &w, &pw);
+    if !(finite(&x) && finite(&w)) {
+        check!(
+            err(&st) == Some(Error::NonFiniteInput),
+            "{ES}: DualKalmanFilter start from non-finite data gave {:?}",
+            err(&st)
+        );
+    }
+    let mut bad_p = p;
+    bad_p[(0, 0)] = T::from_f64_rounded(f64::NAN);
+    check!(
+        matches!(
+            err(&f.start(&SVector::zeros(), &bad_p, &SVector::zeros(), &pw)),
+            Some(Error::InvalidCovariance)
+        ),
+        "{ES}: DualKalmanFilter start with a NaN P0 accepted"
+    );
+    let Ok(mut s) = st.or_else(|_| f.start(&SVector::zeros(), &p, &SVector::zeros(), &pw)) else {
+        panic!(
+            "property broken: {ES}: DualKalmanFilter could not start at rest with P = I\n  data: {}",
+            context()
+        );
+    };
+    for y in ys {
+        let y = to_t::<T, O, 1>(y);
+        let before = bits(&s);
+        let held = bits(s.estimate().input());
+        let (n, missing) = (s.estimate().steps(), s.estimate().missing());
+        count(ES, "checked steps");
+        match f.try_step(&mut s, &y) {
+            Ok(()) => {
+                let e = s.estimate();
+                check!(
+                    e.is_finite()
+                        && finite(s.covariance())
+                        && finite(s.input_covariance())
+                        && e.steps() == n + 1,
+                    "{ES}: DualKalmanFilter Ok step not finite: {s:?}"
+                );
+                if finite(&y) {
+                    check!(
+                        e.missing() == missing,
+                        "{ES}: DualKalmanFilter: a sample counted missing"
+                    );
+                } else {
+                    check!(
+                        e.missing() == missing + 1 && bits(e.input()) == held,
+                        "{ES}: DualKalmanFilter: a missing sample not counted or its input not held"
+                    );
+                }
+            }
+            Err(err) => {
+                count(ES, "failed checked steps");
+                check!(
+                    bits(&s) == before,
+                    "{ES}: DualKalmanFilter failed step ({err:?}) changed the state"
+                );
+                check!(
+                    err == Error::NonFiniteState || (err == Error::InvalidCovariance && finite(&y)),
+                    "{ES}: DualKalmanFilter step gave {err:?}"
                 );
             }
         }
