@@ -206,7 +206,23 @@ pub(crate) const fn kr_operators<const N: usize>(
 }
 
 /// A KR-α (or Chen–Ricles) stepper for constant `M, C, K`: explicit displacement and
-/// velocity, the acceleration from the weighted equation of motion (module docs).
+/// velocity, the acceleration from the weighted equation of motion
+/// (Kolay & Ricles 2014; Chen & Ricles 2008):
+///
+/// ```text
+/// u_{n+1} = u_n + h v_n + h² α2 a_n,        v_{n+1} = v_n + h α1 a_n
+/// M [(I − α3) a_{n+1} + α3 a_n] + C v_{n+1−α_f} + K u_{n+1−α_f} = p_{n+1−α_f}
+/// α1 = (M + γh C + βh² K)⁻¹ M,   α2 = (1/2 + γ) α1
+/// α3 = (M + γh C + βh² K)⁻¹ (α_m M + α_f γh C + α_f βh² K)
+/// ```
+///
+/// with `x_{n+1−α} = (1 − α) x_{n+1} + α x_n` and the Chung–Hulbert `(α_m, α_f, β, γ)` of
+/// `ρ∞` ([`AlphaParameters::chung_hulbert`]); CR is `α_m = α_f = 0`, `β = 1/4`, `γ = 1/2`
+/// (`α1 = α2 = 4 (4M + 2h C + h² K)⁻¹ M`, `α3 = 0`). For linear systems: second order,
+/// unconditionally stable, the characteristic polynomial of
+/// [`GeneralizedAlpha`](crate::GeneralizedAlpha) with the same parameters (spectral
+/// radius `ρ∞` as `ωh → ∞`). Start from a state with a nonzero acceleration with
+/// [`KrAlpha::start_consistent`] (see there). `M` must be regular.
 ///
 /// Same state and start-up as [`Linear`](crate::Linear); `5N² + O(N)` multiply-adds a
 /// step. Size: `8N² + 5` values of `T` (`5N²` for stepping, `3N²` for start-up) and the
@@ -215,10 +231,13 @@ pub(crate) const fn kr_operators<const N: usize>(
 /// ```
 /// use aemstep::{KrAlpha, Stepper};
 /// use aemstep::{matrix, vector};
-/// // u'' + 25 u = 0, h = 0.01 s, ρ∞ = 0.8
+/// // u'' + 25 u = 0, h = 0.01 s, ρ∞ = 0.8, from u0 = 1 (a0 = −25: the consistent start)
 /// let sys = KrAlpha::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], 0.01, 0.8)?;
-/// let mut s = sys.start(&vector![1.0], &vector![0.0], &vector![0.0])?;
-/// for _ in 0..100 {
+/// let mut s = sys.start_consistent(&vector![1.0], &vector![0.0], &vector![0.0])?;
+/// let command = sys.next_displacement(&s); // explicit: known before the step's load
+/// sys.step(&mut s, &vector![0.0]);
+/// assert_eq!(s.u(), &command);
+/// for _ in 1..100 {
 ///     sys.step(&mut s, &vector![0.0]);
 /// }
 /// assert!((s.u()[0] - 5.0f64.cos()).abs() < 2e-3); // t = 1 s, O(h²) error
