@@ -161,11 +161,10 @@ fn one_generic_function_drives_every_linear_scheme() {
     .unwrap();
     eprintln!("Newmark LA: {la:.3e}");
     assert!(la < aem, "Newmark LA {la:e} vs AEM {aem:e}");
-    // The explicit schemes through the generic driver (the papers' start, the physical
-    // `v0` as the scheme's velocity variable): from this start with a nonzero initial
-    // acceleration the displacement error is O(h), not O(h²) — halving h halves it
-    // (measured ratio 1.96–1.97) — and 12× (CR) to 20× (KR-α ρ∞ = 0.5) the AEM's at this
-    // h. `KrAlpha::start_consistent` restores order 2 (tests/kr_alpha.rs).
+    // The explicit schemes (`KrAlpha`, CR and KR-α): second order through the generic
+    // driver, with their own O(h²) constants (measured 1.11× and 1.64× the AEM's error
+    // here) — halving h quarters the error (measured ratios printed). (`start` sets the scheme's velocity variable to v0 − γh α1 a0; the
+    // papers' start, v0 as given, is first order from this state: tests/kr_alpha.rs.)
     for rho in [None, Some(0.5)] {
         let kr = |h: f64| match rho {
             None => KrAlpha::<f64, 3>::chen_ricles(m, c, k, h).unwrap(),
@@ -177,8 +176,8 @@ fn one_generic_function_drives_every_linear_scheme() {
             "KrAlpha ρ∞ = {rho:?}: {e1:.3e} (AEM {aem:.3e}), ratio {:.3}",
             e1 / e2
         );
-        assert!(e1 < 30.0 * aem, "{e1:e} vs AEM {aem:e}");
-        assert!((e1 / e2 - 2.0).abs() < 0.1, "ratio {}", e1 / e2);
+        assert!(e1 < 2.0 * aem, "{e1:e} vs AEM {aem:e}");
+        assert!((e1 / e2 - 4.0).abs() < 0.15, "ratio {}", e1 / e2);
     }
 }
 

@@ -49,8 +49,8 @@
 //! spectral radius `ρ∞` as `ωh → ∞` (checked in `tests/kr_alpha.rs`).
 //! - [`KrAlpha::new`]`(…, ρ∞)`: the KR-α family. `ρ∞ = 1` (`α_m = α_f = 1/2`, `γ = 1/2`,
 //!   `β = 1/4`) gives `α1 = α2` of CR and `α3 = I/2`: the equation of motion averaged over
-//!   the step, the CR sequence from a consistent start, with a spurious root `−1` that
-//!   keeps (but never grows) a start-up residual of the equation of motion.
+//!   the step, the CR sequence from a state that satisfies the equation of motion, with a
+//!   spurious root `−1` that keeps (but never grows) a start-up residual of it.
 //! - [`KrAlpha::chen_ricles`]: the CR algorithm as published, `α_m = α_f = 0`, `γ = 1/2`,
 //!   `β = 1/4`: `α1 = α2 = 4 (4M + 2h C + h² K)⁻¹ M`, `α3 = 0`, the equation of motion
 //!   enforced at `t_{n+1}` (`M a_{n+1} = p_{n+1} − C v_{n+1} − K u_{n+1}`); no dissipation.
@@ -60,12 +60,15 @@
 //!
 //! **The start.** The explicit update `u_{n+1} = u_n + h v_n + (1/2 + γ) h² α1 a_n`
 //! matches the Taylor step `u + h v + (h²/2) a` only if the velocity variable is the
-//! physical velocity less `γh a` (to first order). [`Stepper::start`] takes `v0` as given
-//! (as the papers and OpenSees do): exact from rest under a load that starts at zero (a
-//! ground motion), but from a state with a nonzero initial acceleration (an initial
-//! displacement, a load at `t = 0`) the displacement error is then `O(h)` for the whole
-//! run. [`KrAlpha::start_consistent`] starts the velocity variable at `v0 − γh α1 a0` and
-//! the displacement is second order from any state (both measured in `tests/kr_alpha.rs`).
+//! physical velocity less `γh a` (to first order; for CR, `u_{n+1} = u_n + h v_{n+1}`
+//! exactly: a mid-step velocity). Taking the physical `v0` as the variable (the papers' and
+//! OpenSees' start) from a state with a nonzero initial acceleration (an initial
+//! displacement, a load at `t = 0`) leaves an `O(h)` displacement error for the whole run.
+//! So [`Stepper::start`] starts the variable at `v0 − γh α1 a0` (second order from any
+//! state), and [`Stepper::start_with_acceleration`] takes `u0, v0, a0` as given (the
+//! papers' start; right for a state saved from this scheme). From rest under a load that
+//! starts at zero (a ground motion) the two are the same. Both measured in
+//! `tests/kr_alpha.rs`. The state's `v` is the scheme's variable throughout, not `u'(t_n)`.
 //!
 //! **The load.** As for [`GeneralizedAlpha`](crate::GeneralizedAlpha): the weighted load
 //! needs `p_n`, which the shared [`State`] does not carry.
@@ -221,8 +224,13 @@ pub(crate) const fn kr_operators<const N: usize>(
 /// (`α1 = α2 = 4 (4M + 2h C + h² K)⁻¹ M`, `α3 = 0`). For linear systems: second order,
 /// unconditionally stable, the characteristic polynomial of
 /// [`GeneralizedAlpha`](crate::GeneralizedAlpha) with the same parameters (spectral
-/// radius `ρ∞` as `ωh → ∞`). Start from a state with a nonzero acceleration with
-/// [`KrAlpha::start_consistent`] (see there). `M` must be regular.
+/// radius `ρ∞` as `ωh → ∞`). `M` must be regular.
+///
+/// **The start.** The state's `v` is the scheme's velocity variable, which lags the
+/// physical velocity by `γh a` (to first order). [`Stepper::start`] sets it to
+/// `v0 − γh α1 a0`, and the displacement is second order from any initial state;
+/// [`Stepper::start_with_acceleration`] takes `v0` as given (the papers' and OpenSees'
+/// start: first order in the displacement when `a0 ≠ 0`, the same as `start` from rest).
 ///
 /// Same state and start-up as [`Linear`](crate::Linear); `5N² + O(N)` multiply-adds a
 /// step. Size: `8N² + 5` values of `T` (`5N²` for stepping, `3N²` for start-up) and the
@@ -231,9 +239,9 @@ pub(crate) const fn kr_operators<const N: usize>(
 /// ```
 /// use aemstep::{KrAlpha, Stepper};
 /// use aemstep::{matrix, vector};
-/// // u'' + 25 u = 0, h = 0.01 s, ρ∞ = 0.8, from u0 = 1 (a0 = −25: the consistent start)
+/// // u'' + 25 u = 0, h = 0.01 s, ρ∞ = 0.8, from u0 = 1
 /// let sys = KrAlpha::<f64, 1>::new(&matrix![1.0], &matrix![0.0], &matrix![25.0], 0.01, 0.8)?;
-/// let mut s = sys.start_consistent(&vector![1.0], &vector![0.0], &vector![0.0])?;
+/// let mut s = sys.start(&vector![1.0], &vector![0.0], &vector![0.0])?;
 /// let command = sys.next_displacement(&s); // explicit: known before the step's load
 /// sys.step(&mut s, &vector![0.0]);
 /// assert_eq!(s.u(), &command);
@@ -341,34 +349,6 @@ impl<T: Real, const N: usize> KrAlpha<T, N> {
     pub fn next_displacement(&self, state: &State<T, N>) -> SVector<T, N> {
         let w = self.alpha1_times(&state.a);
         SVector::from_fn(|i, _| state.u[i] + self.h * state.v[i] + self.c2 * w[i])
-    }
-
-    /// The state at `t = 0` that makes the displacement second order from any initial
-    /// condition: `u0` and `a0 = M⁻¹ (p0 − C v0 − K u0)` as [`Stepper::start`], and the
-    /// scheme's velocity variable `v0 − γh α1 a0` in place of `v0`.
-    ///
-    /// Why: the explicit update `u_{n+1} = u_n + h v_n + (1/2 + γ) h² α1 a_n` matches the
-    /// Taylor step `u + h v + h²/2 a` only if `v_n` is the velocity less `γh a_n` (to
-    /// first order; for CR, `u_{n+1} = u_n + h v_{n+1}`: a mid-step velocity). Started
-    /// with the physical `v0` ([`Stepper::start`], as the papers and OpenSees do), a
-    /// nonzero initial acceleration (initial displacement, or a load at `t = 0`) leaves an
-    /// `O(h)` error in the displacement for the whole run; from rest under a load that
-    /// starts at zero (a ground motion) the two starts are the same. Measured in
-    /// `tests/kr_alpha.rs`: error ratio 2 (papers' start) against 4 (this start) when
-    /// halving `h`. The state's `v` is then the scheme's variable, not `u'(t_n)`.
-    ///
-    /// Errors: as [`Stepper::start`]. Cost: that of [`Stepper::start`] plus `N²`
-    /// multiply-adds.
-    pub fn start_consistent(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        let s = Stepper::start(self, u0, v0, p0)?;
-        let w = self.alpha1_times(s.a());
-        let v = SVector::from_fn(|i, _| v0[i] - self.gamma_h * w[i]);
-        State::initial_computed(u0, &v, *s.a())
     }
 
     #[inline(always)]
@@ -513,7 +493,25 @@ impl<T: Real, const N: usize> Stepper<T, N> for KrAlpha<T, N> {
     type Input = SVector<T, N>;
     type State = State<T, N>;
 
-    crate::stepper::full_order_state!(start);
+    /// The state at `t = 0` for a second-order run from any initial condition: `u0`,
+    /// `a0 = M⁻¹ (p0 − C v0 − K u0)`, and the scheme's velocity variable
+    /// `v0 − γh α1 a0` in place of `v0` (see the type's docs, "The start").
+    ///
+    /// Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if `a0` or the
+    /// velocity variable overflows. Cost: `4N²` multiply-adds.
+    fn start(
+        &self,
+        u0: &SVector<T, N>,
+        v0: &SVector<T, N>,
+        p0: &SVector<T, N>,
+    ) -> Result<State<T, N>, Error> {
+        let s = crate::kernel::initial_state(self.start.as_ref(), u0, v0, p0)?;
+        let w = self.alpha1_times(s.a());
+        let v = SVector::from_fn(|i, _| v0[i] - self.gamma_h * w[i]);
+        State::initial_computed(u0, &v, *s.a())
+    }
+
+    crate::stepper::full_order_state!();
 
     #[inline]
     fn time_step(&self) -> T {
