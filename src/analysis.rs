@@ -29,7 +29,9 @@
 
 use nalgebra::{ComplexField, RealField, SVector, matrix};
 
-use crate::{AForm, Error, Exact, GeneralizedAlpha, Linear, Newmark, Real, State, Stepper};
+use crate::{
+    AForm, Error, Exact, GeneralizedAlpha, KrAlpha, Linear, Newmark, Real, State, Stepper,
+};
 
 /// A `3×3` matrix, row-major (`a[i][j]`: row `i`, column `j`); rows and columns ordered
 /// `u, h v, h² a`.
@@ -261,6 +263,18 @@ pub enum Scheme {
     },
     /// The exact discretization ([`Exact`]).
     Exact,
+    /// The explicit KR-α scheme ([`KrAlpha::new`]) with high-frequency spectral radius
+    /// `rho_inf`: for linear systems the characteristic polynomial of
+    /// [`Scheme::GeneralizedAlpha`] with the same `rho_inf`, so the same spectral radius,
+    /// period elongation and amplitude decay (an explicit step at an implicit scheme's
+    /// accuracy).
+    KrAlpha {
+        /// ρ∞ ∈ [0, 1].
+        rho_inf: f64,
+    },
+    /// The Chen–Ricles algorithm ([`KrAlpha::chen_ricles`]): the AEM's (trapezoidal)
+    /// principal roots, a third root `0`.
+    ChenRicles,
 }
 
 /// Analyse `scheme` on `u'' + 2ξω u' + ω² u = 0` at `s = ωh` (built with `ω = 1`,
@@ -286,6 +300,10 @@ pub fn sdof(scheme: Scheme, s: f64, xi: f64) -> Result<SdofProperties, Error> {
             amplification_matrix(&GeneralizedAlpha::<f64, 1>::hht(&m, &c, &k, s, alpha)?)
         }
         Scheme::Exact => amplification_matrix(&Exact::<f64, 1>::new(&m, &c, &k, s)?),
+        Scheme::KrAlpha { rho_inf } => {
+            amplification_matrix(&KrAlpha::<f64, 1>::new(&m, &c, &k, s, rho_inf)?)
+        }
+        Scheme::ChenRicles => amplification_matrix(&KrAlpha::<f64, 1>::chen_ricles(&m, &c, &k, s)?),
     };
     Ok(SdofProperties::from_matrix(a, s, xi))
 }

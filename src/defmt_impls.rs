@@ -21,8 +21,8 @@ use crate::observer::{
 };
 use crate::spectrum::Bank;
 use crate::{
-    AForm, Coefficients, CompensatedLinear, CompensatedState, Exact, GeneralizedAlpha, Linear,
-    LinearInput, Modal, Newmark, Nonlinear, Real, Stepper, Tangent, Varying,
+    AForm, Coefficients, CompensatedLinear, CompensatedState, Exact, GeneralizedAlpha, KrAlpha,
+    Linear, LinearInput, Modal, Newmark, Nonlinear, Real, Stepper, Tangent, Varying,
 };
 
 impl<T: Real + Format, const N: usize> Format for CompensatedState<T, N> {
@@ -177,6 +177,19 @@ impl<T: Real + Format, const N: usize> Format for GeneralizedAlpha<T, N> {
             "GeneralizedAlpha {{ N: {=usize}, h: {} }}",
             N,
             Stepper::time_step(self)
+        )
+    }
+}
+
+impl<T: Real + Format, const N: usize> Format for KrAlpha<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "KrAlpha {{ N: {=usize}, h: {}, alpha_m: {}, alpha_f: {} }}",
+            N,
+            Stepper::time_step(self),
+            self.parameters().alpha_m,
+            self.parameters().alpha_f
         )
     }
 }

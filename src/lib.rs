@@ -25,6 +25,9 @@
 //!   with a per-step [`NewtonReport`]; [`Varying`]: `M(t), C(t), K(t)` ([`TimeVarying`]).
 //! - Comparator schemes behind the same interface: [`Newmark`] (β, γ), [`GeneralizedAlpha`]
 //!   (ρ∞, HHT-α), [`Exact`] (matrix-exponential discretization, piecewise-linear load).
+//! - [`KrAlpha`]: the explicit model-based schemes of real-time hybrid simulation, the
+//!   Chen–Ricles algorithm and the KR-α family (ρ∞): displacement and velocity explicit,
+//!   operators built once (also in `const fn`), `5N²` a step.
 //! - [`hysteresis`]: yielding structures — models with history committed only when a step
 //!   succeeds ([`hysteresis::HistoryModel`]), bilinear, Bouc–Wen and friction laws, a
 //!   hysteretic shear building.
@@ -169,8 +172,8 @@ pub use nonlinear::varying::{Coefficients, TimeVarying, Varying};
 pub use nonlinear::{Iterations, Model, NewtonReport, NewtonSettings, Nonlinear, Tangent};
 pub use scalar::Real;
 pub use schemes::{
-    AForm, AlphaParameters, CompensatedLinear, CompensatedState, Exact, GeneralizedAlpha, Linear,
-    LinearInput, Newmark,
+    AForm, AlphaParameters, CompensatedLinear, CompensatedState, Exact, GeneralizedAlpha, KrAlpha,
+    Linear, LinearInput, Newmark,
 };
 pub use state::State;
 pub use stepper::{StepInput, StepState, Stepper};

@@ -30,7 +30,8 @@ impl<T: Real, const I: usize> StepInput for SVector<T, I> {
 /// the interface every linear scheme of the crate implements — [`Linear`](crate::Linear),
 /// [`AForm`](crate::AForm), [`LinearInput`](crate::LinearInput),
 /// [`Modal`](crate::Modal), [`Newmark`](crate::Newmark),
-/// [`GeneralizedAlpha`](crate::GeneralizedAlpha), [`Exact`](crate::Exact) — so one
+/// [`GeneralizedAlpha`](crate::GeneralizedAlpha), [`Exact`](crate::Exact),
+/// [`KrAlpha`](crate::KrAlpha) — so one
 /// generic function drives them all and switching scheme is a one-line change:
 ///
 /// ```
@@ -114,8 +115,8 @@ pub trait Stepper<T: Real, const N: usize> {
     ///   [`LinearInput`](crate::LinearInput), [`Modal`](crate::Modal)) and
     ///   [`Newmark`](crate::Newmark) depend on `w_n` only and ignore `w_prev` (this
     ///   default);
-    /// - [`GeneralizedAlpha`](crate::GeneralizedAlpha) takes the load as
-    ///   `(1 − α_f) p + α_f p_prev`; [`Exact`](crate::Exact) takes the load linear between
+    /// - [`GeneralizedAlpha`](crate::GeneralizedAlpha) and [`KrAlpha`](crate::KrAlpha) take
+    ///   the load as `(1 − α_f) p + α_f p_prev`; [`Exact`](crate::Exact) takes the load linear between
     ///   `p_prev` and `p`. Through [`Stepper::step`] both must assume a previous load (see
     ///   their docs).
     ///

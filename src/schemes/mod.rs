@@ -6,12 +6,15 @@
 //! - [`LinearInput`]: loads through an influence matrix `p = B w` (`2N² + N·I`).
 //! - [`CompensatedLinear`]: the AEM with the state update compensated (long `f32` runs).
 //! - [`Newmark`], [`GeneralizedAlpha`], [`Exact`]: the comparators.
+//! - [`KrAlpha`]: the explicit model-based schemes of real-time hybrid simulation
+//!   (Chen–Ricles, KR-α).
 
 mod aform;
 mod compensated;
 mod exact;
 mod generalized_alpha;
 mod input;
+mod kr_alpha;
 mod linear;
 mod newmark;
 
@@ -21,5 +24,6 @@ pub use exact::Exact;
 pub(crate) use generalized_alpha::alpha_operators;
 pub use generalized_alpha::{AlphaParameters, GeneralizedAlpha};
 pub use input::LinearInput;
+pub use kr_alpha::KrAlpha;
 pub use linear::Linear;
 pub use newmark::Newmark;
