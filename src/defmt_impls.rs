@@ -15,6 +15,7 @@ use crate::estimation::{
     InputStateFilter, InputStateFilterState, InputStateObserver, JointEstimate, dual::DualFilter,
     dual::DualKalmanFilter, dual::DualKalmanFilterState,
 };
+use crate::hybrid::{Split, SplitState};
 use crate::hysteresis::{EnergyAccount, Law, ShearBuilding, Trial};
 use crate::observer::{
     Estimate, Kalman, KalmanState, Measurement, Observer, Outputs, Readout, StateSpace, SteadyState,
@@ -190,6 +191,24 @@ impl<T: Real + Format, const N: usize> Format for KrAlpha<T, N> {
             Stepper::time_step(self),
             self.parameters().alpha_m,
             self.parameters().alpha_f
+        )
+    }
+}
+
+impl<T: Real + Format, const N: usize> Format for Split<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(f, "Split {{ scheme: {} }}", self.scheme())
+    }
+}
+
+impl<T: Real + Format, const N: usize> Format for SplitState<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "SplitState {{ state: {}, restoring_force: {}, load: {} }}",
+            self.state(),
+            self.restoring_force().as_slice(),
+            self.load().as_slice()
         )
     }
 }

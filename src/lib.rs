@@ -28,6 +28,8 @@
 //! - [`KrAlpha`]: the explicit model-based schemes of real-time hybrid simulation, the
 //!   Chen–Ricles algorithm and the KR-α family (ρ∞): displacement and velocity explicit,
 //!   operators built once (also in `const fn`), `5N²` a step.
+//! - [`hybrid`]: real-time hybrid simulation — the KR-α step split into a displacement
+//!   command and a completion with the measured restoring force.
 //! - [`hysteresis`]: yielding structures — models with history committed only when a step
 //!   succeeds ([`hysteresis::HistoryModel`]), bilinear, Bouc–Wen and friction laws, a
 //!   hysteretic shear building.
@@ -157,6 +159,7 @@ pub mod detection;
 // Modal reduction, stability analysis, ready-made models.
 pub mod analysis;
 pub mod estimation;
+pub mod hybrid;
 pub mod hysteresis;
 pub mod modal;
 pub mod models;

@@ -86,7 +86,7 @@ use crate::linalg::{round_rows, rows_f64, scaled};
 use crate::{AlphaParameters, Error, Real, State, Stepper};
 
 /// The parameters of the CR algorithm: `α_m = α_f = 0`, `β = 1/4`, `γ = 1/2`.
-const CHEN_RICLES: AlphaParameters = AlphaParameters {
+pub(crate) const CHEN_RICLES: AlphaParameters = AlphaParameters {
     alpha_m: 0.0,
     alpha_f: 0.0,
     beta: 0.25,
@@ -111,6 +111,10 @@ pub(crate) struct KrOps<const N: usize> {
 
 /// Check `M, C, K, h` and build the KR-α operators of the parameters `p` (`const fn`).
 /// `max`: the largest finite value of the scalar type the operators will be rounded to.
+/// `k_rest`: the stiffness whose force the step computes itself (`G K_rest`, and the
+/// start's `M⁻¹ K_rest`): `k` for [`KrAlpha`]; the numerical part's linear stiffness for
+/// the split step of [`crate::hybrid::Split`], where `k` only builds `α1, α3` and the rest
+/// of the restoring force is given (measured) each step.
 ///
 /// Errors, in this order: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
 /// [`Error::OperatorOverflow`] (`M + γh C + βh² K` not finite),
@@ -122,11 +126,12 @@ pub(crate) const fn kr_operators<const N: usize>(
     m: &Mat<N, N>,
     c: &Mat<N, N>,
     k: &Mat<N, N>,
+    k_rest: &Mat<N, N>,
     h: f64,
     p: &AlphaParameters,
     max: f64,
 ) -> Result<KrOps<N>, Error> {
-    if !(all_finite(m) && all_finite(c) && all_finite(k)) {
+    if !(all_finite(m) && all_finite(c) && all_finite(k) && all_finite(k_rest)) {
         return Err(Error::NonFiniteInput);
     }
     let h = match check_time_step_as(h, max) {
@@ -157,7 +162,7 @@ pub(crate) const fn kr_operators<const N: usize>(
     let alpha1 = lu.solve(m);
     let alpha3 = lu.solve(&num3);
     // M regular (the start-up operators are its solves): checked before M (I − α3).
-    let start = match start_operators(m, c, k, max) {
+    let start = match start_operators(m, c, k_rest, max) {
         Ok(Some((_, s))) => s,
         Ok(None) => return Err(Error::SingularMass),
         Err(e) => return Err(e),
@@ -173,7 +178,7 @@ pub(crate) const fn kr_operators<const N: usize>(
     let (g, gc, gk, gma3) = (
         lu_d.inverse(),
         lu_d.solve(c),
-        lu_d.solve(k),
+        lu_d.solve(k_rest),
         lu_d.solve(&ma3),
     );
     let c2 = (0.5 + gamma) * h * h;
@@ -181,7 +186,7 @@ pub(crate) const fn kr_operators<const N: usize>(
         fits(&alpha1, m, max),
         fits(&g, &d, max),
         fits(&gc, c, max),
-        fits(&gk, k, max),
+        fits(&gk, k_rest, max),
         fits(&gma3, &ma3, max),
     ];
     // Overflow (of an operator or of a coefficient) anywhere before underflow anywhere.
@@ -315,8 +320,15 @@ impl<T: Real, const N: usize> KrAlpha<T, N> {
         p: AlphaParameters,
     ) -> Result<Self, Error> {
         let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
-        let op = kr_operators(&m, &c, &k, h, &p, T::MAX)?;
-        Ok(Self {
+        Ok(Self::from_ops(
+            &kr_operators(&m, &c, &k, &k, h, &p, T::MAX)?,
+            p,
+        ))
+    }
+
+    /// Round the `f64` operators once to `T` (run time).
+    pub(crate) fn from_ops(op: &KrOps<N>, p: AlphaParameters) -> Self {
+        Self {
             params: p,
             h: T::from_f64_rounded(op.h),
             c2: T::from_f64_rounded(op.c2),
@@ -329,7 +341,7 @@ impl<T: Real, const N: usize> KrAlpha<T, N> {
             gk: round_rows(&op.gk),
             gma3: round_rows(&op.gma3),
             start: Some(op.start.round()),
-        })
+        }
     }
 
     /// The scheme's parameters `(α_m, α_f, β, γ)` (CR: `(0, 0, 1/4, 1/2)`). Cost: O(1).
@@ -429,7 +441,7 @@ macro_rules! const_ctor {
                 rho_inf: f64,
             ) -> Result<Self, Error> {
                 match AlphaParameters::chung_hulbert(rho_inf) {
-                    Ok(p) => Self::from_params(&m, &c, &k, h, p),
+                    Ok(p) => Self::from_params(&m, &c, &k, &k, h, p),
                     Err(e) => Err(e),
                 }
             }
@@ -443,17 +455,20 @@ macro_rules! const_ctor {
                 k: Rows<N>,
                 h: f64,
             ) -> Result<Self, Error> {
-                Self::from_params(&m, &c, &k, h, CHEN_RICLES)
+                Self::from_params(&m, &c, &k, &k, h, CHEN_RICLES)
             }
 
-            const fn from_params(
+            /// The operators of `p` with `k_rest` for the computed restoring force
+            /// ([`kr_operators`]), rounded to the scalar (`const fn`).
+            pub(crate) const fn from_params(
                 m: &Rows<N>,
                 c: &Rows<N>,
                 k: &Rows<N>,
+                k_rest: &Rows<N>,
                 h: f64,
                 p: AlphaParameters,
             ) -> Result<Self, Error> {
-                let op = match kr_operators(m, c, k, h, &p, $t::MAX as f64) {
+                let op = match kr_operators(m, c, k, k_rest, h, &p, $t::MAX as f64) {
                     Ok(op) => op,
                     Err(e) => return Err(e),
                 };

@@ -14,7 +14,7 @@ mod compensated;
 mod exact;
 mod generalized_alpha;
 mod input;
-mod kr_alpha;
+pub(crate) mod kr_alpha;
 mod linear;
 mod newmark;
 
