@@ -9,8 +9,9 @@ use aemstep::models::{self, Rows, base_excitation};
 use aemstep::nalgebra::{SVector, vector};
 use aemstep::observer::{Measurement, Observer, Outputs, Readout, StateSpace};
 use aemstep::spectrum::{Bank, RotD, Scheme, Substeps};
+use aemstep::hybrid::Split;
 use aemstep::{
-    CompensatedLinear, Damping, Error, Linear, LinearInput, Modal, Real, State, Stepper,
+    CompensatedLinear, Damping, Error, KrAlpha, Linear, LinearInput, Modal, Real, State, Stepper,
 };
 
 const fn ok<T: Copy>(r: Result<T, Error>) -> T {
@@ -74,6 +75,9 @@ static BANK64: Bank<f64, 3> = ok(Bank::with_f64(
     Substeps::Fixed(4),
 ));
 static ROT32: RotD<f32, 180> = RotD::new_f32();
+static KR32: KrAlpha<f32, 5> = ok(KrAlpha::from_rows_f32(B.0, B.1, B.2, H, 0.8));
+static CR64: KrAlpha<f64, 5> = ok(KrAlpha::from_rows_chen_ricles_f64(B.0, B.1, B.2, H));
+static SPLIT32: Split<f32, 5> = ok(Split::from_rows_f32(B.0, B.1, B.2, B.2, H, 0.8));
 
 // The inherent `const fn time_step` in a `const`.
 const H32: f32 = LIN32.time_step();
@@ -96,6 +100,10 @@ fn const_time_step_is_the_steppers_time_step() {
     assert_eq!(MODAL64.time_step(), trait_time_step(&MODAL64));
     assert_eq!(LIN64.time_step(), H);
     assert_eq!(MODAL32.time_step(), H as f32);
+    assert_eq!(KR32.time_step(), trait_time_step(&KR32));
+    assert_eq!(CR64.time_step(), trait_time_step(&CR64));
+    // The split step's time step is its scheme's.
+    assert_eq!(SPLIT32.time_step(), trait_time_step(SPLIT32.scheme()));
     // The observer, the model and the bank: the same name.
     assert_eq!(OBS32.time_step(), H as f32);
     assert_eq!(SS.time_step, H);
