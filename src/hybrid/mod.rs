@@ -6,10 +6,19 @@
 //!   [`Split::command`] (the displacement of `t_{n+1}` from the committed state) and
 //!   [`Split::complete`] (the step finished with the measured restoring force). A missing
 //!   or NaN force is a typed error and changes nothing.
+//! - [`Compensator`]: between the model's target and the actuator — [`Polynomial`]
+//!   extrapolation over a known delay (orders 1–3), [`Adaptive`] extrapolation over a delay
+//!   it estimates from the measured displacement.
+//! - [`Actuator`]: an emulated actuator (pure delay and first-order lag) for tests and
+//!   examples, so a whole hybrid test runs on the host and under QEMU.
 //!
 //! Equations, the scene (a 5-storey building with its first storey "physical") and the
 //! measured errors against actuator delay: `docs/hybrid.md`.
 
+mod actuator;
+mod compensation;
 mod split;
 
+pub use actuator::{Actuator, ActuatorState};
+pub use compensation::{Adaptive, Compensator, CompensatorState, Polynomial};
 pub use split::{Split, SplitState};
