@@ -119,6 +119,8 @@ GENERATED = {
     "docs/estimation.md": dict(cmd=example("estimation_building", "{dir}"), out="file"),
     # 24 damage runs (7 observers each) and 400 intact runs of 80 s: about 20 s (release).
     "docs/detection.md": dict(cmd=example("detection_building", "{dir}"), out="file"),
+    # About 400 runs of the 31 s record at 1024 Hz (the critical-delay searches): ~20 s.
+    "docs/hybrid.md": dict(cmd=example("hybrid_building", "{dir}"), out="file"),
 }
 # Generated in place by a slower stage of the test command: compared with the git index.
 IN_PLACE = {

@@ -225,3 +225,8 @@ pub struct EstimationDocDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/detection.md")]
 pub struct DetectionDocDoctests;
+
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/hybrid.md")]
+pub struct HybridDocDoctests;

@@ -20,6 +20,7 @@ const SKIP: &[(&str, &str)] = &[
     ("ObserverDocDoctests", "cfg(doctest) marker"),
     ("EstimationDocDoctests", "cfg(doctest) marker"),
     ("DetectionDocDoctests", "cfg(doctest) marker"),
+    ("HybridDocDoctests", "cfg(doctest) marker"),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

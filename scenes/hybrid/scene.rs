@@ -14,7 +14,8 @@ pub const BLD: (Rows<N>, Rows<N>, Rows<N>) = models::five_storey_building();
 /// Storey stiffness (N/m): the specimen's initial stiffness, in the operators' `K`.
 pub const K1: f64 = models::FIVE_STOREY_STIFFNESS;
 /// The numerical part's stiffness: the building without storey 1 (N/m).
-pub const K_NUM: Rows<N> = models::shear_building([models::FIVE_STOREY_MASS; N], [0.0, K1, K1, K1, K1]).1;
+pub const K_NUM: Rows<N> =
+    models::shear_building([models::FIVE_STOREY_MASS; N], [0.0, K1, K1, K1, K1]).1;
 /// Record scale factor.
 pub const SCALE: f64 = 2.0;
 /// The specimen's yield force (N) and post-yield stiffness ratio.
@@ -53,3 +54,5 @@ pub const MAX_DELAY: f64 = 0.05;
 pub const fn masses() -> [f64; N] {
     models::floor_masses(&BLD.0)
 }
+/// The adaptive compensator's extrapolation order.
+pub const ADAPTIVE_ORDER: usize = 2;
