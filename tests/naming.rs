@@ -5,11 +5,11 @@
 //! the value generic code reads through `Stepper::time_step`; `State::restore` checks its
 //! parts and restores a state the stepper continues from bit for bit.
 
+use aemstep::hybrid::Split;
 use aemstep::models::{self, Rows, base_excitation};
 use aemstep::nalgebra::{SVector, vector};
 use aemstep::observer::{Measurement, Observer, Outputs, Readout, StateSpace};
 use aemstep::spectrum::{Bank, RotD, Scheme, Substeps};
-use aemstep::hybrid::Split;
 use aemstep::{
     CompensatedLinear, Damping, Error, KrAlpha, Linear, LinearInput, Modal, Real, State, Stepper,
 };
