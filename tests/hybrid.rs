@@ -2,7 +2,7 @@
 //! independent implementation of the papers' equations with a nonlinear restoring force
 //! (Chen & Ricles 2008; Kolay & Ricles 2014: `u, v` explicit through `α1, α2`, the
 //! weighted equation of motion `M [(I − α3) a' + α3 a] + C v̄ + R̄ = p̄` with
-//! `R̄ = (1 − α_f) R(u') + α_f R(u)`), written here in `nalgebra::DMatrix` arithmetic; the
+//! `R̄ = (1 − α_f) R(u') + α_f R(u)`), written in `tests/support/kr.rs` (`DMatrix`); the
 //! zero-delay equivalence with the all-numerical explicit run; the partition with a
 //! hysteretic numerical part; the Chen–Ricles stability limit for a specimen stiffer than
 //! the operators assume against its closed form; bad input and failed steps; the `const`
@@ -15,6 +15,10 @@ use aemstep::models::{self, Rows, base_excitation};
 use aemstep::nalgebra::{SMatrix, SVector};
 use aemstep::{Error, KrAlpha, Real, Stepper};
 use nalgebra::{DMatrix, DVector};
+
+#[path = "support/kr.rs"]
+mod kr;
+use kr::{Reference, members};
 
 const EPS: f64 = f64::EPSILON;
 const B: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();
@@ -31,28 +35,6 @@ fn dm<const N: usize>(a: &SMatrix<f64, N, N>) -> DMatrix<f64> {
     DMatrix::from_fn(N, N, |i, j| a[(i, j)])
 }
 
-/// `(α_m, α_f, β, γ)` of ρ∞ (Chung–Hulbert), or of CR (`None`).
-fn params(rho: Option<f64>) -> (f64, f64, f64, f64) {
-    match rho {
-        Some(r) => {
-            let am = (2.0 * r - 1.0) / (r + 1.0);
-            let af = r / (r + 1.0);
-            let d = 1.0 - am + af;
-            (am, af, d * d / 4.0, 0.5 - am + af)
-        }
-        None => (0.0, 0.0, 0.25, 0.5),
-    }
-}
-
-fn members() -> [(&'static str, Option<f64>); 4] {
-    [
-        ("CR", None),
-        ("KR-α ρ∞ = 1", Some(1.0)),
-        ("KR-α ρ∞ = 0.5", Some(0.5)),
-        ("KR-α ρ∞ = 0", Some(0.0)),
-    ]
-}
-
 fn split<T: Real, const N: usize>(
     m: &SMatrix<f64, N, N>,
     c: &SMatrix<f64, N, N>,
@@ -64,69 +46,6 @@ fn split<T: Real, const N: usize>(
     match rho {
         Some(r) => Split::new(m, c, k, kn, h, r).unwrap(),
         None => Split::chen_ricles(m, c, k, kn, h).unwrap(),
-    }
-}
-
-/// The papers' scheme with a nonlinear restoring force, written independently: operators
-/// from `M, C` and the assumed stiffness `K`; the step solves the weighted equation of
-/// motion for `a'` by LU with `R(u')` evaluated at the explicit displacement.
-struct Reference {
-    m: DMatrix<f64>,
-    c: DMatrix<f64>,
-    h: f64,
-    af: f64,
-    a1: DMatrix<f64>,
-    a2: DMatrix<f64>,
-    a3: DMatrix<f64>,
-}
-
-impl Reference {
-    fn new(m: DMatrix<f64>, c: DMatrix<f64>, k: DMatrix<f64>, h: f64, rho: Option<f64>) -> Self {
-        let (am, af, beta, gamma) = params(rho);
-        let meff = &m + &c * (gamma * h) + &k * (beta * h * h);
-        let inv = meff.try_inverse().expect("regular");
-        let a1 = &inv * &m;
-        let a2 = &a1 * (0.5 + gamma);
-        let a3 = &inv * (&m * am + &c * (af * gamma * h) + &k * (af * beta * h * h));
-        Self {
-            m,
-            c,
-            h,
-            af,
-            a1,
-            a2,
-            a3,
-        }
-    }
-
-    /// The explicit displacement and velocity of the next step.
-    fn explicit(&self, x: &[DVector<f64>; 3]) -> (DVector<f64>, DVector<f64>) {
-        let [u, v, a] = x;
-        let h = self.h;
-        (u + v * h + &self.a2 * a * (h * h), v + &self.a1 * a * h)
-    }
-
-    /// Complete the step: `r0, r1` the restoring forces at `u` and `u'`, `p0, p1` the
-    /// loads at `t_n` and `t_{n+1}`.
-    fn complete(
-        &self,
-        x: &mut [DVector<f64>; 3],
-        r0: &DVector<f64>,
-        r1: &DVector<f64>,
-        p0: &DVector<f64>,
-        p1: &DVector<f64>,
-    ) {
-        let (u1, v1) = self.explicit(x);
-        let [_, v, a] = &*x;
-        let af = self.af;
-        let vbar = &v1 * (1.0 - af) + v * af;
-        let rbar = r1 * (1.0 - af) + r0 * af;
-        let pbar = p1 * (1.0 - af) + p0 * af;
-        let n = v.len();
-        let lhs = &self.m * (DMatrix::identity(n, n) - &self.a3);
-        let rhs = pbar - &self.c * vbar - rbar - &self.m * &self.a3 * a;
-        let a1 = lhs.lu().solve(&rhs).expect("regular");
-        *x = [u1, v1, a1];
     }
 }
 

@@ -1,5 +1,5 @@
 //! The Chen–Ricles (CR) and KR-α schemes (`KrAlpha`, issue 22) against an independent
-//! implementation written here from the papers' equations (Chen & Ricles 2008; Kolay &
+//! implementation written from the papers' equations (`tests/support/kr.rs`; Chen & Ricles 2008; Kolay &
 //! Ricles 2014, eqs. of the method: explicit `u, v` through `α1, α2`, the weighted
 //! equation of motion with `α3`), in plain `nalgebra::DMatrix` arithmetic; the spectral
 //! radius against the closed-form characteristic polynomials for ρ∞ = 1, 1/2, 0 (derived
@@ -13,6 +13,10 @@ use aemstep::nalgebra::{SMatrix, SVector};
 use aemstep::{Error, GeneralizedAlpha, KrAlpha, State, Stepper};
 use nalgebra::{DMatrix, DVector};
 
+#[path = "support/kr.rs"]
+mod kr;
+use kr::{Reference, members};
+
 const EPS: f64 = f64::EPSILON;
 
 fn sm<const N: usize>(r: &Rows<N>) -> SMatrix<f64, N, N> {
@@ -25,83 +29,6 @@ fn s1(x: f64) -> SMatrix<f64, 1, 1> {
 
 fn dm<const N: usize>(a: &SMatrix<f64, N, N>) -> DMatrix<f64> {
     DMatrix::from_fn(N, N, |i, j| a[(i, j)])
-}
-
-/// The papers' scheme, written independently: `α1 = (M + γhC + βh²K)⁻¹ M`,
-/// `α2 = (1/2 + γ) α1`, `α3 = (M + γhC + βh²K)⁻¹ (α_m M + α_f γh C + α_f βh² K)`;
-/// `u' = u + h v + h² α2 a`, `v' = v + h α1 a`, and
-/// `M [(I − α3) a' + α3 a] + C [(1 − α_f) v' + α_f v] + K [(1 − α_f) u' + α_f u]
-///  = (1 − α_f) p' + α_f p`, solved for `a'` by LU at every step.
-struct Reference {
-    m: DMatrix<f64>,
-    c: DMatrix<f64>,
-    k: DMatrix<f64>,
-    h: f64,
-    af: f64,
-    a1: DMatrix<f64>,
-    a2: DMatrix<f64>,
-    a3: DMatrix<f64>,
-}
-
-/// `(α_m, α_f, β, γ)` of ρ∞ (Chung–Hulbert), or of CR (`None`).
-fn params(rho: Option<f64>) -> (f64, f64, f64, f64) {
-    match rho {
-        Some(r) => {
-            let am = (2.0 * r - 1.0) / (r + 1.0);
-            let af = r / (r + 1.0);
-            let d = 1.0 - am + af;
-            (am, af, d * d / 4.0, 0.5 - am + af)
-        }
-        None => (0.0, 0.0, 0.25, 0.5),
-    }
-}
-
-impl Reference {
-    fn new(m: DMatrix<f64>, c: DMatrix<f64>, k: DMatrix<f64>, h: f64, rho: Option<f64>) -> Self {
-        let (am, af, beta, gamma) = params(rho);
-        let meff = &m + &c * (gamma * h) + &k * (beta * h * h);
-        let inv = meff.try_inverse().expect("regular");
-        let a1 = &inv * &m;
-        let a2 = &a1 * (0.5 + gamma);
-        let a3 = &inv * (&m * am + &c * (af * gamma * h) + &k * (af * beta * h * h));
-        Self {
-            m,
-            c,
-            k,
-            h,
-            af,
-            a1,
-            a2,
-            a3,
-        }
-    }
-
-    /// One step from `(u, v, a)` under `p` (at `t_n`) and `p1` (at `t_{n+1}`).
-    fn step(&self, x: &mut [DVector<f64>; 3], p: &DVector<f64>, p1: &DVector<f64>) {
-        let [u, v, a] = x;
-        let (h, af) = (self.h, self.af);
-        let u1 = &*u + &*v * h + &self.a2 * &*a * (h * h);
-        let v1 = &*v + &self.a1 * &*a * h;
-        let ubar = &u1 * (1.0 - af) + &*u * af;
-        let vbar = &v1 * (1.0 - af) + &*v * af;
-        let pbar = p1 * (1.0 - af) + p * af;
-        let n = u.len();
-        let lhs = &self.m * (DMatrix::identity(n, n) - &self.a3);
-        let rhs = pbar - &self.c * vbar - &self.k * ubar - &self.m * &self.a3 * &*a;
-        let a1 = lhs.lu().solve(&rhs).expect("regular");
-        *u = u1;
-        *v = v1;
-        *a = a1;
-    }
-}
-
-fn members() -> [(&'static str, Option<f64>); 4] {
-    [
-        ("CR", None),
-        ("KR-α ρ∞ = 1", Some(1.0)),
-        ("KR-α ρ∞ = 0.5", Some(0.5)),
-        ("KR-α ρ∞ = 0", Some(0.0)),
-    ]
 }
 
 fn build<const N: usize>(
