@@ -513,20 +513,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
         if !(is_covariance(&qr, false) && is_covariance(&qwr, false) && is_covariance(&rr, true)) {
             return Err(Error::InvalidCovariance);
         }
-        if !(all_finite(&model.a)
-            && all_finite(&model.b)
-            && all_finite(&model.c)
-            && all_finite(&model.d)
-            && all_finite(&model.gamma1))
-        {
-            return Err(Error::NonFiniteInput);
-        }
+        model.check_finite()?;
         crate::kinematics::check_time_step_as(model.time_step, T::MAX)?;
-        let fits = finite_as(&model.a, T::MAX)
-            && finite_as(&model.b, T::MAX)
-            && finite_as(&model.c, T::MAX)
-            && finite_as(&model.d, T::MAX)
-            && finite_as(&model.gamma1, T::MAX)
+        let fits = model.fits(T::MAX)
             && finite_as(&qr, T::MAX)
             && finite_as(&qwr, T::MAX)
             && finite_as(&rr, T::MAX);

@@ -686,22 +686,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         if !is_covariance(&qr, false) {
             return Err(Error::InvalidCovariance);
         }
-        if !(all_finite(&model.a)
-            && all_finite(&model.b)
-            && all_finite(&model.c)
-            && all_finite(&model.d)
-            && all_finite(&model.gamma1))
-        {
-            return Err(Error::NonFiniteInput);
-        }
+        model.check_finite()?;
         model.weighted_feedthrough(&rr)?;
-        let fits = finite_as(&model.a, T::MAX)
-            && finite_as(&model.b, T::MAX)
-            && finite_as(&model.c, T::MAX)
-            && finite_as(&model.d, T::MAX)
-            && finite_as(&model.gamma1, T::MAX)
-            && finite_as(&qr, T::MAX)
-            && finite_as(&rr, T::MAX);
+        let fits = model.fits(T::MAX) && finite_as(&qr, T::MAX) && finite_as(&rr, T::MAX);
         if !fits {
             return Err(Error::OperatorOverflow);
         }

@@ -127,7 +127,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::Error;
 use crate::linalg::cholesky::cholesky;
-use crate::linalg::{Mat, add_scaled, all_finite, mul, transpose};
+use crate::linalg::{Mat, add_scaled, all_finite, finite_as, mul, transpose};
 use crate::observer::{Measurement, StateSpace, is_covariance, lu_of, symmetrize};
 
 /// A model in the standard form of the input–state filters (derivation in the
@@ -156,6 +156,31 @@ pub struct InputModel<const S: usize, const I: usize, const O: usize> {
 pub const RANK_TOLERANCE: f64 = 1e-10;
 
 impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
+    /// Every matrix finite: the estimators' first check of a model (which may have been
+    /// built or edited by hand). Errors: [`Error::NonFiniteInput`].
+    pub(crate) fn check_finite(&self) -> Result<(), Error> {
+        if all_finite(&self.a)
+            && all_finite(&self.b)
+            && all_finite(&self.c)
+            && all_finite(&self.d)
+            && all_finite(&self.gamma1)
+        {
+            Ok(())
+        } else {
+            Err(Error::NonFiniteInput)
+        }
+    }
+
+    /// Every matrix rounds to a finite value of the scalar type whose largest finite value
+    /// is `max`.
+    pub(crate) fn fits(&self, max: f64) -> bool {
+        finite_as(&self.a, max)
+            && finite_as(&self.b, max)
+            && finite_as(&self.c, max)
+            && finite_as(&self.d, max)
+            && finite_as(&self.gamma1, max)
+    }
+
     /// The standard form of `model` measured by `meas` (`const fn`): `A = Φ`,
     /// `B = Φ Γ₁ + Γ₀`, `C = H`, `D̃ = H Γ₁ + D`. Checks the first identifiability
     /// condition, `O ≥ I`.
