@@ -9,7 +9,7 @@
 //! builds.
 #![allow(clippy::needless_range_loop)]
 
-use aemstep::hybrid::{Split, SplitState};
+use aemstep::hybrid::{Actuator, Split, SplitState};
 use aemstep::hysteresis::{Bilinear, BilinearHistory, Law};
 use aemstep::models::{self, Rows, base_excitation};
 use aemstep::nalgebra::{SMatrix, SVector};
@@ -172,7 +172,8 @@ fn split_matches_the_papers_equations_with_yielding_storeys() {
     }
 }
 
-/// Zero delay, the specimen a linear spring equal to the numerical storey 1: the hybrid
+/// Zero delay, the specimen a linear spring equal to the numerical storey 1 behind the
+/// emulated actuator (no delay, no lag: it reaches the command bit for bit): the hybrid
 /// run is the all-numerical [`KrAlpha`] run to rounding. The two differ only in how the
 /// storey-1 force enters (`G (p̄ − r̄)` with `r = k u_0` against `G K ū`): a few roundings
 /// of `N`-term dot products per step, carried by the stable recurrence. Measured (printed)
@@ -193,11 +194,16 @@ fn zero_delay_linear_specimen_is_the_all_numerical_run() {
         let k1 = T::from_f64_rounded(K1);
         let mut s = sys.start(&z, &z, &z, &load(0)).unwrap();
         let mut a = all.start(&z, &z, &load(0)).unwrap();
+        let act = Actuator::<T, 4>::new(1.0 / 1024.0, 0.0, 0.0).unwrap();
+        let mut at = act.rest(T::zero());
         let (mut err, mut size) = (0.0f64, 0.0f64);
         for n in 1..=4096 {
             let cmd = sys.command(&s);
+            // Through the emulated actuator with no delay and no lag: the command itself.
+            let reached = act.step(&mut at, cmd[0]).unwrap();
+            assert_eq!(reached.as_f64().to_bits(), cmd[0].as_f64().to_bits());
             let mut r = z;
-            r[0] = k1 * cmd[0];
+            r[0] = k1 * reached;
             sys.complete(&mut s, &r, &load(n)).unwrap();
             all.try_step_with_previous_input(&mut a, &load(n - 1), &load(n))
                 .unwrap();

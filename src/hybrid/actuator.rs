@@ -14,7 +14,7 @@ use crate::{Error, Real};
 /// ```
 ///
 /// `τ = (j + f) h` with `j` whole samples and `f ∈ [0, 1)`: `c̃_n = (1 − f) c_{n−j} + f
-/// c_{n−j−1}`. `τ = 0` and `T_a = 0` give `d_n = c_n`. The line holds the last `L`
+/// c_{n−j−1}`. `τ = 0` and `T_a = 0` give `d_n = c_n` exactly. The line holds the last `L`
 /// commands, so `τ ≤ (L − 2) h`. The lag's low-frequency (mean) delay is
 /// `h/(e^{h/T_a} − 1) ≈ T_a − h/2` (the update takes the sample's command at once). For tests and examples (a hybrid loop on the host or
 /// under QEMU with no hardware), not a model of any particular actuator.
@@ -37,9 +37,11 @@ use crate::{Error, Real};
 pub struct Actuator<T, const L: usize> {
     /// Whole samples of delay `j`.
     whole: usize,
-    /// Fractional part `f` and the lag's coefficient `1 − e^{−h/T_a}`.
+    /// The interpolation weights `1 − f`, `f`, and the lag's coefficient
+    /// `1 − e^{−h/T_a}` (`None` without a lag).
+    near: T,
     frac: T,
-    lag: T,
+    lag: Option<T>,
     delay: T,
 }
 
@@ -80,14 +82,17 @@ impl<T: Real, const L: usize> Actuator<T, L> {
         let whole = samples as usize;
         let frac = samples - whole as f64;
         let lag = if lag == 0.0 {
-            1.0
+            None
         } else {
-            1.0 - nalgebra::ComplexField::exp(-h / lag)
+            Some(T::from_f64_rounded(
+                1.0 - nalgebra::ComplexField::exp(-h / lag),
+            ))
         };
         Ok(Self {
             whole,
+            near: T::from_f64_rounded(1.0 - frac),
             frac: T::from_f64_rounded(frac),
-            lag: T::from_f64_rounded(lag),
+            lag,
             delay: T::from_f64_rounded(delay),
         })
     }
@@ -125,8 +130,13 @@ impl<T: Real, const L: usize> Actuator<T, L> {
             }
         };
         let (a, b) = (at(self.whole), at(self.whole + 1));
-        let delayed = a + self.frac * (b - a);
-        let reached = s.reached + self.lag * (delayed - s.reached);
+        // `(1 − f) a + f b`: exactly `a` for a whole number of samples, and no difference
+        // of two commands to overflow.
+        let delayed = self.near * a + self.frac * b;
+        let reached = match self.lag {
+            Some(g) => s.reached + g * (delayed - s.reached),
+            None => delayed,
+        };
         if !reached.is_finite() {
             return Err(Error::NonFiniteState);
         }
