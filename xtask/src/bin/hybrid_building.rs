@@ -390,7 +390,9 @@ fn aem_bilinear() -> Run {
 }
 
 fn pct(x: f64) -> String {
-    if x < 0.01 {
+    if x == 0.0 {
+        "0".into()
+    } else if x < 0.01 {
         format!("{x:.1e}")
     } else {
         format!("{x:.2}")
