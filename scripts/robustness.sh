@@ -38,8 +38,9 @@ def fuzz_section(path):
         spectrum="`Bank` (new, with: both schemes, every sub-step rule), `RotD`, `batch::spectra`",
         estimation="`InputModel` (from_parts, zero_dynamics), `InputStateGains` (solve, new), `InputStateObserver` (new, from_parts_f32/_f64), `InputStateFilter`, `DualGains`, `DualFilter` (new, from_parts_f32/_f64), `AugmentedModel`, `FixedLag` (new, from_parts_f32/_f64); S = 2, 4, O = 1 … 3",
         detection="`chi_square_quantile`, `normal_quantile`, `innovation_covariance`, `Whitener` (new, from_rows_f32/_f64), `Window`, `ChiSquareTest`, `Detector`, `Cusum`, `ModelBank`, `Observer::step_innovation`, `Kalman::try_step_innovation`",
+        hybrid="`KrAlpha` (new, chen_ricles, from_rows_f32/_f64, from_rows_chen_ricles_f32/_f64), `hybrid::Split` (the same with `K_num`; start, start_with_acceleration, command, complete with NaN, infinite and specimen forces); N = 1, 2, 3",
     )
-    order = ["linear_family", "modal", "nonlinear", "hysteresis", "observer", "spectrum", "estimation", "detection"]
+    order = ["linear_family", "modal", "nonlinear", "hysteresis", "observer", "spectrum", "estimation", "detection", "hybrid"]
     missing = [t for t in order if t not in runs]
     if missing:
         raise SystemExit(f"FAILED: fuzz/stats.txt has no run of {missing}")
@@ -189,6 +190,10 @@ Library fixes (each `Ok` with garbage, or a wrong error, before):
   up to about 60); else `RiccatiNotConverged`.
 - An `f32` Newmark said `OperatorOverflow` where `f64` said `SingularEffectiveMatrix`: the
   coefficients' overflow is now judged with the other operators, after the singularity.
+  Likewise an `f32` `KrAlpha` (and `hybrid::Split`) said `OperatorUnderflow` (`M⁻¹` of
+  an `M` with entries up to `f64::MAX`, below `f32`'s range) where `f64` said
+  `SingularEffectiveMatrix` (`M (I − α3)` singular): its start-up operators' range is
+  judged after that singularity now, as documented (target `hybrid`).
 - `Modal` reported a NaN in its damping after the eigenproblem (so it could come back as
   `MassNotSpd`); now with the other data, as `NonFiniteInput`. `Linear` and
   `LinearInput` started with a singular `M` and a NaN initial value said `SingularMass`

@@ -1209,3 +1209,23 @@ fn innovation_covariance_symmetrized_near_max_overflows() {
     );
     assert_eq!(innovation_covariance(&kf, &meas, &[[2.0]]), Ok([[2.0]]));
 }
+
+/// `KrAlpha` judged the range of its start-up operators (`M⁻¹`, `M⁻¹C`, `M⁻¹K`) before the
+/// singularity of `M (I − α3)`, against its documented order (singularity, then range): an
+/// `f32` build said `OperatorUnderflow` where the `f64` build of the same data said
+/// `SingularEffectiveMatrix` (`M` with entries from 1e1 to 1.8e308, so `M⁻¹` is below
+/// `f32`'s range; found by the `hybrid` fuzz target,
+/// `fuzz/regressions/hybrid/f32-start-operators-range-after-singular-m-i-minus-alpha3`).
+/// Now the start-up operators' range is judged with the other operators'.
+#[test]
+fn kr_alpha_start_operators_range_after_singular_m_i_minus_alpha3() {
+    use aemstep::KrAlpha;
+    use aemstep::hybrid::Split;
+    let m = matrix![6.582018229284824e63, 1.201202692608752e257; f64::MAX, -10.0];
+    let ck = M2::repeat(-10.0);
+    let h = 1e-4;
+    let want = Some(Error::SingularEffectiveMatrix);
+    assert_eq!(KrAlpha::<f64, 2>::new(&m, &ck, &ck, h, 0.0).err(), want);
+    assert_eq!(KrAlpha::<f32, 2>::new(&m, &ck, &ck, h, 0.0).err(), want);
+    assert_eq!(Split::<f32, 2>::new(&m, &ck, &ck, &ck, h, 0.0).err(), want);
+}

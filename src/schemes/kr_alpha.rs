@@ -161,11 +161,14 @@ pub(crate) const fn kr_operators<const N: usize>(
     );
     let alpha1 = lu.solve(m);
     let alpha3 = lu.solve(&num3);
-    // M regular (the start-up operators are its solves): checked before M (I − α3).
-    let start = match start_operators(m, c, k_rest, max) {
-        Ok(Some((_, s))) => s,
+    // M regular (the start-up operators are its solves): checked before M (I − α3). The
+    // start-up operators' range is judged with the other operators', after that
+    // singularity: an f32 build said `OperatorUnderflow` where f64 said
+    // `SingularEffectiveMatrix` (found by fuzzing).
+    let (start, start_fit) = match start_operators(m, c, k_rest, max) {
+        Ok(Some((_, s))) => (Some(s), Ok(())),
         Ok(None) => return Err(Error::SingularMass),
-        Err(e) => return Err(e),
+        Err(e) => (None, Err(e)),
     };
     // D = M (I − α3) = M − M α3, judged against the size of its two terms.
     let ma3 = mul(m, &alpha3);
@@ -188,6 +191,7 @@ pub(crate) const fn kr_operators<const N: usize>(
         fits(&gc, c, max),
         fits(&gk, k_rest, max),
         fits(&gma3, &ma3, max),
+        start_fit,
     ];
     // Overflow (of an operator or of a coefficient) anywhere before underflow anywhere.
     match first_error(fit) {
@@ -198,6 +202,11 @@ pub(crate) const fn kr_operators<const N: usize>(
         Some(e) => return Err(e),
         None => {}
     }
+    let start = match start {
+        Some(s) => s,
+        // (unreachable: `start_fit` is its error)
+        None => return Err(Error::OperatorOverflow),
+    };
     Ok(KrOps {
         alpha1,
         g,

@@ -12,7 +12,7 @@
 //! `common.rs` the decoder (`Bytes`), the counters, the independent references and the
 //! checks several targets share; each fuzz target `fuzz_targets/<t>.rs` has its checks in
 //! `<t>.rs` here (`linear_family`, `modal`, `nonlinear`, `hysteresis`, `observer`,
-//! `spectrum`, `estimation`, `detection`), each starting with a line saying what it checks.
+//! `spectrum`, `estimation`, `detection`, `hybrid`), each starting with a line saying what it checks.
 //!
 //! Properties (as `tests/properties.rs`, over much more varied data):
 //! - never a panic (a panic aborts the fuzzer: a crash);
@@ -27,7 +27,13 @@
 //! - the same bad input gives the same error variant from every stepper: a non-finite
 //!   load, initial value or matrix entry is `NonFiniteInput`, a bad `h` is
 //!   `InvalidTimeStep`, an effective matrix singular for one AEM-family constructor is
-//!   singular for all, `f32` and `f64` agree except where `f32` overflows.
+//!   singular for all, `f32` and `f64` agree except where `f32` overflows;
+//! - the split step of real-time hybrid simulation (`hybrid`) is the KR-α step it splits:
+//!   `Split` with `K_num = K` has `KrAlpha`'s operators bit for bit, its start is
+//!   `KrAlpha`'s with the load `p0 − r0`, `command` is the `u` a successful `complete`
+//!   commits, `complete` is the scheme's step with the load `p − r` bit for bit, and a
+//!   failed `complete` (`NonFiniteForce`, `NonFiniteInput`, `NonFiniteState`) changes
+//!   nothing.
 //!
 //! Every property break panics with a message starting `property broken:`.
 #![allow(
@@ -50,6 +56,7 @@ macro_rules! check {
 mod common;
 mod detection;
 mod estimation;
+mod hybrid;
 mod hysteresis;
 mod linear_family;
 mod modal;
@@ -63,6 +70,7 @@ mod spectrum;
 pub use common::{Bytes, SpdInfo, System, context, count, count_lines, counts, spd_info};
 pub use detection::detection;
 pub use estimation::estimation;
+pub use hybrid::hybrid;
 pub use hysteresis::hysteresis;
 pub use linear_family::linear_family;
 pub use modal::modal;
@@ -71,7 +79,7 @@ pub use observer::observer;
 pub use spectrum::spectrum;
 
 /// The fuzz targets, in the order of the docs table.
-pub const TARGETS: [&str; 8] = [
+pub const TARGETS: [&str; 9] = [
     "linear_family",
     "modal",
     "nonlinear",
@@ -80,6 +88,7 @@ pub const TARGETS: [&str; 8] = [
     "spectrum",
     "estimation",
     "detection",
+    "hybrid",
 ];
 
 /// Run the checks of `target` on one input. Panics when a property breaks.
@@ -93,6 +102,7 @@ pub fn run(target: &str, data: &[u8]) {
         "spectrum" => spectrum(data),
         "estimation" => estimation(data),
         "detection" => detection(data),
+        "hybrid" => hybrid(data),
         _ => panic!("unknown fuzz target {target}"),
     }
 }
