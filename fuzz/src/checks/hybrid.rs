@@ -17,7 +17,7 @@
 //!
 //! The decoder and the checks every target shares are in `common.rs`.
 
-use aemstep::hybrid::{Split, SplitState};
+use aemstep::hybrid::{Actuator, Adaptive, Compensator, Polynomial, Split, SplitState};
 use aemstep::nalgebra::{SMatrix, SVector};
 use aemstep::{Error, KrAlpha, Real, Stepper};
 
@@ -98,6 +98,229 @@ fn hybrid_n<const N: usize>(b: &mut Bytes) {
     hybrid_typed::<f64, N>(&d);
     hybrid_typed::<f32, N>(&d);
     hybrid_cross::<N>(&d);
+    delay_compensation(b);
+}
+
+/// The emulated actuator and the compensators on decoded parameters and a command
+/// sequence.
+struct DelayInputs {
+    h: f64,
+    delay: f64,
+    lag: f64,
+    tau_max: f64,
+    order: usize,
+    x: [f64; 8],
+}
+
+fn delay_compensation(b: &mut Bytes) {
+    let h = b.time_step();
+    let d = DelayInputs {
+        h,
+        delay: match b.pick(3) {
+            0 => b.param(0.0, 6.0 * h),
+            1 => (b.pick(7) as f64) * h,
+            _ => b.value(),
+        },
+        lag: if b.flag() { 0.0 } else { b.param(0.0, 0.01) },
+        tau_max: b.param(0.0, 0.05),
+        order: usize::from(b.pick(5)),
+        x: core::array::from_fn(|_| if b.flag() { b.value() } else { b.unit() - 0.5 }),
+    };
+    set_context(format!(
+        "actuator/compensators: h = {:e}, delay = {:e}, lag = {:e}, τ_max = {:e}, order = {}, x = {:?}",
+        d.h, d.delay, d.lag, d.tau_max, d.order, d.x
+    ));
+    delay_typed::<f64>(&d);
+    delay_typed::<f32>(&d);
+    // The `const` twins of Polynomial are the run-time builds.
+    check!(
+        Polynomial::new_f64(d.order, d.h, d.delay) == Polynomial::<f64>::new(d.order, d.h, d.delay),
+        "Polynomial::new_f64 differs from Polynomial::new"
+    );
+    check!(
+        Polynomial::new_f32(d.order, d.h, d.delay) == Polynomial::<f32>::new(d.order, d.h, d.delay),
+        "Polynomial::new_f32 differs from Polynomial::new"
+    );
+}
+
+/// Construction rules, then every command: `Err` changes nothing, `Ok` is finite (and the
+/// identity for a zero delay without a lag).
+fn delay_typed<T: Real>(d: &DelayInputs) {
+    let h_ok = check_time_step_t::<T>(d.h);
+    let delay_ok = d.delay.is_finite() && d.delay >= 0.0;
+    let lag_ok = d.lag.is_finite() && d.lag >= 0.0;
+    let t = |x: f64| T::from_f64_rounded(x);
+
+    let act = Actuator::<T, 8>::new(d.h, d.delay, d.lag);
+    outcome(HYB, &act);
+    if !h_ok {
+        check!(
+            act == Err(Error::InvalidTimeStep),
+            "Actuator: bad h gave {act:?}"
+        );
+    } else if !(delay_ok && lag_ok) {
+        check!(
+            act == Err(Error::InvalidParameter),
+            "Actuator: bad delay or lag gave {act:?}"
+        );
+    }
+    if let Ok(a) = &act {
+        let identity = d.delay == 0.0 && d.lag == 0.0;
+        let mut s = a.rest(T::zero());
+        for &x in &d.x {
+            let before = format!("{s:?}");
+            match a.step(&mut s, t(x)) {
+                Ok(y) => {
+                    count(HYB, "actuator steps");
+                    check!(
+                        y.is_finite() && y == s.reached(),
+                        "Actuator: {y:?} not finite or not kept"
+                    );
+                    if identity {
+                        check!(y == t(x), "Actuator without delay or lag: {y:?} for {x:e}");
+                    }
+                }
+                Err(e) => {
+                    count(HYB, "actuator steps refused");
+                    check!(
+                        format!("{s:?}") == before,
+                        "Actuator: {e:?} changed the state"
+                    );
+                    check!(
+                        matches!(e, Error::NonFiniteInput | Error::NonFiniteState),
+                        "Actuator: step error {e:?}"
+                    );
+                    if !t(x).is_finite() {
+                        check!(
+                            e == Error::NonFiniteInput,
+                            "Actuator: a non-finite command gave {e:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    let poly = Polynomial::<T>::new(d.order, d.h, d.delay);
+    outcome(HYB, &poly);
+    if !(1..=3).contains(&d.order) {
+        check!(
+            poly == Err(Error::InvalidParameter),
+            "Polynomial: order {} gave {poly:?}",
+            d.order
+        );
+    } else if !h_ok {
+        check!(
+            poly == Err(Error::InvalidTimeStep),
+            "Polynomial: bad h gave {poly:?}"
+        );
+    } else if !delay_ok {
+        check!(
+            poly == Err(Error::InvalidParameter),
+            "Polynomial: bad delay gave {poly:?}"
+        );
+    }
+    if let Ok(p) = &poly {
+        check!(
+            p.weights().iter().all(|w| w.is_finite()),
+            "Polynomial: weights {:?}",
+            p.weights()
+        );
+        compensate(p, d, |_| {}, d.delay == 0.0);
+    }
+
+    let adaptive = Adaptive::<T>::new(d.order, d.h, d.tau_max * 0.5, d.tau_max);
+    outcome(HYB, &adaptive);
+    if !(1..=3).contains(&d.order) {
+        check!(
+            adaptive == Err(Error::InvalidParameter),
+            "Adaptive: order {} gave {adaptive:?}",
+            d.order
+        );
+    } else if !h_ok {
+        check!(
+            adaptive == Err(Error::InvalidTimeStep),
+            "Adaptive: bad h gave {adaptive:?}"
+        );
+    }
+    if let Ok(a) = &adaptive {
+        let max = t(d.tau_max);
+        compensate(
+            a,
+            d,
+            |s| {
+                let tau = a.delay(s);
+                check!(
+                    tau >= T::zero() && tau <= max,
+                    "Adaptive: estimate {tau:?} outside [0, {max:?}]"
+                );
+            },
+            false,
+        );
+    }
+}
+
+/// Commands of `comp` for the targets of `d` (the measured value: the previous target, or
+/// a decoded value): `Err` leaves the state as it was, `Ok` is finite; `identity`: the
+/// command is the target.
+fn compensate<T: Real, C: Compensator<T>>(
+    comp: &C,
+    d: &DelayInputs,
+    also: impl Fn(&C::State),
+    identity: bool,
+) where
+    C::State: core::fmt::Debug,
+{
+    let t = |x: f64| T::from_f64_rounded(x);
+    let mut s = comp.rest(T::zero());
+    let mut measured = T::zero();
+    for &x in &d.x {
+        let before = format!("{s:?}");
+        match comp.command(&mut s, t(x), measured) {
+            Ok(c) => {
+                count(HYB, "compensator commands");
+                check!(c.is_finite(), "compensator: command {c:?}");
+                if identity {
+                    check!(c == t(x), "compensator with zero delay: {c:?} for {x:e}");
+                }
+                measured = t(x);
+            }
+            Err(e) => {
+                count(HYB, "compensator commands refused");
+                check!(
+                    format!("{s:?}") == before,
+                    "compensator: {e:?} changed the state"
+                );
+                check!(
+                    matches!(e, Error::NonFiniteInput | Error::NonFiniteState),
+                    "compensator: error {e:?}"
+                );
+                if !t(x).is_finite() {
+                    check!(
+                        e == Error::NonFiniteInput,
+                        "compensator: a non-finite target gave {e:?}"
+                    );
+                }
+            }
+        }
+        also(&s);
+    }
+}
+
+/// `h` valid for `T` (the crate's rule: finite, positive, `h`, `h/2`, `h²/4` representable).
+fn check_time_step_t<T: Real>(h: f64) -> bool {
+    let max = T::MAX.as_f64();
+    let fits = |x: f64| {
+        let r = T::from_f64_rounded(x).as_f64();
+        x.is_finite() && x <= max && r.is_finite() && r != 0.0
+    };
+    h.is_finite()
+        && h > 0.0
+        && (h * h).is_finite()
+        && h * h > 0.0
+        && fits(h)
+        && fits(0.5 * h)
+        && fits(0.25 * h * h)
 }
 
 /// Every constructor in `T`: the data and parameter rules, finite operators on `Ok`, the
