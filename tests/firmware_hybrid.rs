@@ -161,8 +161,11 @@ fn reference_is_current_and_host_runs_are_within_bounds() {
         assert!(w32 <= ENGINEERING * peak);
         assert!(w64 <= BOUND_F64);
         println!(
-            "{rate} Hz: host last storey-1 drift f32 bits = {:#010x}, f64 bits = {:#018x}",
-            (*r32.last().unwrap() as f32).to_bits(),
+            "host last storey-1 drift {rate} f32 bits = {:#x}",
+            (*r32.last().unwrap() as f32).to_bits()
+        );
+        println!(
+            "host last storey-1 drift {rate} f64 bits = {:#x}",
             again.last().unwrap().to_bits()
         );
     }
