@@ -249,7 +249,8 @@ fn run(k: usize, syst: &mut SYST, queue: &'static mut Queue<Msg, 16>, specimen: 
         BOUND
     );
     hprintln!(
-        "target last storey-1 drift {} bits = {:#x}",
+        "target last storey-1 drift {} {} bits = {:#x}",
+        rate,
         ty,
         last.to_bits()
     );
