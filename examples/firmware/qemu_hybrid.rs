@@ -87,6 +87,11 @@ macro_rules! precision {
         static AG: &[F] = &elcentro::$ag;
         /// The bound of the host twin (`tests/firmware_hybrid.rs`) for this type.
         const HOST_BOUND: f64 = reference::$bound;
+        /// `x` in `f64` (exact).
+        #[allow(clippy::useless_conversion)] // the identity for `f64`
+        fn wide(x: F) -> f64 {
+            f64::from(x)
+        }
     };
 }
 #[cfg(not(aemstep_fpu = "double"))]
@@ -214,7 +219,7 @@ fn run(k: usize, syst: &mut SYST, queue: &'static mut Queue<Msg, 16>, specimen: 
             };
             if n.is_multiple_of(every) {
                 let r = reference.get((n / every) as usize).copied();
-                let err = libm::fabs(f64::from(d) - r.unwrap_or(f64::NAN));
+                let err = libm::fabs(wide(d) - r.unwrap_or(f64::NAN));
                 if err.is_nan() || err > BOUND {
                     fail!(
                         "{} Hz, step {}: |storey-1 drift - host f64| = {:e} m > bound {:e} m",
