@@ -2,7 +2,7 @@
 //! 1940 NS ×2, storey 1 the "physical" specimen (bilinear), storeys 2–5 numerical, stepped
 //! at `RATE` Hz by the split KR-α step. Data as `const`s and the record's resampling, shared
 //! by `xtask/src/bin/hybrid_building.rs` (the page, `f64`), `tests/firmware_hybrid.rs` (the
-//! host twin) and `examples/firmware/src/bin/qemu_hybrid.rs` (`f32` on target).
+//! host twin) and `examples/firmware/qemu_hybrid.rs` (`f32` on the M4F, `f64` on the M7).
 #![allow(dead_code)] // each includer uses a different subset
 
 use aemstep::models::{self, Rows};
