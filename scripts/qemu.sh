@@ -7,6 +7,10 @@
 # across Cortex-M cores (docs/cortex-m-cores.md), which fails if the M4F's f32 step
 # exceeds 3 instructions per multiply-add at N >= 6.
 #
+# `qemu_hybrid` runs twice: as every example on the M4F (f32), and built with
+# `-C target-cpu=cortex-m7 --cfg aemstep_fpu="double"` on the Cortex-M7 board (`mps2-an500`,
+# the runner of scripts/cores.sh) in f64; both runs' costs go into the hybrid section.
+#
 # The examples are package `aemstep-firmware` (examples/firmware/, a workspace member; the
 # root crate has no firmware feature or dependency). One more, `qemu_defmt`, logs through
 # defmt: its output is decoded by `defmt-print` and compared line by line with
@@ -20,14 +24,15 @@ cd "$(dirname "$0")/.."
 TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
-EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum qemu_hysteretic qemu_observer qemu_estimator)
+EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum qemu_hysteretic qemu_observer qemu_estimator qemu_hybrid)
 # Broken on purpose: "example variant" pairs that must exit with failure (status 1); the
 # variant is `--cfg aemstep_broken="<variant>"` (not a public feature, see Cargo.toml).
 BROKEN=("qemu_timer inject-nan" "qemu_timer tight-bound" "qemu_nonlinear inject-nan"
     "qemu_modal modal-tight-bound" "qemu_schemes inject-nan" "qemu_spectrum spectrum-tight-bound"
     "qemu_hysteretic hysteretic-tight-bound"
     "qemu_observer observer-nan" "qemu_observer observer-tight-bound"
-    "qemu_estimator estimator-tight-bound")
+    "qemu_estimator estimator-tight-bound"
+    "qemu_hybrid hybrid-tight-bound" "qemu_hybrid hybrid-nan")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
 PKG=(-p aemstep-firmware)
 DEFMT_PRINT_VERSION=1.2.0 # the host decoder; its format must match the target's defmt 1.x
@@ -89,6 +94,8 @@ run() { # <example> <variant>: runs the ELF `build` kept under QEMU; sets RC
 step "qemu: clippy of the firmware examples ($TARGET)"
 cargo clippy "${PKG[@]}" --release --target "$TARGET" --features defmt --examples -- -D warnings ||
     fail "clippy (firmware examples)"
+cargo clippy "${PKG[@]}" --release --target "$TARGET" --example qemu_hybrid \
+    -- -D warnings --cfg 'aemstep_fpu="double"' || fail "clippy (qemu_hybrid, f64)"
 for variant in footprint-modal footprint-all; do
     cargo clippy "${PKG[@]}" --release --target "$TARGET" --example qemu_footprint \
         -- -D warnings --cfg "aemstep_control=\"$variant\"" || fail "clippy (qemu_footprint, $variant)"
@@ -111,6 +118,37 @@ for pair in "${BROKEN[@]}"; do
     grep -q '^FAIL: ' "$OUT/$ex-broken:$variant.log" || fail "$ex ($variant) failed without saying why"
     echo "ok: $ex with --cfg aemstep_broken=\"$variant\" failed as it must (exit 1)"
 done
+
+step "qemu: qemu_hybrid in f64 on the Cortex-M7 (mps2-an500, double-precision FPU)"
+# The runner and target directory of scripts/cores.sh's M7 (its dependencies stay cached);
+# `cargo rustc` passes the cfg to the example crate only.
+M7_RUNNER=(qemu-system-arm -machine mps2-an500 -cpu cortex-m7 -nographic -semihosting-config
+    enable=on,target=native -icount shift=0,sleep=off -kernel)
+M7_DIR=$TARGET_DIR/core-M7
+m7_hybrid() { # <name> <extra cfg or ->: builds qemu_hybrid in f64 for the M7 as $OUT/qemu_hybrid-<name>, runs it; sets RC
+    local name=$1 extra=()
+    [[ $2 == - ]] || extra=(--cfg "$2")
+    env CARGO_TARGET_DIR="$M7_DIR" CARGO_TARGET_THUMBV7EM_NONE_EABIHF_RUSTFLAGS="-C target-cpu=cortex-m7" \
+        cargo rustc -q "${PKG[@]}" --release --target "$TARGET" --example qemu_hybrid -- \
+        --cfg 'aemstep_fpu="double"' "${extra[@]}" || fail "build qemu_hybrid ($name)"
+    cp "$M7_DIR/$TARGET/release/examples/qemu_hybrid" "$OUT/qemu_hybrid-$name"
+    set +e
+    timeout "$RUN_TIMEOUT" "${M7_RUNNER[@]}" "$OUT/qemu_hybrid-$name" >"$OUT/qemu_hybrid-$name.log" 2>&1
+    RC=$?
+    set -e
+    cat "$OUT/qemu_hybrid-$name.log"
+    [[ $RC -ne 124 ]] || fail "qemu_hybrid ($name) timed out after ${RUN_TIMEOUT}s"
+}
+m7_hybrid m7 -
+[[ $RC -eq 0 ]] || fail "qemu_hybrid on the Cortex-M7 (f64) exited with $RC"
+grep '^COST hybrid f64 ' "$OUT/qemu_hybrid-m7.log" >/dev/null || fail "qemu_hybrid on the M7 did not step in f64"
+echo "ok: qemu_hybrid in f64 on the Cortex-M7 exited 0"
+# The broken variant here is the NaN force: the f64 run is bit-identical to the host's (error
+# 0), so no tightened bound can fail it.
+m7_hybrid m7-broken 'aemstep_broken="hybrid-nan"'
+[[ $RC -eq 1 ]] || fail "qemu_hybrid on the M7 with --cfg aemstep_broken=\"hybrid-nan\" exited $RC, expected 1"
+grep '^FAIL: ' "$OUT/qemu_hybrid-m7-broken.log" >/dev/null || fail "qemu_hybrid on the M7 (broken) failed without saying why"
+echo "ok: qemu_hybrid on the M7 with --cfg aemstep_broken=\"hybrid-nan\" failed as it must (exit 1)"
 
 step "qemu: defmt: the decoded log of qemu_defmt, line by line against $DEFMT_EXPECTED"
 # The firmware writes defmt frames to semihosting stdout; defmt-print formats them on the
@@ -259,6 +297,19 @@ target_bits=$(sed -n 's/^target storey-1 drift f32 bits = //p' "$OUT/qemu_observ
     fail "observer storey-1 drift: host '$host_bits', target '$target_bits'"
 echo "ok: both $host_bits"
 
+step "qemu: host and target runs are bit-identical (hybrid loop: storey-1 drift at 79.9 s; M4F f32, M7 f64)"
+host_log=$(cargo test -q --release --features std --test firmware_hybrid -- --nocapture 2>&1)
+for rate in 1024 2048; do
+    for pair in "f32 qemu_hybrid-qemu" "f64 qemu_hybrid-m7"; do
+        read -r ty log <<<"$pair"
+        host_bits=$(sed -n "s/^host last storey-1 drift $rate $ty bits = //p" <<<"$host_log")
+        target_bits=$(sed -n "s/^target last storey-1 drift $rate $ty bits = //p" "$OUT/$log.log")
+        [[ -n $host_bits && $host_bits == "$target_bits" ]] ||
+            fail "hybrid storey-1 drift at $rate Hz ($ty): host '$host_bits', target '$target_bits'"
+        echo "ok: $rate Hz $ty: both $host_bits"
+    done
+done
+
 step "qemu: host and Cortex-M4F runs are bit-identical (joint estimator: roof force and detector window at 80 s)"
 host_log=$(cargo test -q --release --test firmware_estimator -- --nocapture --exact \
     f32_run_within_the_firmware_bound 2>&1)
@@ -317,6 +368,12 @@ sym_size() { # <elf> <symbol>: code bytes of the symbol and of every function it
     awk 'NR == FNR { want[$1] = 1; next } NF == 4 && ($4 in want) && !done[$4]++ { s += strtonum_hex($2) }
         function strtonum_hex(h,   i, v, c) { v = 0; h = tolower(h); for (i = 1; i <= length(h); i++) { c = index("0123456789abcdef", substr(h, i, 1)) - 1; v = v * 16 + c } return v }
         END { print s + 0 }' "$OUT/fns" - <<<"$syms"
+}
+hyb_err() { # <run: qemu or m7> <rate>: the max |drift − host| the run printed
+    sed -n "s/^qemu_hybrid: .* at $2 Hz .* = \\([^ ]*\\) m <= bound .*/\\1/p" "$OUT/qemu_hybrid-$1.log"
+}
+hyb_bound() { # <run>: the bound the run checked
+    sed -n 's/^qemu_hybrid: .* <= bound \([^ ]*\) m$/\1/p' "$OUT/qemu_hybrid-$1.log" | sed -n 1p
 }
 mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     awk -v e="$1" -v k="$2" '$1 == "MEM" && $2 == e && $3 == k { v = $4 } END { printf "%s", v == "" ? "-" : v }' \
@@ -412,6 +469,33 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     echo "|---|---:|---:|---:|"
     grep '^COST estimator' "$OUT/qemu_estimator-qemu.log" | while read -r _ what instr madds; do
         echo "| \`$what\` | $instr | $madds | $(awk -v a="$instr" -v b="$madds" 'BEGIN { printf "%.2f", a / b }') |"
+    done
+    echo
+    echo "## Hybrid loop (\`examples/firmware/qemu_hybrid.rs\`)"
+    echo
+    echo "One step of the real-time hybrid loop of issue 22 (\`scenes/hybrid/rig.rs\`): the 5-storey building's split"
+    echo "KR-α step (\`Split<T, 5>\`: displacement command, then completion with the measured force), order-2"
+    echo "polynomial compensation of a 5 ms actuator delay, the emulated actuator, the bilinear storey-1 specimen;"
+    echo "mean and worst case over every step of El Centro ×2 (79.9 s), stepped from SysTick. \`f32\` on the"
+    echo "Cortex-M4F (\`mps2-an386\`); \`f64\` on the Cortex-M7 (\`mps2-an500\`, \`-C target-cpu=cortex-m7\`, its"
+    echo "double-precision FPU). Against the host's f64 run, at 1024 Hz: max |storey-1 drift − host| ="
+    echo "$(hyb_err qemu 1024) m in \`f32\` (bound $(hyb_bound qemu) m), $(hyb_err m7 1024) m in \`f64\` (bound $(hyb_bound m7) m)."
+    echo
+    echo "Share of the budget: instructions per step over the core clock's cycles in one sample period"
+    echo "(clock / rate), assuming 1 instruction per cycle. These are instructions, not cycles: flash wait states,"
+    echo "FPU latencies (an \`f64\` divide takes many cycles) and the M7's dual issue move the true share either way,"
+    echo "and the interrupt's entry and exit are not counted; read DWT CYCCNT on the part for time. Each step is"
+    echo "counted in whole SysTick ticks of 40 instructions (± 40 on one count; the mean averages them)."
+    echo
+    echo "| core | type | rate (Hz) | instructions / step (mean) | instructions / step (max) | clock (MHz) | budget (cycles / step) | share of the budget (mean) | share of the budget (max) |"
+    echo "|---|---|---:|---:|---:|---:|---:|---:|---:|"
+    for pair in "qemu Cortex-M4F 168" "m7 Cortex-M7 480"; do
+        read -r run core mhz <<<"$pair"
+        grep '^COST hybrid ' "$OUT/qemu_hybrid-$run.log" | while read -r _ _ ty rate mean max; do
+            awk -v c="$core" -v t="$ty" -v r="$rate" -v a="$mean" -v b="$max" -v m="$mhz" 'BEGIN {
+                budget = m * 1e6 / r
+                printf "| %s | `%s` | %d | %d | %d | %d | %d | %.2f %% | %.2f %% |\n", c, t, r, a, b, m, budget, 100 * a / budget, 100 * b / budget }'
+        done
     done
     echo
     echo "## Footprint (\`examples/firmware/qemu_footprint.rs\`)"

@@ -2,7 +2,7 @@
 //! 1940 NS ×2, storey 1 the "physical" specimen (bilinear), storeys 2–5 numerical, stepped
 //! at `RATE` Hz by the split KR-α step. Data as `const`s and the record's resampling, shared
 //! by `xtask/src/bin/hybrid_building.rs` (the page, `f64`), `tests/firmware_hybrid.rs` (the
-//! host twin) and `examples/firmware/src/bin/qemu_hybrid.rs` (`f32` on target).
+//! host twin) and `examples/firmware/qemu_hybrid.rs` (`f32` on the M4F, `f64` on the M7).
 #![allow(dead_code)] // each includer uses a different subset
 
 use aemstep::models::{self, Rows};
@@ -56,3 +56,15 @@ pub const fn masses() -> [f64; N] {
 }
 /// The adaptive compensator's extrapolation order.
 pub const ADAPTIVE_ORDER: usize = 2;
+
+/// The firmware's rig (`examples/firmware/qemu_hybrid.rs`, `scenes/hybrid/rig.rs`): the
+/// emulated actuator's pure delay (s), no lag.
+pub const FIRMWARE_DELAY: f64 = 0.005;
+/// The firmware's compensator: polynomial extrapolation of this order over
+/// [`FIRMWARE_DELAY`] (the delay known, as a calibrated rig's would be).
+pub const FIRMWARE_ORDER: usize = 2;
+/// The firmware's step rates (Hz): `h = 1/1024` and `1/2048` s.
+pub const FIRMWARE_RATES: [u64; 2] = [1024, 2048];
+/// The firmware checks the storey-1 drift every `1/FIRMWARE_SAMPLE_HZ` s (every
+/// `rate / FIRMWARE_SAMPLE_HZ` steps).
+pub const FIRMWARE_SAMPLE_HZ: u64 = 16;
