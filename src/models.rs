@@ -102,7 +102,7 @@ pub fn drifts<T: Real, const N: usize>(u: &SVector<T, N>) -> SVector<T, N> {
 /// assert_eq!(models::rows_of(&a), k);
 /// ```
 pub fn matrix_of<T: Real, const N: usize>(rows: &Rows<N>) -> SMatrix<T, N, N> {
-    SMatrix::from_fn(|i, j| T::from_f64_rounded(rows[i][j]))
+    crate::linalg::matrix_t(rows)
 }
 
 /// The row-major array of a matrix (`a[i][j]` = entry `(i, j)`, as `f64`), the inverse of

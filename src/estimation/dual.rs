@@ -30,7 +30,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::InputModel;
 use super::joint::{JointEstimate, joint_start, shift};
-use crate::linalg::{self, all_finite, finite_as, identity, round_rows};
+use crate::linalg::{self, all_finite, finite_as, identity, matrix_t, round_rows, sym};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real};
@@ -477,16 +477,6 @@ pub struct DualKalmanFilter<T, const S: usize, const I: usize, const O: usize> {
     time_step: T,
 }
 
-/// `(a + aᵀ)/2`.
-fn sym<T: Real, const N: usize>(a: &SMatrix<T, N, N>) -> SMatrix<T, N, N> {
-    (a + a.transpose()) * T::from_f64_rounded(0.5)
-}
-
-/// `a` as a `T` matrix, each entry rounded once.
-fn to_t<T: Real, const R: usize, const C: usize>(a: &[[f64; C]; R]) -> SMatrix<T, R, C> {
-    SMatrix::from_fn(|i, j| T::from_f64_rounded(a[i][j]))
-}
-
 impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T, S, I, O> {
     /// The filter of `model` with process noise `q` (`S×S` on `ξ`, symmetric positive
     /// semidefinite, units of `x` squared per step), the random walk's covariance `qw`
@@ -523,14 +513,14 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
             return Err(Error::OperatorOverflow);
         }
         Ok(Self {
-            a: to_t(&model.a),
-            b: to_t(&model.b),
-            c: to_t(&model.c),
-            d: to_t(&model.d),
+            a: matrix_t(&model.a),
+            b: matrix_t(&model.b),
+            c: matrix_t(&model.c),
+            d: matrix_t(&model.d),
             gamma1: round_rows(&model.gamma1),
-            q: to_t(&qr),
-            qw: to_t(&qwr),
-            r: to_t(&rr),
+            q: matrix_t(&qr),
+            qw: matrix_t(&qwr),
+            r: matrix_t(&rr),
             time_step: T::from_f64_rounded(model.time_step),
         })
     }

@@ -6,7 +6,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::InputModel;
 use crate::linalg::{self, Mat, add_scaled, all_finite, finite_as, identity, max_abs, mul};
-use crate::linalg::{round_rows, rows_f64, transpose};
+use crate::linalg::{matrix_t, round_rows, rows_f64, sym, transpose};
 use crate::observer::{A_SMALL, balance, doubling, inf_norm, is_covariance, lu_of, symmetrize};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
@@ -664,11 +664,6 @@ pub struct InputStateFilter<T, const S: usize, const I: usize, const O: usize> {
     r: SMatrix<T, O, O>,
 }
 
-/// `(a + aᵀ)/2`.
-fn sym<T: Real, const S: usize>(a: &SMatrix<T, S, S>) -> SMatrix<T, S, S> {
-    (a + a.transpose()) * T::from_f64_rounded(0.5)
-}
-
 impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T, S, I, O> {
     /// The filter of `model`, process noise `q` (`S×S` on `ξ`, symmetric positive
     /// semidefinite), measurement noise `r` (`O×O`, symmetric positive definite), in
@@ -692,15 +687,14 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         if !fits {
             return Err(Error::OperatorOverflow);
         }
-        let m = |x: f64| T::from_f64_rounded(x);
         Ok(Self {
-            a: SMatrix::from_fn(|i, j| m(model.a[i][j])),
-            b: SMatrix::from_fn(|i, j| m(model.b[i][j])),
-            c: SMatrix::from_fn(|i, j| m(model.c[i][j])),
-            d: SMatrix::from_fn(|i, j| m(model.d[i][j])),
+            a: matrix_t(&model.a),
+            b: matrix_t(&model.b),
+            c: matrix_t(&model.c),
+            d: matrix_t(&model.d),
             gamma1: round_rows(&model.gamma1),
-            q: SMatrix::from_fn(|i, j| m(qr[i][j])),
-            r: SMatrix::from_fn(|i, j| m(rr[i][j])),
+            q: matrix_t(&qr),
+            r: matrix_t(&rr),
         })
     }
 

@@ -38,6 +38,17 @@ pub type Rows<const N: usize> = [[f64; N]; N];
 /// A row-major `R×C` matrix of `f64`.
 pub(crate) type Mat<const R: usize, const C: usize> = [[f64; C]; R];
 
+/// A row-major `f64` array as a `T` matrix, each entry rounded once: how the filters and
+/// [`matrix_of`](crate::models::matrix_of) store what they were built from.
+pub(crate) fn matrix_t<T: Real, const R: usize, const C: usize>(a: &Mat<R, C>) -> SMatrix<T, R, C> {
+    SMatrix::from_fn(|i, j| T::from_f64_rounded(a[i][j]))
+}
+
+/// `(a + aᵀ)/2`: the Kalman-type filters' symmetrization of a covariance after an update.
+pub(crate) fn sym<T: Real, const S: usize>(a: &SMatrix<T, S, S>) -> SMatrix<T, S, S> {
+    (a + a.transpose()) * T::from_f64_rounded(0.5)
+}
+
 /// All entries finite.
 pub(crate) const fn all_finite<const R: usize, const C: usize>(a: &Mat<R, C>) -> bool {
     let mut i = 0;

@@ -6,7 +6,7 @@ use nalgebra::{SMatrix, SVector};
 use super::fixed::{Estimate, initial_estimate};
 use super::riccati::is_covariance;
 use super::state_space::{Measurement, StateSpace};
-use crate::linalg::{all_finite, finite_as, rows_f64};
+use crate::linalg::{all_finite, finite_as, matrix_t, rows_f64, sym};
 use crate::{Error, Real};
 
 /// The state of a [`Kalman`] filter: the [`Estimate`] and its a-posteriori error
@@ -57,12 +57,6 @@ pub struct Kalman<T, const S: usize, const I: usize, const O: usize> {
     r: SMatrix<T, O, O>,
 }
 
-/// `(a + aᵀ)/2`.
-fn sym<T: Real, const S: usize>(a: &SMatrix<T, S, S>) -> SMatrix<T, S, S> {
-    let half = T::from_f64_rounded(0.5);
-    (a + a.transpose()) * half
-}
-
 impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O> {
     /// The filter of `model` measuring `meas`, process noise `q` (`S×S`, symmetric
     /// positive semidefinite), measurement noise `r` (`O×O`, symmetric positive
@@ -93,15 +87,14 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         if !fits {
             return Err(Error::OperatorOverflow);
         }
-        let m = |x: f64| T::from_f64_rounded(x);
         Ok(Self {
-            phi: SMatrix::from_fn(|i, j| m(model.phi[i][j])),
-            gamma0: SMatrix::from_fn(|i, j| m(model.gamma0[i][j])),
-            gamma1: SMatrix::from_fn(|i, j| m(model.gamma1[i][j])),
-            h: SMatrix::from_fn(|i, j| m(meas.h[i][j])),
-            d: SMatrix::from_fn(|i, j| m(meas.d[i][j])),
-            q: SMatrix::from_fn(|i, j| m(qr[i][j])),
-            r: SMatrix::from_fn(|i, j| m(rr[i][j])),
+            phi: matrix_t(&model.phi),
+            gamma0: matrix_t(&model.gamma0),
+            gamma1: matrix_t(&model.gamma1),
+            h: matrix_t(&meas.h),
+            d: matrix_t(&meas.d),
+            q: matrix_t(&qr),
+            r: matrix_t(&rr),
         })
     }
 
