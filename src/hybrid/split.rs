@@ -248,7 +248,7 @@ impl<T: Real, const N: usize> Split<T, N> {
     }
 
     /// The operators as a plain [`KrAlpha`] of `M, C, K` with `K_num` for its stiffness
-    /// term: stepping it with the load `p − r` is the split step. Cost: a copy.
+    /// term: stepping it with the load `p − r` is the split step. Cost: none.
     pub fn scheme(&self) -> &KrAlpha<T, N> {
         &self.kr
     }

@@ -146,7 +146,7 @@ fn delay_compensation(b: &mut Bytes) {
 /// Construction rules, then every command: `Err` changes nothing, `Ok` is finite (and the
 /// identity for a zero delay without a lag).
 fn delay_typed<T: Real>(d: &DelayInputs) {
-    let h_ok = check_time_step_t::<T>(d.h);
+    let h_ok = valid_h_as::<T>(d.h);
     let delay_ok = d.delay.is_finite() && d.delay >= 0.0;
     let lag_ok = d.lag.is_finite() && d.lag >= 0.0;
     let t = |x: f64| T::from_f64_rounded(x);
@@ -305,22 +305,6 @@ fn compensate<T: Real, C: Compensator<T>>(
         }
         also(&s);
     }
-}
-
-/// `h` valid for `T` (the crate's rule: finite, positive, `h`, `h/2`, `h²/4` representable).
-fn check_time_step_t<T: Real>(h: f64) -> bool {
-    let max = T::MAX.as_f64();
-    let fits = |x: f64| {
-        let r = T::from_f64_rounded(x).as_f64();
-        x.is_finite() && x <= max && r.is_finite() && r != 0.0
-    };
-    h.is_finite()
-        && h > 0.0
-        && (h * h).is_finite()
-        && h * h > 0.0
-        && fits(h)
-        && fits(0.5 * h)
-        && fits(0.25 * h * h)
 }
 
 /// Every constructor in `T`: the data and parameter rules, finite operators on `Ok`, the
