@@ -23,7 +23,8 @@ use crate::observer::{
 use crate::spectrum::Bank;
 use crate::{
     AForm, Coefficients, CompensatedLinear, CompensatedState, Exact, GeneralizedAlpha, KrAlpha,
-    Linear, LinearInput, Modal, Newmark, Nonlinear, Real, Stepper, Tangent, Varying,
+    Linear, LinearInput, Modal, Newmark, Nonlinear, Real, Stepper, SymTridiagonal, Tangent,
+    TridiagonalTangent, Varying,
 };
 
 impl<T: Real + Format, const N: usize> Format for CompensatedState<T, N> {
@@ -69,6 +70,27 @@ impl<T: Real + Format, const N: usize> Format for Tangent<T, N> {
             "Tangent {{ stiffness (columns): {}, damping (columns): {} }}",
             self.stiffness.as_slice(),
             self.damping.as_slice()
+        )
+    }
+}
+
+impl<T: Real + Format, const N: usize> Format for SymTridiagonal<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "SymTridiagonal {{ diagonal: {}, off: {} }}",
+            self.diagonal.as_slice(),
+            self.off.as_slice()
+        )
+    }
+}
+
+impl<T: Real + Format, const N: usize> Format for TridiagonalTangent<T, N> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "TridiagonalTangent {{ mass: {}, stiffness: {}, damping: {} }}",
+            self.mass, self.stiffness, self.damping
         )
     }
 }

@@ -172,7 +172,10 @@ mod defmt_impls;
 pub use error::Error;
 pub use modal::{Damping, Modal, ModalState};
 pub use nonlinear::varying::{Coefficients, TimeVarying, Varying};
-pub use nonlinear::{Iterations, Model, NewtonReport, NewtonSettings, Nonlinear, Tangent};
+pub use nonlinear::{
+    Iterations, Model, NewtonReport, NewtonSettings, Nonlinear, SymTridiagonal, Tangent,
+    TridiagonalTangent,
+};
 pub use scalar::Real;
 pub use schemes::{
     AForm, AlphaParameters, CompensatedLinear, CompensatedState, Exact, GeneralizedAlpha, KrAlpha,

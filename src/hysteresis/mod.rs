@@ -44,7 +44,7 @@ pub use parallel::Parallel;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::{Real, Tangent};
+use crate::{Real, Tangent, TridiagonalTangent};
 
 /// The force of a [`HistoryModel`] at a trial `(u, v)` and the history that accepting it
 /// would commit.
@@ -104,6 +104,30 @@ pub trait HistoryModel<T: Real, const N: usize> {
         _u: &SVector<T, N>,
         _v: &SVector<T, N>,
     ) -> Option<Tangent<T, N>> {
+        None
+    }
+
+    /// The trial at `(u, v)` (as [`HistoryModel::trial`]), writing the mass and the
+    /// consistent tangent at that trial in symmetric tridiagonal form into `tangent`, for a
+    /// model whose `M`, `∂F/∂u` and `∂F/∂v` are all symmetric tridiagonal: the
+    /// [`Nonlinear`](crate::Nonlinear) stepper then forms and solves each Newton system in
+    /// `O(N)` from what the trial already computed, instead of a dense tangent and an
+    /// `N³/3` factorization. Return the same trial as [`HistoryModel::trial`] and write the
+    /// same matrices as [`HistoryModel::mass`] and [`HistoryModel::tangent`] (their three
+    /// diagonals, the rest being zero); return `Some` for every `(u, v)` or for none.
+    /// (`tangent` is written in place, not returned: it is six `N`-vectors, filled once a
+    /// trial.)
+    ///
+    /// `None` (the default), leaving `tangent` as it was, keeps the dense path.
+    /// [`ShearBuilding`] returns `Some` when its damping matrix is symmetric tridiagonal
+    /// (storey dashpots, Rayleigh damping).
+    fn trial_tridiagonal(
+        &self,
+        _committed: &Self::History,
+        _u: &SVector<T, N>,
+        _v: &SVector<T, N>,
+        _tangent: &mut TridiagonalTangent<T, N>,
+    ) -> Option<Trial<T, N, Self::History>> {
         None
     }
 }

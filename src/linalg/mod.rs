@@ -9,6 +9,8 @@
 //!   (`G = M_eff⁻¹` is the solve with the identity, `GC`, `GK` solves with `C`, `K`), and a
 //!   generic in-place solve for the per-step matrices of the nonlinear and time-varying
 //!   steppers.
+//! - [`tridiagonal`]: the `O(N)` Newton solve of a shear building (positive definite,
+//!   else the caller pivots with [`lu`]).
 //! - [`cholesky`], [`symmetric_eigen`]: the generalized eigenproblem of modal reduction.
 //! - [`expm`]: the matrix exponential of the exact scheme.
 //!
@@ -22,6 +24,7 @@ pub(crate) mod expm;
 pub(crate) mod lu;
 pub(crate) mod op_rows;
 pub(crate) mod symmetric_eigen;
+pub(crate) mod tridiagonal;
 
 use nalgebra::SMatrix;
 

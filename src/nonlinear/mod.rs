@@ -10,13 +10,18 @@
 //! ```
 //!
 //! `R = 0` is solved by Newton's method from the predictor `q_{n−1}`, with the matrix
-//! `J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u`, factorized by LU with partial pivoting at every
-//! iteration.
+//! `J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u`, factorized at every iteration: by LU with partial
+//! pivoting, or — for a model whose `M`, `∂F/∂u`, `∂F/∂v` are symmetric tridiagonal (a
+//! shear building, [`HistoryModel::trial_tridiagonal`]) — by `L D Lᵀ` on the three
+//! diagonals while `J` is positive definite (pivoted LU of the same `J` otherwise).
 //!
-//! **Cost per step**: `k · (N³/3 + 4N² multiply-adds + one tangent evaluation) + (k + 1)`
-//! force evaluations, where `k` is the number of Newton iterations (at most the budget). Without
-//! an analytic tangent the tangent evaluation is `N` extra force evaluations (a directional
-//! finite difference per column of `J`). Stack: about three `N×N` matrices of `T`.
+//! **Cost per step**, `k` Newton iterations (at most the budget): dense,
+//! `k · (N³/3 + 4N² multiply-adds + one tangent evaluation) + (k + 1)` force evaluations
+//! (without an analytic tangent the tangent evaluation is `N` extra force evaluations, a
+//! directional finite difference per column of `J`); tridiagonal, `k · 26N` flops (`J` and
+//! its scale `16N`, the solve `9N` with `N` divisions, the update `N`) and `(k + 1)` trials,
+//! each with its tangent, plus `8N` for `M q` and the residual a trial. Stack: about three
+//! `N×N` matrices of `T`.
 
 pub(crate) mod varying;
 
@@ -27,6 +32,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::hysteresis::{HistoryModel, Trial};
 use crate::kinematics::{AemKinematics, Kinematics, check_time_step_as};
 use crate::linalg::lu::{solve_in_place, solve_in_place_scaled};
+use crate::linalg::tridiagonal;
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
@@ -37,6 +43,60 @@ pub struct Tangent<T, const N: usize> {
     pub stiffness: SMatrix<T, N, N>,
     /// Tangent damping `∂F/∂v` (force per velocity), `N×N`.
     pub damping: SMatrix<T, N, N>,
+}
+
+/// A symmetric tridiagonal `N×N` matrix: the stiffness, damping or mass of a chain of
+/// degrees of freedom (a shear building, masses and springs in series).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SymTridiagonal<T, const N: usize> {
+    /// The diagonal, `A_ii`.
+    pub diagonal: SVector<T, N>,
+    /// The off-diagonal: `off[i] = A_{i,i−1} = A_{i−1,i}` for `i ≥ 1`; `off[0]` is not
+    /// read (keep it zero).
+    pub off: SVector<T, N>,
+}
+
+impl<T: Real, const N: usize> SymTridiagonal<T, N> {
+    /// `A x`, each row summed in column order (`A_{i,i−1} x_{i−1} + A_ii x_i +
+    /// A_{i,i+1} x_{i+1}`): the same value as the dense product, whose other terms are
+    /// exact zeros. Cost: `3N` multiplies, `2N` adds.
+    pub fn mul(&self, x: &SVector<T, N>) -> SVector<T, N> {
+        let (d, e, x) = (&self.diagonal.data.0[0], &self.off.data.0[0], &x.data.0[0]);
+        let mut y = [T::zero(); N];
+        for i in 0..N {
+            let mut s = T::zero();
+            if i > 0 {
+                s = e[i] * x[i - 1];
+            }
+            s += d[i] * x[i];
+            if i + 1 < N {
+                s += e[i + 1] * x[i + 1];
+            }
+            y[i] = s;
+        }
+        SVector::from(y)
+    }
+
+    /// Every entry read (the diagonal and `off[1..]`) is finite. Cost: `2N`.
+    fn is_finite(&self) -> bool {
+        self.diagonal.iter().all(|x| x.is_finite())
+            && self.off.iter().skip(1).all(|x| x.is_finite())
+    }
+}
+
+/// The mass and the tangent of a model whose `M`, `∂F/∂u` and `∂F/∂v` are all symmetric
+/// tridiagonal (a shear building with storey springs and storey or Rayleigh damping), as
+/// [`HistoryModel::trial_tridiagonal`](crate::hysteresis::HistoryModel::trial_tridiagonal)
+/// returns it with each trial: the [`Nonlinear`] stepper then forms and solves the Newton
+/// matrix `J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u` in `O(N)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TridiagonalTangent<T, const N: usize> {
+    /// The mass matrix `M` (mass units); the same at every trial.
+    pub mass: SymTridiagonal<T, N>,
+    /// The tangent stiffness `∂F/∂u` (force per displacement).
+    pub stiffness: SymTridiagonal<T, N>,
+    /// The tangent damping `∂F/∂v` (force per velocity).
+    pub damping: SymTridiagonal<T, N>,
 }
 
 /// A nonlinear structural model `M u'' + F(u, u') = p(t)`, implemented by the user.
@@ -173,13 +233,21 @@ pub struct NewtonReport<T> {
 /// ```text
 /// v̂ = v_{n−1} + (h/2) q_{n−1},   û = u_{n−1} + h v_{n−1} + (h²/4) q_{n−1}
 /// R(q_n) = M q_n + F(û + (h²/4) q_n, v̂ + (h/2) q_n) − p_n = 0
-/// J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u          (LU with partial pivoting, every iteration)
+/// J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u          (factorized every iteration)
 /// v_n = v̂ + (h/2) q_n,            u_n = û + (h²/4) q_n
 /// ```
 ///
-/// **Cost per step**, for `k` Newton iterations: `k × (N³/3 + 4N² multiply-adds + one
-/// tangent evaluation) + (k + 1)` force evaluations. Without an analytic tangent, a
-/// tangent evaluation is `N` force evaluations. Stack: about three `N×N` matrices of `T`.
+/// `J` is factorized by LU with partial pivoting; a model that gives its trials with a
+/// tridiagonal tangent ([`HistoryModel::trial_tridiagonal`], e.g.
+/// [`ShearBuilding`](crate::hysteresis::ShearBuilding) with Rayleigh or storey damping) has
+/// `J` formed on its three diagonals and solved by `L D Lᵀ` in `O(N)` while positive
+/// definite, by pivoted LU of the same `J` otherwise.
+///
+/// **Cost per step**, for `k` Newton iterations: dense, `k × (N³/3 + 4N² multiply-adds + one
+/// tangent evaluation) + (k + 1)` force evaluations (without an analytic tangent, a tangent
+/// evaluation is `N` force evaluations); tridiagonal, `k × 26N` flops and `(k + 1)` trials
+/// with their tangents, `8N` flops more a trial (`M q`, residual). Stack: about three `N×N`
+/// matrices of `T`.
 ///
 /// A Duffing oscillator `u'' + 0.2 u' + u + u³ = p(t)` (paper Example 5), with two Newton
 /// iterations every step:
@@ -393,6 +461,10 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
     /// The one Newton iteration of every nonlinear step (memoryless models through
     /// [`Memoryless`], `History = ()`): from the predictor `q_{n−1}`, every trial from the
     /// `committed` history. Returns the last iterate, its trial history and the report.
+    ///
+    /// A model that gives its trials with a tridiagonal tangent
+    /// ([`HistoryModel::trial_tridiagonal`]) has its Newton systems formed and solved in
+    /// `O(N)` ([`Linearization`]); every other the dense way. The iteration is the same.
     fn newton<Mo: HistoryModel<T, N> + ?Sized>(
         &self,
         model: &Mo,
@@ -403,10 +475,32 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         if !all_finite(p) {
             return Err(Error::NonFiniteInput);
         }
-        let m = model.mass();
-        if !m.iter().all(|x| x.is_finite()) {
-            return Err(Error::NonFiniteInput);
-        }
+        let zero = SymTridiagonal {
+            diagonal: SVector::zeros(),
+            off: SVector::zeros(),
+        };
+        let path = Linearization {
+            model,
+            committed,
+            tangent: TridiagonalTangent {
+                mass: zero,
+                stiffness: zero,
+                damping: zero,
+            },
+            banded: false,
+            mass: None,
+        };
+        self.iterate(path, state, p)
+    }
+
+    /// Newton's iteration on `R(q) = M q + F(û + (h²/4) q, v̂ + (h/2) q) − p = 0` from the
+    /// predictor `q_{n−1}`, the trials and the Newton systems given by `path`.
+    fn iterate<Mo: HistoryModel<T, N> + ?Sized>(
+        &self,
+        mut path: Linearization<'_, Mo, Mo::History, T, N>,
+        state: &State<T, N>,
+        p: &SVector<T, N>,
+    ) -> Result<Candidate<T, N, Mo::History>, Error> {
         let (b, c) = (self.kin.half_h, self.kin.quarter_h2);
         let (vh, uh) = self.kin.predict_all(&state.u, &state.v, &state.a);
         let (budget, fixed) = match self.settings.iterations {
@@ -421,11 +515,12 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         let mut last_branch = 0u64;
         loop {
             let (v, u) = self.kin.correct_all(&vh, &uh, &q);
+            let (trial, mq) = path.evaluate(&u, &v, &q)?;
             let Trial {
                 force: f,
                 history,
                 branch,
-            } = model.trial(committed, &u, &v);
+            } = trial;
             if !all_finite(&f) {
                 return Err(Error::NonFiniteForce);
             }
@@ -433,7 +528,6 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
                 branch_changes += 1;
             }
             last_branch = branch;
-            let mq = m * q;
             let r = mq + f - p;
             let residual = relative_residual(&r, &mq, &f, p);
             let correction = if iterations == 0 {
@@ -464,39 +558,174 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
                 };
                 return Ok((next, history, report));
             }
-            // J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u, with an entry scale for the pivot test.
-            let (mut j, scale) = match model.tangent(committed, &u, &v) {
-                Some(t) => {
-                    if !t
-                        .stiffness
-                        .iter()
-                        .chain(t.damping.iter())
-                        .all(|x| x.is_finite())
-                    {
-                        return Err(Error::NonFiniteForce);
-                    }
-                    let j = m + t.damping * b + t.stiffness * c;
-                    let scale = m
-                        .iter()
-                        .zip(t.damping.iter())
-                        .zip(t.stiffness.iter())
-                        .fold(T::zero(), |s, ((x, d), k)| {
-                            s.max(x.abs() + b * d.abs() + c * k.abs())
-                        });
-                    (j, scale)
-                }
-                None => finite_difference_jacobian(model, committed, &m, &u, &v, &f, b, c)?,
-            };
             let mut delta = r;
-            if !solve_in_place(&mut j, &mut delta, scale) {
-                return Err(Error::SingularJacobian);
-            }
+            path.solve(&u, &v, &f, b, c, &mut delta)?;
             q -= delta;
             last_delta = norm_inf(&delta);
             iterations += 1;
         }
     }
 }
+
+/// How a Newton iteration gets its trials and solves its systems. A model whose trials
+/// come with `M`, `∂F/∂u`, `∂F/∂v` on three diagonals ([`HistoryModel::trial_tridiagonal`])
+/// has `J` formed on them (`8N` flops) and solved by `L D Lᵀ` (`N` divisions, `6N` flops)
+/// when positive definite, else by pivoted LU of the same `J` laid out densely. Every other
+/// model: [`HistoryModel::trial`], a dense tangent (the model's, or finite differences) and
+/// LU with partial pivoting, `N³/3` multiply-adds a system.
+struct Linearization<'a, Mo: ?Sized, H, T, const N: usize> {
+    model: &'a Mo,
+    committed: &'a H,
+    /// The tridiagonal mass and tangent of the last trial, when `banded`.
+    tangent: TridiagonalTangent<T, N>,
+    /// The last trial came with [`Linearization::tangent`].
+    banded: bool,
+    /// The dense mass, fetched (and checked finite) once, when a trial came without one.
+    mass: Option<SMatrix<T, N, N>>,
+}
+
+impl<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>
+    Linearization<'_, Mo, Mo::History, T, N>
+{
+    /// The trial at `(u, v)` and `M q`.
+    ///
+    /// Errors: [`Error::NonFiniteInput`] (`M` not finite).
+    #[inline(always)]
+    fn evaluate(
+        &mut self,
+        u: &SVector<T, N>,
+        v: &SVector<T, N>,
+        q: &SVector<T, N>,
+    ) -> Result<Evaluated<T, N, Mo::History>, Error> {
+        if let Some(trial) = self
+            .model
+            .trial_tridiagonal(self.committed, u, v, &mut self.tangent)
+        {
+            if !self.tangent.mass.is_finite() {
+                return Err(Error::NonFiniteInput);
+            }
+            self.banded = true;
+            return Ok((trial, self.tangent.mass.mul(q)));
+        }
+        self.banded = false;
+        let m = self.dense_mass()?;
+        Ok((self.model.trial(self.committed, u, v), m * q))
+    }
+
+    /// The model's dense `M`, checked finite once.
+    fn dense_mass(&mut self) -> Result<SMatrix<T, N, N>, Error> {
+        if let Some(m) = self.mass {
+            return Ok(m);
+        }
+        let m = self.model.mass();
+        if !m.iter().all(|x| x.is_finite()) {
+            return Err(Error::NonFiniteInput);
+        }
+        self.mass = Some(m);
+        Ok(m)
+    }
+
+    /// `r ← J⁻¹ r`, `J = M + b ∂F/∂v + c ∂F/∂u` at the last evaluated `(u, v)`, whose
+    /// force was `f`.
+    ///
+    /// Errors: [`Error::NonFiniteForce`] (a tangent entry), [`Error::SingularJacobian`].
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn solve(
+        &mut self,
+        u: &SVector<T, N>,
+        v: &SVector<T, N>,
+        f: &SVector<T, N>,
+        b: T,
+        c: T,
+        r: &mut SVector<T, N>,
+    ) -> Result<(), Error> {
+        if !self.banded {
+            let m = self.dense_mass()?;
+            return dense_solve(self.model, self.committed, &m, u, v, f, b, c, r);
+        }
+        let t = &self.tangent;
+        if !t.stiffness.is_finite() || !t.damping.is_finite() {
+            return Err(Error::NonFiniteForce);
+        }
+        let (m, d, k) = (&t.mass, &t.damping, &t.stiffness);
+        let mut scale = T::zero();
+        let mut j = SymTridiagonal {
+            diagonal: SVector::zeros(),
+            off: SVector::zeros(),
+        };
+        for i in 0..N {
+            j.diagonal[i] = m.diagonal[i] + b * d.diagonal[i] + c * k.diagonal[i];
+            scale =
+                scale.max(m.diagonal[i].abs() + b * d.diagonal[i].abs() + c * k.diagonal[i].abs());
+            if i > 0 {
+                j.off[i] = m.off[i] + b * d.off[i] + c * k.off[i];
+                scale = scale.max(m.off[i].abs() + b * d.off[i].abs() + c * k.off[i].abs());
+            }
+        }
+        let rhs = *r;
+        if tridiagonal::solve_positive(&j, r, scale) {
+            return Ok(());
+        }
+        // Not positive definite (a softening storey): pivot, on the same J.
+        *r = rhs;
+        let mut dense = SMatrix::<T, N, N>::from_fn(|row, col| match row.abs_diff(col) {
+            0 => j.diagonal[row],
+            1 => j.off[row.max(col)],
+            _ => T::zero(),
+        });
+        if !solve_in_place(&mut dense, r, scale) {
+            return Err(Error::SingularJacobian);
+        }
+        Ok(())
+    }
+}
+
+/// `r ← J⁻¹ r` with the dense tangent (the model's, or finite differences of its trials)
+/// and LU with partial pivoting. Cost: `N³/3 + 3N²` and one tangent evaluation.
+#[allow(clippy::too_many_arguments)]
+fn dense_solve<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>(
+    model: &Mo,
+    committed: &Mo::History,
+    m: &SMatrix<T, N, N>,
+    u: &SVector<T, N>,
+    v: &SVector<T, N>,
+    f: &SVector<T, N>,
+    b: T,
+    c: T,
+    r: &mut SVector<T, N>,
+) -> Result<(), Error> {
+    // J = M + (h/2) ∂F/∂v + (h²/4) ∂F/∂u, with an entry scale for the pivot test.
+    let (mut j, scale) = match model.tangent(committed, u, v) {
+        Some(t) => {
+            if !t
+                .stiffness
+                .iter()
+                .chain(t.damping.iter())
+                .all(|x| x.is_finite())
+            {
+                return Err(Error::NonFiniteForce);
+            }
+            let j = m + t.damping * b + t.stiffness * c;
+            let scale = m
+                .iter()
+                .zip(t.damping.iter())
+                .zip(t.stiffness.iter())
+                .fold(T::zero(), |s, ((x, d), k)| {
+                    s.max(x.abs() + b * d.abs() + c * k.abs())
+                });
+            (j, scale)
+        }
+        None => finite_difference_jacobian(model, committed, m, u, v, f, b, c)?,
+    };
+    if !solve_in_place(&mut j, r, scale) {
+        return Err(Error::SingularJacobian);
+    }
+    Ok(())
+}
+
+/// A trial and `M q` at one Newton iterate.
+type Evaluated<T, const N: usize, H> = (Trial<T, N, H>, SVector<T, N>);
 
 /// A candidate step of a model with history: the state, the history accepting it would
 /// commit, and the Newton report.
