@@ -508,6 +508,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
             Iterations::Exactly(k) => (k, true),
         };
         let tol = self.settings.tolerance;
+        let p_size = norm_inf(p);
         let mut q = state.a;
         let mut iterations = 0u32;
         let mut last_delta = T::zero();
@@ -529,7 +530,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
             }
             last_branch = branch;
             let r = mq + f - p;
-            let residual = relative_residual(&r, &mq, &f, p);
+            let residual = relative_residual(&r, &mq, &f, p_size);
             let correction = if iterations == 0 {
                 T::zero()
             } else {
@@ -770,14 +771,15 @@ fn norm_inf<T: Real, const N: usize>(x: &SVector<T, N>) -> T {
     x.iter().fold(T::zero(), |s, e| s.max(e.abs()))
 }
 
-/// `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)`, `0` when the denominator is zero (then `r = 0` too).
+/// `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` (`p_size = ‖p‖∞`), `0` when the denominator is zero
+/// (then `r = 0` too).
 fn relative_residual<T: Real, const N: usize>(
     r: &SVector<T, N>,
     mq: &SVector<T, N>,
     f: &SVector<T, N>,
-    p: &SVector<T, N>,
+    p_size: T,
 ) -> T {
-    let scale = norm_inf(mq).max(norm_inf(f)).max(norm_inf(p));
+    let scale = norm_inf(mq).max(norm_inf(f)).max(p_size);
     if scale > T::zero() {
         norm_inf(r) / scale
     } else {
