@@ -77,8 +77,7 @@ fn runs_on_the_threads_asked_for() {
             let now = running.fetch_add(1, Ordering::SeqCst) + 1;
             peak.fetch_max(now, Ordering::SeqCst);
             let start = Instant::now();
-            while peak.load(Ordering::SeqCst) < want && start.elapsed() < Duration::from_secs(10)
-            {
+            while peak.load(Ordering::SeqCst) < want && start.elapsed() < Duration::from_secs(10) {
                 std::thread::yield_now();
             }
             running.fetch_sub(1, Ordering::SeqCst);
@@ -117,7 +116,11 @@ fn a_panic_propagates_on_one_thread_too_and_the_payload_is_kept() {
             })
         });
         let payload = r.expect_err("the job panicked");
-        assert_eq!(payload.downcast_ref::<u32>(), Some(&700), "threads = {threads}");
+        assert_eq!(
+            payload.downcast_ref::<u32>(),
+            Some(&700),
+            "threads = {threads}"
+        );
     }
 }
 
@@ -161,7 +164,10 @@ fn ida_runs_equal_serial_runs() {
         .iter()
         .map(|&s| ida::peak_drift(&bld, &stepper, ag, s, steps).unwrap())
         .collect();
-    assert!(serial[2] > ida::FY / aemstep::models::FIVE_STOREY_STIFFNESS, "{serial:?}");
+    assert!(
+        serial[2] > ida::FY / aemstep::models::FIVE_STOREY_STIFFNESS,
+        "{serial:?}"
+    );
     for threads in [2, 0] {
         let got = batch::map(&scales, threads, |&s| {
             ida::peak_drift(&bld, &stepper, ag, s, steps).unwrap()

@@ -48,7 +48,10 @@ pub fn building() -> Result<Building, Error> {
 
 /// The stepper: h = [`H`], Newton up to [`NEWTON_ITERATIONS`] to [`NEWTON_TOLERANCE`].
 pub fn stepper() -> Result<Nonlinear<f64, N>, Error> {
-    Nonlinear::new(H, NewtonSettings::up_to(NEWTON_ITERATIONS, NEWTON_TOLERANCE))
+    Nonlinear::new(
+        H,
+        NewtonSettings::up_to(NEWTON_ITERATIONS, NEWTON_TOLERANCE),
+    )
 }
 
 /// The ground acceleration (m/s²) at step `n` (t = n h): the record `ag` (m/s², at 0.02 s)
@@ -92,7 +95,9 @@ pub fn peak_drift(
     for n in 1..=steps {
         let p = building.ground_load(ground(ag, scale, n));
         stepper.try_step_with_history(building, &mut s, &mut history, &p)?;
-        peak = Building::drifts(s.u()).iter().fold(peak, |m, d| m.max(d.abs()));
+        peak = Building::drifts(s.u())
+            .iter()
+            .fold(peak, |m, d| m.max(d.abs()));
     }
     Ok(peak)
 }
