@@ -38,6 +38,8 @@
 //! - [`spectrum`]: response spectra: a bank of damped oscillators fed one
 //!   ground-acceleration sample at a time, RotD50/RotD100, and (feature `std`) many
 //!   records in parallel on the host.
+//! - `batch` (feature `std`): many independent jobs (records, intensities, periods) on a
+//!   work-stealing pool of a chosen thread count, results in input order.
 //! - [`observer`]: virtual sensing — the discrete state-space form of the linear schemes,
 //!   a fixed-gain observer with the steady-state Kalman gain (also in `const fn`), a full
 //!   Kalman filter, modal observers.
@@ -132,6 +134,11 @@ pub use nalgebra;
 mod macros;
 #[doc(hidden)]
 pub use macros::rows_to_columns as __rows_to_columns;
+
+// Independent jobs on a work-stealing pool (host only).
+#[cfg(feature = "std")]
+#[cfg_attr(docsrs, doc(cfg(feature = "std")))]
+pub mod batch;
 
 // The state and the interface every scheme shares.
 mod error;
