@@ -156,33 +156,69 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
         core::array::from_fn(|i| self.laws[i].trial(&committed[i], d[i], r[i]))
     }
 
-    /// The force `C v + F_s` and the trial history of `N` storey trials. `C v` on the
-    /// three diagonals when `C` is tridiagonal (`5N` flops, the same value as the dense
-    /// product: its other terms are exact zeros), else dense (`N²`).
-    #[inline]
-    fn assemble(
+    /// The trial at `(u, v)`: the `N` storey laws at the drifts and drift rates, the force
+    /// `C v + F_s` (`C v` on the three diagonals when `C` is tridiagonal, `5N` flops, the
+    /// same value as the dense product, whose other terms are exact zeros; else dense,
+    /// `N²`), the trial history, and — when `tangent` is given (tridiagonal `C` only) —
+    /// `M`, `∂F/∂u`, `∂F/∂v` on three diagonals. One pass over the storeys, nothing
+    /// stored between the law calls and the assembly.
+    #[inline(always)]
+    fn fused(
         &self,
-        storeys: &[LawTrial<T, L::History>; N],
+        committed: &[L::History; N],
+        u: &SVector<T, N>,
         v: &SVector<T, N>,
+        mut tangent: Option<&mut TridiagonalTangent<T, N>>,
     ) -> Trial<T, N, [L::History; N]> {
+        let (ua, va) = (&u.data.0[0], &v.data.0[0]);
         let mut force = match &self.band {
-            Some(band) => band.mul(v),
-            None => self.damping * v,
+            Some(band) => band.mul(v).data.0[0],
+            None => (self.damping * v).data.0[0],
         };
-        let mut branch = 0u64;
-        for i in 0..N {
-            let f = storeys[i].force;
-            force[i] += f;
-            if i > 0 {
-                force[i - 1] -= f;
+        if let Some(t) = tangent.as_deref_mut() {
+            t.mass.diagonal = self.masses;
+            t.mass.off = SVector::zeros();
+            if let Some(band) = &self.band {
+                t.damping = *band;
             }
-            if storeys[i].inelastic {
+        }
+        let mut history = *committed;
+        let mut branch = 0u64;
+        let (mut u_below, mut v_below) = (T::zero(), T::zero());
+        for i in 0..N {
+            // δ_i = u_i − u_{i−1} (u_{−1} = 0: δ_0 = u_0 exactly), as `drifts`.
+            let (d, r) = if i == 0 {
+                (ua[0], va[0])
+            } else {
+                (ua[i] - u_below, va[i] - v_below)
+            };
+            (u_below, v_below) = (ua[i], va[i]);
+            let s = self.laws[i].trial(&committed[i], d, r);
+            force[i] += s.force;
+            if i > 0 {
+                force[i - 1] -= s.force;
+            }
+            if s.inelastic {
                 branch |= 1 << (i % 64);
+            }
+            history[i] = s.history;
+            if let Some(t) = tangent.as_deref_mut() {
+                let (k, c) = (s.stiffness, s.damping);
+                t.stiffness.diagonal[i] = k;
+                t.damping.diagonal[i] += c;
+                if i == 0 {
+                    t.stiffness.off[0] = T::zero();
+                } else {
+                    t.stiffness.diagonal[i - 1] += k;
+                    t.stiffness.off[i] = -k;
+                    t.damping.diagonal[i - 1] += c;
+                    t.damping.off[i] -= c;
+                }
             }
         }
         Trial {
-            force,
-            history: core::array::from_fn(|i| storeys[i].history),
+            force: SVector::from(force),
+            history,
             branch,
         }
     }
@@ -214,7 +250,7 @@ impl<T: Real, L: Law<T>, const N: usize> HistoryModel<T, N> for ShearBuilding<T,
         u: &SVector<T, N>,
         v: &SVector<T, N>,
     ) -> Trial<T, N, [L::History; N]> {
-        self.assemble(&self.storeys(committed, u, v), v)
+        self.fused(committed, u, v, None)
     }
 
     fn tangent(
@@ -253,28 +289,7 @@ impl<T: Real, L: Law<T>, const N: usize> HistoryModel<T, N> for ShearBuilding<T,
         v: &SVector<T, N>,
         tangent: &mut TridiagonalTangent<T, N>,
     ) -> Option<Trial<T, N, [L::History; N]>> {
-        let band = self.band.as_ref()?;
-        let storeys = self.storeys(committed, u, v);
-        let TridiagonalTangent {
-            mass,
-            stiffness,
-            damping,
-        } = tangent;
-        mass.diagonal = self.masses;
-        mass.off = SVector::zeros();
-        *damping = *band;
-        for i in 0..N {
-            let (k, c) = (storeys[i].stiffness, storeys[i].damping);
-            stiffness.off[i] = T::zero();
-            stiffness.diagonal[i] = k;
-            damping.diagonal[i] += c;
-            if i > 0 {
-                stiffness.diagonal[i - 1] += k;
-                stiffness.off[i] = -k;
-                damping.diagonal[i - 1] += c;
-                damping.off[i] -= c;
-            }
-        }
-        Some(self.assemble(&storeys, v))
+        self.band.as_ref()?;
+        Some(self.fused(committed, u, v, Some(tangent)))
     }
 }
