@@ -156,9 +156,10 @@ fn time<R>(reps: usize, mut f: impl FnMut() -> R) -> (f64, f64) {
     (t[0], t[t.len() / 2])
 }
 
-/// The host's scalar `f64` multiply-add rate (flop/s): 24 independent chains of
+/// The host's `f64` multiply-add rate without AVX (flop/s): 24 independent chains of
 /// `a = a·m + k` (2 flops each, no dependence between chains), as
-/// xtask/benches/steps.rs `floor_compute` does without AVX; fastest of 20 timings.
+/// xtask/benches/steps.rs `floor_compute` does without AVX; fastest of 20 timings. The
+/// compiler packs the chains two to an SSE2 register: the SSE2 rate, twice one lane's.
 fn peak_flops() -> f64 {
     const LANES: usize = 24;
     const ROUNDS: usize = 1 << 16;
