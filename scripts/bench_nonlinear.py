@@ -241,8 +241,8 @@ def main():
               "parameters and its own local Newton) is not integrated as `aemstep::hysteresis::BoucWen`, so the "
               "histories would not be the same scheme. Friction storeys have no Steel01-like peer (OpenSees' "
               "friction models are bearing elements) and are aemstep only.", "",
-              f"Flops: `flops_per_iteration` in xtask/src/bin/nonlinear_bench.rs (the dense-J path: "
-              f"J = M + (h/2) C + (h²/4) K, LU 2N³/3, two sets of law trials); the floor is that count at the "
+              f"Flops: `flops_per_step` in xtask/src/bin/nonlinear_bench.rs, counted from the code (the tridiagonal "
+              f"path: k + 1 trials with their tangents, k solves of J on three diagonals by L D Lᵀ); the floor is that count at the "
               f"host's measured f64 multiply-add rate without AVX, {peak / 1e9:.1f} Gflop/s (24 independent "
               "chains of `a = a·m + k`, as xtask/benches/steps.rs `floor_compute` without AVX; the compiler "
               "packs the chains two to an SSE2 register, so it is the SSE2 rate, 2× the one-lane scalar "

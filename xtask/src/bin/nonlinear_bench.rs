@@ -6,7 +6,7 @@
 //!
 //! Prints one JSON object a line per case: ns/step (fastest, median of `R` whole runs timed
 //! with `std::time::Instant`), Newton iterations and trial evaluations per step, the flops
-//! a step needs by [`flops_per_iteration`], and their share of the measured scalar floor.
+//! a step needs by [`flops_per_step`], and their share of the measured scalar floor.
 //! `--drifts PATH` writes the 5-storey bilinear drift history (one step a line, `%.17e`) for
 //! the script's comparison with OpenSees. `--ida K`: the serial IDA row, `K` analyses of
 //! the 5-storey bilinear building at scales `2.0·j/K`, `j = 1…K` (0 skips it).
@@ -35,35 +35,38 @@ enum LawKind {
     BilinearFriction,
 }
 
-/// Floating-point operations of ONE Newton iteration of `Nonlinear::newton` on a
-/// `ShearBuilding` of `n` storeys, as the code path in src/nonlinear/mod.rs and
-/// src/hysteresis/building.rs reads today (dense `N×N` matrices throughout). Counted:
-/// additions, multiplications, divisions, comparisons/abs/max (1 each); branches and copies
-/// not. Per iteration, one trial at the new iterate (for the residual) and one tangent:
+/// Floating-point operations of one step of `Nonlinear` on a `ShearBuilding` of `n` storeys
+/// with Rayleigh (tridiagonal) damping and `k` Newton iterations, as the code path in
+/// src/nonlinear/mod.rs (`iterate`, `Linearization`), src/linalg/tridiagonal.rs and
+/// src/hysteresis/building.rs (`fused`) reads. Counted: additions, multiplications,
+/// divisions, comparisons/abs/max/finiteness tests (1 each); branches and copies not.
 ///
-/// - correction `v = v̂ + (h/2) q`, `u = û + (h²/4) q`: `4n`;
-/// - trial: drifts of `u` and `v` `2n`, `n` law trials ([`law_trial_flops`]), `C v` dense
-///   `2n²`, storey forces into floors `2n`;
-/// - residual `M q` dense (`M` diagonal but stored `N×N`) `2n²`, `r = M q + F − p` `2n`,
-///   relative residual (three ∞-norms and a max) `6n + 3`, correction test `4n + 4`;
-/// - tangent: the drifts again `2n`, `n` law trials again, stiffness `K_t` tridiagonal
-///   assembled into a dense matrix `4n`, `C + diag` `n`;
-/// - `J = M + (h/2) C_t + (h²/4) K_t` dense `4n²`, its entry scale `5n²`;
-/// - LU with partial pivoting `2n³/3` (`n³/3` multiply-adds) plus pivot search `n²/2`,
-///   forward/back substitution `2n²`, `q −= δ` and `‖δ‖∞` `3n`.
-///
-/// The other engineer's tridiagonal path replaces the `n³` and most `n²` terms; update this
-/// function with it.
-fn flops_per_iteration(n: usize, law: LawKind) -> f64 {
+/// - once a step: predictor `v̂, û` `6n`, `p` finite `n`, `‖p‖∞` `2n`; the new state finite
+///   `3n`;
+/// - each of the `k + 1` trials: correction `v, u` `4n`; drifts `2n`; `n` law trials
+///   ([`law_trial_flops`]); `C v` on three diagonals `5n`, storey forces into floors `2n`;
+///   the tridiagonal tangent `4n`; force and mass finite `3n`; `M q` on three diagonals
+///   `5n`; `r = M q + F − p` `2n`; relative residual (three ∞-norms) `6n + 3`;
+/// - each of the `k` trials after the first: the correction test (three ∞-norms, three
+///   divisions) `6n + 5`;
+/// - each of the `k` solves: tangent finite `4n`; `J` on three diagonals `8n` and its entry
+///   scale `16n`; `L D Lᵀ` with the pivot tests `11n` (`n` divisions); `q −= δ`, `‖δ‖∞` `3n`.
+fn flops_per_step(n: usize, law: LawKind, k: f64) -> f64 {
     let n = n as f64;
-    let laws = 2.0 * n * law_trial_flops(law);
-    let linear = 4.0 * n
-        + (2.0 * n + 2.0 * n * n + 2.0 * n)
-        + (2.0 * n * n + 2.0 * n + 6.0 * n + 3.0 + 4.0 * n + 4.0)
-        + (2.0 * n + 4.0 * n + n)
-        + (4.0 * n * n + 5.0 * n * n)
-        + (2.0 * n * n * n / 3.0 + n * n / 2.0 + 2.0 * n * n + 3.0 * n);
-    laws + linear
+    let once = 6.0 * n + n + 2.0 * n + 3.0 * n;
+    let trial = 4.0 * n
+        + 2.0 * n
+        + n * law_trial_flops(law)
+        + 5.0 * n
+        + 2.0 * n
+        + 4.0 * n
+        + 3.0 * n
+        + 5.0 * n
+        + 2.0 * n
+        + (6.0 * n + 3.0);
+    let correction = 6.0 * n + 5.0;
+    let solve = 4.0 * n + 8.0 * n + 16.0 * n + 11.0 * n + 3.0 * n;
+    once + (k + 1.0) * trial + k * (correction + solve)
 }
 
 /// Flops of one storey law trial (src/hysteresis/bilinear.rs, bouc_wen.rs, friction.rs).
@@ -192,7 +195,7 @@ fn case<L: Law<f64> + Copy, const N: usize>(
     let (fast, median) = time(reps, || run(&b, scene::SCALE, None).peak);
     let steps = r.steps as f64;
     let its = r.iterations as f64 / steps;
-    let flops = its * flops_per_iteration(N, kind);
+    let flops = flops_per_step(N, kind, its);
     let mut s = String::new();
     write!(
         s,
@@ -204,7 +207,7 @@ fn case<L: Law<f64> + Copy, const N: usize>(
         median / steps * 1e9,
         its + 1.0,
         fast / r.iterations.max(1) as f64 * 1e9,
-        flops_per_iteration(N, kind),
+        flops_per_step(N, kind, 1.0) - flops_per_step(N, kind, 0.0),
         flops / (fast / steps * peak),
         r.peak,
     )
