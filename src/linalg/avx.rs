@@ -119,6 +119,30 @@ fn column_blocks_avx<T: Real, const N: usize, const K: usize, const W: usize>(
     super::op_rows::column_blocks::<T, N, K, W>(ops, from, x, out);
 }
 
+/// Run `f` (a closure whose body is inlined loops over independent lanes, e.g. the
+/// spectrum bank's per-sample step over its oscillators) compiled with AVX enabled when
+/// [`available`], else as is. Same bits either way, for the reasons in the module docs:
+/// AVX only widens the packed `mul`/`add`/`max`/compare operations, each lane rounded as
+/// on SSE2, and nothing is fused. Cost: one relaxed load, a branch and a call.
+#[inline(always)]
+pub(crate) fn run<R>(f: impl FnOnce() -> R) -> R {
+    if PLAIN_ONLY || !available() {
+        f()
+    } else {
+        // SAFETY: `available()` is true: the CPU reports AVX and the OS saves its
+        // registers (module docs), the precondition of `run_avx`.
+        unsafe { run_avx(f) }
+    }
+}
+
+/// `f` inlined into a function compiled with AVX enabled (a callee without target
+/// features may be inlined into one with more).
+#[target_feature(enable = "avx")]
+#[inline(never)]
+fn run_avx<R>(f: impl FnOnce() -> R) -> R {
+    f()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
