@@ -565,18 +565,21 @@ impl<T: Real, const P: usize> Bank<T, P> {
         if r.samples == 0 {
             return;
         }
-        let zero = T::from_f64_rounded(0.0);
-        let all = || {
-            for _ in 0..samples {
-                let a0 = r.last;
-                r.last = zero;
-                self.advance(r, a0, zero);
-            }
-        };
         #[cfg(target_arch = "x86_64")]
-        crate::linalg::avx::run(all);
+        crate::linalg::avx::run(|| self.ring_out(r, samples));
         #[cfg(not(target_arch = "x86_64"))]
-        all();
+        self.ring_out(r, samples);
+    }
+
+    /// The loop of [`Bank::free_vibration`] (inlined where it is called).
+    #[inline(always)]
+    fn ring_out(&self, r: &mut Response<T, P>, samples: u32) {
+        let zero = T::from_f64_rounded(0.0);
+        for _ in 0..samples {
+            let a0 = r.last;
+            r.last = zero;
+            self.advance(r, a0, zero);
+        }
     }
 
     /// One period of the longest oscillator, in samples (`⌈T_max/h⌉`): after the record,
