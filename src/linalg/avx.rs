@@ -17,14 +17,16 @@
 //! and the OS to have enabled the SSE and AVX register state in `XCR0` — the conditions
 //! under which the Intel and AMD manuals define AVX instructions to execute. `XGETBV`
 //! itself is read only once CPUID reports OSXSAVE (its own precondition), and CPUID (an
-//! `unsafe` intrinsic on the MSRV) exists on every x86-64 CPU. These three blocks are the
+//! `unsafe` intrinsic on the MSRV) exists on every x86-64 CPU. These blocks (the query, the
+//! two guarded calls: [`column_blocks`] and [`run`], the spectrum bank's step) are the
 //! crate's only `unsafe`. A build that already targets AVX
 //! (`-C target-cpu=native`, `-C target-feature=+avx`) compiles the plain loop with AVX
 //! and never takes this path.
 //!
 //! Cost: one relaxed atomic load and a branch a step (the CPUID query runs once per
-//! process); the dispatch is used only for operators of at least [`MIN_BYTES`] bytes,
-//! below which the call does not pay for itself.
+//! process); [`column_blocks`] takes it only for operators of at least [`MIN_BYTES`] bytes,
+//! below which the call does not pay for itself. [`run`] (the spectrum bank, about 100 ns a
+//! sample at `P = 100`) halves `Bank<f64, 100>`'s step (`docs/spectrum.md`).
 
 #![allow(unsafe_code)]
 
@@ -117,6 +119,30 @@ fn column_blocks_avx<T: Real, const N: usize, const K: usize, const W: usize>(
     out: &mut [T],
 ) {
     super::op_rows::column_blocks::<T, N, K, W>(ops, from, x, out);
+}
+
+/// Run `f` (a closure whose body is inlined loops over independent lanes, e.g. the
+/// spectrum bank's per-sample step over its oscillators) compiled with AVX enabled when
+/// [`available`], else as is. Same bits either way, for the reasons in the module docs:
+/// AVX only widens the packed `mul`/`add`/`max`/compare operations, each lane rounded as
+/// on SSE2, and nothing is fused. Cost: one relaxed load, a branch and a call.
+#[inline(always)]
+pub(crate) fn run<R>(f: impl FnOnce() -> R) -> R {
+    if PLAIN_ONLY || !available() {
+        f()
+    } else {
+        // SAFETY: `available()` is true: the CPU reports AVX and the OS saves its
+        // registers (module docs), the precondition of `run_avx`.
+        unsafe { run_avx(f) }
+    }
+}
+
+/// `f` inlined into a function compiled with AVX enabled (a callee without target
+/// features may be inlined into one with more).
+#[target_feature(enable = "avx")]
+#[inline(never)]
+fn run_avx<R>(f: impl FnOnce() -> R) -> R {
+    f()
 }
 
 #[cfg(test)]
