@@ -53,6 +53,8 @@ mod bank;
 mod operators;
 mod rotd;
 
+pub mod inelastic;
+
 #[cfg(feature = "std")]
 #[cfg_attr(docsrs, doc(cfg(feature = "std")))]
 pub mod batch;
