@@ -64,8 +64,8 @@
 //! (`tests/inelastic.rs`, 10 periods 0.1–3 s, 5 %, EPP and `α = 0.05`, `R = 2, 4`): the
 //! worst ductility error is 7.6e-3 relative with 20 points per period, 2.7e-3 with 40,
 //! 9.4e-4 with 80 (against 2 000, EPP, `R = 4`), and against the independent reference
-//! 6.1e-3 at 40 (1.3e-4 at 400); 40 halves the error of 20 for twice the sub-steps, and
-//! is within 1 % everywhere tested.
+//! 6.1e-3 at 40 (1.3e-4 at 400); 40 cuts the error of 20 by about 3 for twice the
+//! sub-steps, and is within 1 % everywhere tested.
 //!
 //! **Cost**: [`Yielding::step`] is `Σ_p n_p` sub-steps per sample
 //! ([`Yielding::substeps_per_sample`]). A *record pass* is `N` samples plus
