@@ -52,8 +52,8 @@
 //! `Δu = (b − αω²u₀ − s(1 − α)a_y)/(κ + αω²)`, `f₁ = αω²u₁ + s(1 − α)a_y` (a step that
 //! goes from one edge past the other is caught too: `s` is the side left). This is the
 //! solution the crate's nonlinear AEM with Newton converges to, at a fixed cost: about
-//! 20 flops and 3 comparisons per sub-step (both branches computed and selected, so no
-//! data-dependent branch). With `a_y = +∞` the oscillator never yields and the step is the
+//! 30 flops and 4 comparisons per sub-step, the peak and the plastic work included (both
+//! branches computed, then selected: the work does not depend on the data). With `a_y = +∞` the oscillator never yields and the step is the
 //! elastic [`Bank`](super::Bank) with [`Scheme::Aem`](super::Scheme::Aem) (same sub-steps),
 //! to rounding.
 //!
@@ -68,7 +68,9 @@
 //! sub-steps, and is within 1 % everywhere tested.
 //!
 //! **Cost**: [`Yielding::step`] is `Σ_p n_p` sub-steps per sample
-//! ([`Yielding::substeps_per_sample`]). A *record pass* is `N` samples plus
+//! ([`Yielding::substeps_per_sample`]; on the host, x86-64, about 8 ns per oscillator
+//! sub-step in `f64` and 9 in `f32`: a serial chain per oscillator, not vectorized across
+//! the bank). A *record pass* is `N` samples plus
 //! [`Yielding::free_vibration_samples`] of free vibration: the constant-strength spectrum
 //! takes 2 passes, the constant-ductility spectrum `1 + (points − 1) + refinement` at most
 //! (see [`Yielding::constant_ductility`]; the passes are reported). No allocation, no
@@ -466,8 +468,8 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// time still advances by `h` with the last finite sample held in its place, as in
     /// [`Bank::step`](super::Bank::step).
     ///
-    /// Cost: `Σ_p n_p` sub-steps ([`Yielding::substeps_per_sample`]) of about 20 flops and
-    /// 3 comparisons each; no allocation, no panic.
+    /// Cost: `Σ_p n_p` sub-steps ([`Yielding::substeps_per_sample`]) of about 30 flops and
+    /// 4 comparisons each, whatever the branch; no allocation, no panic.
     pub fn step(&self, r: &mut YieldResponse<T, P>, ag: T) {
         let a1 = if super::finite(ag) {
             ag
@@ -551,12 +553,12 @@ impl<T: Real, const P: usize> Yielding<T, P> {
                 let yields = q > lim || -q > lim;
                 let (u1, f1) = if yields { (u_p, f_p) } else { (u_e, f_e) };
                 v = two_h * (u1 - u) - v;
-                if yields {
-                    let ddp = (u1 - u) - (f1 - f) * inv_w2;
-                    work += ddp * (f1 - half * hard * ddp);
-                    plastic += if ddp > zero { ddp } else { -ddp };
-                    count = count.saturating_add(1);
-                }
+                // plastic increment Δd_p = Δu − Δf/ω² (zero, not rounding, when elastic)
+                let ddp = (u1 - u) - (f1 - f) * inv_w2;
+                let ddp = if yields { ddp } else { zero };
+                work += ddp * (f1 - half * hard * ddp);
+                plastic += if ddp > zero { ddp } else { -ddp };
+                count = count.saturating_add(u32::from(yields));
                 u = u1;
                 f = f1;
                 g = g1;
@@ -681,7 +683,9 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// `search` is out of range ([`Search`]; its `tol` below `4 ε` of `T`), or the record
     /// leaves an oscillator at rest. Cost: `1 + (k_max) + refinement` record passes,
     /// `k_max ≤ points − 1` the grid index of the slowest bracket; refinement at most
-    /// `2 ⌈log₂((1 − ρ)/tol)⌉ + 2`, typically 5 to 10 ([`ConstantDuctility::passes`]).
+    /// `2 ⌈log₂((1 − ρ)/tol)⌉ + 2`, typically 5 to 10 ([`ConstantDuctility::passes`];
+    /// measured with [`Search::DEFAULT`] on El Centro, 10 periods 0.1–3 s, `μ_t = 2, 4`:
+    /// 22 to 44 passes in all).
     pub fn constant_ductility(
         &self,
         record: &[T],
