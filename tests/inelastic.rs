@@ -530,3 +530,47 @@ fn no_crossing_is_reported() {
         assert!(rel(cd.yield_acceleration[p], 0.9 * cd.elastic[p]) < 1e-12);
     }
 }
+
+/// Several strengths give the target: the library returns the largest (Chopra §7.5). Two
+/// EPP oscillators whose μ(a_y) on El Centro crosses the target three times (found by a
+/// scan): a dense scan of the library's own μ (1 800 strengths from `a_y0` down to
+/// `0.1 a_y0`) lists the crossings, and the search's answer is the largest one, within the
+/// scan's spacing; it is well above the smallest.
+#[test]
+fn largest_of_several_crossings() {
+    let t = [19.0, 23.0].map(|i: f64| 0.05 * 100f64.powf(i / 39.0)); // 0.471 s, 0.756 s
+    let y = Yielding::<f64, 2>::new(t, [ZETA; 2], 0.0, DT).unwrap();
+    let a0 = y.elastic_strength(record());
+    for (p, mu_t) in [(0usize, 2.0), (1, 4.0)] {
+        let m = 1800;
+        let mut crossings = Vec::new();
+        let mut prev: Option<(f64, f64)> = None;
+        for k in 0..=m {
+            let eta = 1.0 - 0.9 * k as f64 / m as f64;
+            let ay = a0.map(|x| x * eta);
+            let mu = y.response(record(), &ay).unwrap().ductility()[p];
+            if let Some((a_prev, mu_prev)) = prev
+                && (mu_prev - mu_t) * (mu - mu_t) <= 0.0
+            {
+                crossings.push(0.5 * (a_prev + ay[p]));
+            }
+            prev = Some((ay[p], mu));
+        }
+        println!("T {:.3} μ_t {mu_t}: crossings at a_y {crossings:?}", t[p]);
+        assert!(crossings.len() >= 3, "not a multiple-solution case");
+        let largest = crossings[0]; // the scan runs downward
+        let smallest = *crossings.last().unwrap();
+        let spacing = 0.9 * a0[p] / m as f64;
+        let cd = y
+            .constant_ductility(record(), mu_t, &Search::DEFAULT)
+            .unwrap();
+        let got = cd.yield_acceleration[p];
+        assert_eq!(cd.outcome[p], Outcome::Converged);
+        assert!(
+            (got - largest).abs() <= spacing,
+            "T = {}: {got} vs the largest crossing {largest}",
+            t[p]
+        );
+        assert!(got - smallest > 10.0 * spacing);
+    }
+}
