@@ -96,7 +96,7 @@ use core::f64::consts::TAU;
 /// [`YieldResponse`] carries its own ([`Yielding::at_rest`]), so one bank serves every
 /// strength of a root find.
 ///
-/// Size: `13P` values of `T`, `2P` bytes, `2P + 2` `f64` and one `T`.
+/// Size: `9P + 1` values of `T`, `2P` bytes and `2P + 2` `f64`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Yielding<T, const P: usize> {
@@ -277,7 +277,7 @@ yielding_ctor!(f64, new_f64, with_f64);
 /// its peaks so far. Start with [`Yielding::at_rest`]; feed samples with
 /// [`Yielding::step`].
 ///
-/// Units follow the samples (m/s² in, m out). Size: `10P + 1` values of `T`, `P` `u32` and
+/// Units follow the samples (m/s² in, m out). Size: `9P + 1` values of `T`, `P` `u32` and
 /// two counters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
