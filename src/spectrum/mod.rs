@@ -41,6 +41,13 @@
 //! [`Bank::free_vibration_samples`] (one period of the longest oscillator) is long enough.
 //! The difference it makes on El Centro is in `docs/spectrum.md`.
 //!
+//! **Inelastic spectra** ([`inelastic`]): a bank of yielding oscillators (bilinear with
+//! kinematic hardening, elastic–perfectly plastic at `α = 0`) stepped by the same AEM
+//! kinematics, the implicit step solved exactly by return mapping at a fixed cost; over a
+//! record, the constant-strength spectrum (ductility for given `R`) and the
+//! constant-ductility spectrum (the largest strength giving a target ductility, bracketed
+//! on a grid then refined by a safeguarded root find).
+//!
 //! **Bad input**: a non-positive or non-finite period, periods out of order, or a damping
 //! ratio outside `[0, 1)` are typed errors at build time ([`Error::InvalidPeriod`],
 //! [`Error::InvalidDamping`]); a non-finite sample is skipped and counted, the peaks kept
@@ -52,6 +59,8 @@
 mod bank;
 mod operators;
 mod rotd;
+
+pub mod inelastic;
 
 #[cfg(feature = "std")]
 #[cfg_attr(docsrs, doc(cfg(feature = "std")))]
