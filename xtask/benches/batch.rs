@@ -46,14 +46,18 @@ fn loadavg() -> String {
 
 fn main() {
     let skip_criterion = std::env::args().any(|a| a == "--skip-criterion");
+    // `cargo test` runs this target without `--bench`, unoptimized: a smoke run of a few
+    // short jobs (the batch equals the serial loop), no timing.
+    let smoke = !std::env::args().any(|a| a == "--bench");
+    let records = if smoke { 4 } else { RECORDS };
     println!("LOADAVG before {}", loadavg());
     let rec = elcentro::AG_F64;
 
     // (a) 200 spectra
-    let recs: Vec<Vec<f64>> = (0..RECORDS)
+    let recs: Vec<Vec<f64>> = (0..records)
         .map(|i| {
             rec.iter()
-                .map(|a| a * (0.5 + i as f64 / RECORDS as f64))
+                .map(|a| a * (0.5 + i as f64 / records as f64))
                 .collect()
         })
         .collect();
@@ -71,8 +75,12 @@ fn main() {
     // (b) 100 yielding analyses
     let building = ida::building().expect("building");
     let stepper = ida::stepper().expect("stepper");
-    let scales = ida::scales();
-    let steps = ida::steps(rec.len());
+    let mut scales = ida::scales();
+    let mut steps = ida::steps(rec.len());
+    if smoke {
+        scales.truncate(2);
+        steps = 400;
+    }
     let analyses = |threads: usize| -> Vec<f64> {
         batch::map(black_box(&scales), threads, |&s| {
             ida::peak_drift(&building, &stepper, &rec, s, steps).expect("converged")
@@ -94,6 +102,13 @@ fn main() {
         peaks.iter().filter(|&&d| d > yield_drift).count(),
         scales.len()
     );
+
+    if smoke {
+        spectra(1);
+        spectra(2);
+        println!("smoke run (cargo test); `cargo bench -p xtask --bench batch` measures");
+        return;
+    }
 
     if std::env::args().any(|a| a == "--ida-serial") {
         let mut best = f64::INFINITY;
