@@ -18,7 +18,7 @@ The OpenSees model (the choices, each checked by the drift comparison):
   it takes no stiffness-proportional damping;
 - `rayleigh a0 0 a1 0` (betaKinit = a1): C = a0 M + a1 K_initial, constant, as in aemstep;
 - `UniformExcitation` (load −M ι a_g) of a `Path` time series holding a_g at every step,
-  interpolated to h = 0.005 in Python by the same integer rule as scenes/yielding5/building.rs;
+  interpolated to h = 0.005 in Python by the same integer rule as scenes/ida/building.rs;
 - `integrator Newmark 0.5 0.25`, `algorithm Newton`, `numberer Plain`, `constraints Plain`,
   the fastest `system` of those tried; `test NormUnbalance` (the residual, as aemstep's
   test) at 1e-12 × the storey yield force (aemstep's is relative to the force scale);
@@ -45,7 +45,7 @@ TARGET = os.environ.get("CARGO_TARGET_DIR", os.path.join(ROOT, "target"))
 DOC = os.path.join(ROOT, "docs", "performance.md")
 BEGIN, END = "<!-- nonlinear peers: begin -->", "<!-- nonlinear peers: end -->"
 
-# scenes/yielding5/building.rs
+# scenes/ida/building.rs
 MASS, STIFF, FY, ALPHA, XI, SCALE, RATE, STEPS, TOL = 1e5, 1e8, 3.0e6, 0.05, 0.05, 2.0, 200, 15975, 1e-12
 G = 9.80665  # scenes/modal/elcentro.rs `G`
 H = 1.0 / RATE
@@ -57,7 +57,7 @@ def record():
 
 
 def ground(ag, n, scale):
-    """scenes/yielding5/building.rs `ground`, operation for operation."""
+    """scenes/ida/building.rs `ground`, operation for operation."""
     pos = n * 50
     i, rem = pos // RATE, pos % RATE
     if i + 1 >= len(ag):

@@ -5,7 +5,8 @@
 //! h = 1/[`RATE`] s, stepped by `Nonlinear::<f64, 5>` with Newton up to 50 iterations to
 //! 1e-12. One run returns the peak absolute storey drift.
 //!
-//! Shared by `xtask/benches/batch.rs` (the scaling benchmark) and `tests/batch.rs`; the
+//! Shared by `xtask/benches/batch.rs` (the scaling benchmark), `tests/batch.rs` and
+//! `xtask/src/bin/nonlinear_bench.rs` (the step beside OpenSees, record ×[`SCALE`]); the
 //! record is passed in (`elcentro::AG_F64`, `scenes/modal/elcentro.rs`).
 #![allow(dead_code)] // each includer uses a different subset
 
@@ -15,6 +16,14 @@ use aemstep::{Error, NewtonSettings, Nonlinear, models};
 
 /// Storeys.
 pub const N: usize = 5;
+/// Floor mass (kg), every floor.
+pub const MASS: f64 = models::FIVE_STOREY_MASS;
+/// Storey stiffness (N/m), every storey.
+pub const STIFFNESS: f64 = models::FIVE_STOREY_STIFFNESS;
+/// Rayleigh damping ratio in modes 1 and 2.
+pub const XI: f64 = models::FIVE_STOREY_DAMPING;
+/// The record scale of the single-run benchmark (`nonlinear_bench`, the OpenSees twin).
+pub const SCALE: f64 = 2.0;
 /// Every storey's yield force (N): yield drift `FY / FIVE_STOREY_STIFFNESS` = 3 cm.
 pub const FY: f64 = 3.0e6;
 /// Post-yield stiffness ratio.

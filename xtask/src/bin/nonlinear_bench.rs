@@ -13,7 +13,7 @@
 
 #[path = "../../../scenes/modal/elcentro.rs"]
 mod elcentro;
-#[path = "../../../scenes/yielding5/building.rs"]
+#[path = "../../../scenes/ida/building.rs"]
 mod scene;
 
 use std::fmt::Write as _;
@@ -87,7 +87,7 @@ fn law_trial_flops(law: LawKind) -> f64 {
 fn damping<const N: usize>() -> Rows<N> {
     let (m, k) = models::shear_building([scene::MASS; N], [scene::STIFFNESS; N]);
     if N == 5 {
-        let c = scene::BLD.1;
+        let c = models::five_storey_building().1;
         let mut out = [[0.0; N]; N];
         for i in 0..N {
             out[i].copy_from_slice(&c[i]);
@@ -116,7 +116,7 @@ fn run<L: Law<f64>, const N: usize>(
 ) -> Run {
     let stepper = Nonlinear::<f64, N>::new(
         1.0 / scene::RATE as f64,
-        NewtonSettings::up_to(scene::BUDGET, scene::TOL),
+        NewtonSettings::up_to(scene::NEWTON_ITERATIONS, scene::NEWTON_TOLERANCE),
     )
     .expect("settings");
     let zero = SVector::<f64, N>::zeros();
@@ -125,8 +125,8 @@ fn run<L: Law<f64>, const N: usize>(
         .expect("start");
     let mut iterations = 0u64;
     let mut peak = 0.0f64;
-    for n in 1..=scene::STEPS {
-        let ag = scene::ground(&elcentro::AG_F64, n, scene::RATE, scale);
+    for n in 1..=scene::steps(elcentro::SAMPLES) {
+        let ag = scene::ground(&elcentro::AG_F64, scale, n);
         let r = stepper
             .try_step_with_history(b, &mut s, &mut h, &b.ground_load(ag))
             .expect("step");
@@ -141,7 +141,7 @@ fn run<L: Law<f64>, const N: usize>(
     }
     Run {
         iterations,
-        steps: scene::STEPS,
+        steps: scene::steps(elcentro::SAMPLES),
         peak,
     }
 }
