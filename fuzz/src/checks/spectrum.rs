@@ -1,10 +1,13 @@
 //! Fuzz target `spectrum` (`fuzz_targets/spectrum.rs`): checks Bank::new, Bank::with (both
-//! schemes, every sub-step rule), RotD, the host batch; f32 and f64.
+//! schemes, every sub-step rule), RotD, the host batch, and the yielding bank
+//! (`inelastic::Yielding`: construction, streaming, constant strength and constant
+//! ductility); f32 and f64.
 //!
 //! The decoder and the checks every target shares are in `common.rs`.
 
 use std::fmt::Debug;
 
+use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
 use aemstep::spectrum::{Bank, Response, RotD, RotDResponse, Scheme, Substeps};
 use aemstep::{Error, Real};
 
@@ -46,12 +49,36 @@ pub fn spectrum(data: &[u8]) {
         })
         .collect();
     let batch = b.pick(8) == 0;
+    let yielding = Inelastic {
+        alpha: match b.pick(4) {
+            0 => b.value(),
+            1 => 0.0,
+            _ => b.param(0.0, 0.5),
+        },
+        ay: [b.value(), b.param(0.01, 20.0), f64::INFINITY],
+        reduction: [b.param(1.0, 8.0), b.value(), b.param(1.0, 8.0)],
+        target: match b.pick(4) {
+            0 => b.value(),
+            _ => b.param(1.0, 8.0),
+        },
+        search: Search {
+            points: b.u16() % 40,
+            lowest: b.param(0.0, 1.0),
+            tol: match b.pick(4) {
+                0 => b.value(),
+                _ => 10f64.powf(-7.0 * b.unit()),
+            },
+        },
+    };
     set_context(format!(
-        "periods = {period:?}, damping = {damping:?}, dt = {dt:e}, scheme = {scheme:?}, substeps = {sub:?}, samples = {samples:?}, batch = {batch}"
+        "periods = {period:?}, damping = {damping:?}, dt = {dt:e}, scheme = {scheme:?}, substeps = {sub:?}, samples = {samples:?}, batch = {batch}, yielding = {yielding:?}"
     ));
     let r64 = bank_typed::<f64>(&period, &damping, dt, scheme, sub, &samples, batch);
     let r32 = bank_typed::<f32>(&period, &damping, dt, scheme, sub, &samples, batch);
     same_kind(SP, "Bank f64 vs f32", &r64, &r32);
+    let y64 = inelastic_typed::<f64>(&period, &damping, dt, sub, &samples, &yielding, r64);
+    let y32 = inelastic_typed::<f32>(&period, &damping, dt, sub, &samples, &yielding, r32);
+    same_kind(SP, "Yielding f64 vs f32", &y64, &y32);
     count(SP, "inputs");
     count(SP, b.category());
 }
@@ -258,4 +285,131 @@ fn at_rest<T: Real + 'static>(
         Box::new((rot, b.at_rest(), rr))
     };
     *x.downcast().expect("the scalar asked for")
+}
+
+/// The yielding bank's own data (beside the elastic bank's periods, damping, step, rule).
+#[derive(Debug)]
+struct Inelastic {
+    alpha: f64,
+    ay: [f64; 3],
+    reduction: [f64; 3],
+    target: f64,
+    search: Search,
+}
+
+/// `inelastic::Yielding` on the same periods, damping, step and sub-step rule as the
+/// elastic bank: the same variant for the same bad data (the elastic bank's error
+/// `bank_err`, then `InvalidMaterial` for α outside `[0, 1)`); strengths, reduction
+/// factors, targets and search settings out of range are typed errors; streaming never
+/// panics, skips and counts non-finite samples, and its peaks never fall; a
+/// constant-ductility result keeps its strength inside its bracket.
+fn inelastic_typed<T: Real>(
+    period: &[f64; 3],
+    damping: &[f64; 3],
+    dt: f64,
+    sub: Substeps,
+    samples: &[(f64, f64)],
+    y: &Inelastic,
+    bank_err: Option<Error>,
+) -> Option<Error> {
+    let bank = Yielding::<T, 3>::with(*period, *damping, y.alpha, dt, sub);
+    outcome(SP, &bank);
+    let got = bank.as_ref().err().copied();
+    let alpha_ok = y.alpha.is_finite() && (0.0..1.0).contains(&y.alpha);
+    match bank_err {
+        // The elastic bank's data errors come first, in its order.
+        Some(e) if e != Error::OperatorOverflow => check!(
+            got == Some(e),
+            "{SP}: Yielding::with gave {got:?} where Bank::with gave {e:?}"
+        ),
+        _ if !alpha_ok => check!(
+            got == Some(Error::InvalidMaterial) || got == bank_err,
+            "{SP}: Yielding::with with α = {} gave {got:?}",
+            y.alpha
+        ),
+        _ => check!(
+            got.is_none() || got == Some(Error::OperatorOverflow),
+            "{SP}: Yielding::with gave {got:?} for data within the rule"
+        ),
+    }
+    let Ok(bank) = bank else { return got };
+    let ay = y.ay.map(T::from_f64_rounded);
+    let rest = bank.at_rest(&ay);
+    outcome(SP, &rest);
+    let bad_strength = ay.iter().any(|&a| !(a > T::zero()));
+    if bad_strength {
+        check!(
+            rest == Err(Error::InvalidMaterial),
+            "{SP}: Yielding::at_rest with strengths {ay:?} gave {:?}",
+            rest.as_ref().err()
+        );
+    }
+    let record: Vec<T> = samples
+        .iter()
+        .map(|&(x, _)| T::from_f64_rounded(x))
+        .collect();
+    if let Ok(mut r) = rest {
+        for &x in &record {
+            let before = r;
+            bank.step(&mut r, x);
+            count(SP, "yielding samples");
+            check!(
+                r.samples() == before.samples() + 1
+                    && r.skipped() == before.skipped() + u64::from(!x.is_finite()),
+                "{SP}: Yielding::step did not count a sample"
+            );
+            for p in 0..3 {
+                check!(!(r.sd()[p] < before.sd()[p]), "{SP}: a yielding peak fell");
+            }
+        }
+        bank.free_vibration(&mut r, bank.free_vibration_samples().min(40));
+    }
+    // The whole-record functions step the record and one longest period of free vibration
+    // per pass (a constant-ductility search makes up to `points + 128` passes): only where
+    // that is cheap, so every input stays fast (a long period at a tiny step is a
+    // legitimate, slow input).
+    let work = (record.len() as u64 + u64::from(bank.free_vibration_samples()))
+        * u64::from(bank.substeps_per_sample());
+    if work > 4_000 {
+        count(SP, "yielding whole-record checks skipped (slow input)");
+        return None;
+    }
+    let reduction = y.reduction.map(T::from_f64_rounded);
+    let cs = bank.constant_strength(&record, &reduction);
+    outcome(SP, &cs);
+    if let Err(e) = cs {
+        check!(
+            matches!(e, Error::InvalidParameter | Error::InvalidMaterial),
+            "{SP}: constant_strength gave {e:?}"
+        );
+    }
+    if reduction.iter().any(|&x| !(x > T::zero() && x.is_finite())) {
+        check!(
+            cs.as_ref().err() == Some(&Error::InvalidParameter),
+            "{SP}: constant_strength with R = {reduction:?} gave {:?}",
+            cs.as_ref().err()
+        );
+    }
+    let cd = bank.constant_ductility(&record, T::from_f64_rounded(y.target), &y.search);
+    outcome(SP, &cd);
+    match cd {
+        Err(e) => check!(
+            matches!(e, Error::InvalidParameter | Error::InvalidMaterial),
+            "{SP}: constant_ductility gave {e:?}"
+        ),
+        Ok(c) => {
+            count(SP, "constant-ductility searches");
+            for p in 0..3 {
+                if c.outcome[p] == Outcome::Converged {
+                    let (lo, hi) = (c.bracket[p][0], c.bracket[p][1]);
+                    let a = c.yield_acceleration[p];
+                    check!(
+                        lo <= a && a <= hi,
+                        "{SP}: constant_ductility strength {a:?} outside its bracket [{lo:?}, {hi:?}]"
+                    );
+                }
+            }
+        }
+    }
+    None
 }
