@@ -538,21 +538,11 @@ impl<T: Real, const P: usize> Bank<T, P> {
     /// oscillator whose bound fails (about 2 % of the checks on El Centro,
     /// [`Response::walks`]); no allocation, no panic.
     pub fn step(&self, r: &mut Response<T, P>, ag: T) {
-        let a1 = if super::finite(ag) {
-            ag
-        } else {
-            r.skipped += 1;
-            r.last
-        };
-        if r.samples == 0 {
-            // t = 0: at rest, u'' = −a_g, absolute acceleration 0; nothing to step.
-            r.last = a1;
-        } else {
-            let a0 = r.last;
-            r.last = a1;
+        // t = 0: at rest, u'' = −a_g, absolute acceleration 0; nothing to step.
+        if let Some((a0, a1)) = super::take_sample(&mut r.last, &mut r.samples, &mut r.skipped, ag)
+        {
             self.advance_wide(r, a0, a1);
         }
-        r.samples += 1;
     }
 
     /// Continue after the record in free vibration: the ground acceleration returns
@@ -587,19 +577,7 @@ impl<T: Real, const P: usize> Bank<T, P> {
     /// absolute acceleration) comes within one period; stepping this long catches it.
     /// Cost: a scan of the periods.
     pub fn free_vibration_samples(&self) -> u32 {
-        let mut t = 0.0f64;
-        for &p in &self.period {
-            if p > t {
-                t = p;
-            }
-        }
-        let x = t / self.time_step;
-        let f = x as u32; // saturating cast
-        if (f as f64) < x {
-            f.saturating_add(1)
-        } else {
-            f
-        }
+        super::longest_period_samples(&self.period, self.time_step)
     }
 
     /// [`Bank::advance`], on x86-64 compiled with AVX when the CPU has it (4 `f64` or 8

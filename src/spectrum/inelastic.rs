@@ -471,20 +471,10 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// Cost: `Σ_p n_p` sub-steps ([`Yielding::substeps_per_sample`]) of about 30 flops and
     /// 4 comparisons each, whatever the branch; no allocation, no panic.
     pub fn step(&self, r: &mut YieldResponse<T, P>, ag: T) {
-        let a1 = if super::finite(ag) {
-            ag
-        } else {
-            r.skipped += 1;
-            r.last
-        };
-        if r.samples == 0 {
-            r.last = a1;
-        } else {
-            let a0 = r.last;
-            r.last = a1;
+        if let Some((a0, a1)) = super::take_sample(&mut r.last, &mut r.samples, &mut r.skipped, ag)
+        {
             self.advance(r, a0, a1);
         }
-        r.samples += 1;
     }
 
     /// Continue after the record in free vibration: the ground acceleration returns
@@ -508,17 +498,7 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// vibration the record-level functions append to the record. Cost: a scan of the
     /// periods.
     pub fn free_vibration_samples(&self) -> u32 {
-        let t = self
-            .period
-            .iter()
-            .fold(0.0f64, |m, &p| if p > m { p } else { m });
-        let x = t / self.time_step;
-        let f = x as u32; // saturating
-        if (f as f64) < x {
-            f.saturating_add(1)
-        } else {
-            f
-        }
+        super::longest_period_samples(&self.period, self.time_step)
     }
 
     /// One sample interval `a0 → a1`: `n_p` sub-steps of every oscillator.

@@ -77,6 +77,45 @@ pub(crate) fn finite<T: crate::Real>(x: T) -> bool {
     x - x == T::from_f64_rounded(0.0)
 }
 
+/// A bank's bookkeeping of one new ground-acceleration sample `ag` (shared by [`Bank`] and
+/// [`inelastic::Yielding`]): a non-finite sample is counted in `skipped` and replaced by the
+/// last finite one; `last` becomes the sample held; the first sample (at rest, `t = 0`)
+/// closes no interval, every later one the interval `(a_{n−1}, a_n)` returned.
+/// Cost: a few comparisons.
+#[inline(always)]
+pub(crate) fn take_sample<T: crate::Real>(
+    last: &mut T,
+    samples: &mut u64,
+    skipped: &mut u64,
+    ag: T,
+) -> Option<(T, T)> {
+    let a1 = if finite(ag) {
+        ag
+    } else {
+        *skipped += 1;
+        *last
+    };
+    let first = *samples == 0;
+    *samples += 1;
+    let a0 = core::mem::replace(last, a1);
+    (!first).then_some((a0, a1))
+}
+
+/// One period of the longest oscillator in samples of `h`, `⌈T_max/h⌉` (saturating at
+/// `u32::MAX`): the free vibration that catches every peak after a record. Cost: a scan.
+pub(crate) fn longest_period_samples(periods: &[f64], h: f64) -> u32 {
+    let t = periods
+        .iter()
+        .fold(0.0f64, |m, &p| if p > m { p } else { m });
+    let x = t / h;
+    let f = x as u32; // saturating cast
+    if (f as f64) < x {
+        f.saturating_add(1)
+    } else {
+        f
+    }
+}
+
 /// The largest number of sub-steps per sample an oscillator takes (`Substeps` is clamped
 /// to it).
 pub const MAX_SUBSTEPS: u16 = 1024;
