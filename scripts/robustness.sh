@@ -35,7 +35,7 @@ def fuzz_section(path):
         nonlinear="`Nonlinear` (cubic springs, analytic or finite-difference tangent; Newton settings), `Varying`; N = 1, 2",
         hysteresis="`Bilinear`, `BoucWen`, `Friction`, `Parallel` (trials along a path), `ShearBuilding`, its `Nonlinear` steps with history",
         observer="`StateSpace` (aem, from_rows_aem, exact, modal; wrong S), outputs, `SteadyState`, `Observer` (new, from_parts_f32/_f64), `Kalman`, `Readout`",
-        spectrum="`Bank` (new, with: both schemes, every sub-step rule), `RotD`, `batch::spectra`",
+        spectrum="`Bank` (new, with: both schemes, every sub-step rule), `RotD`, `batch::spectra`, `inelastic::Yielding` (with, at_rest, step, constant_strength, constant_ductility)",
         estimation="`InputModel` (from_parts, zero_dynamics), `InputStateGains` (solve, new), `InputStateObserver` (new, from_parts_f32/_f64), `InputStateFilter`, `DualGains`, `DualFilter` (new, from_parts_f32/_f64), `AugmentedModel`, `FixedLag` (new, from_parts_f32/_f64); S = 2, 4, O = 1 … 3",
         detection="`chi_square_quantile`, `normal_quantile`, `innovation_covariance`, `Whitener` (new, from_rows_f32/_f64), `Window`, `ChiSquareTest`, `Detector`, `Cusum`, `ModelBank`, `Observer::step_innovation`, `Kalman::try_step_innovation`",
         hybrid="`KrAlpha` (new, chen_ricles, from_rows_f32/_f64, from_rows_chen_ricles_f32/_f64), `hybrid::Split` (the same with `K_num`; start, start_with_acceleration, command, complete with NaN, infinite and specimen forces); N = 1, 2, 3; `hybrid::Actuator`, `Polynomial` (new, new_f32/_f64), `Adaptive` on command sequences with NaN and infinite values",
