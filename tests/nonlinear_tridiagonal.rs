@@ -165,14 +165,8 @@ impl HistoryModel<f64, 3> for Chain {
         }
     }
     fn tangent(&self, _: &(), _: &SVector<f64, 3>, _: &SVector<f64, 3>) -> Option<Tangent<f64, 3>> {
-        let b = self.band();
-        let k = SMatrix::from_fn(|i, j| match i.abs_diff(j) {
-            0 => b.diagonal[i],
-            1 => b.off[i.max(j)],
-            _ => 0.0,
-        });
         Some(Tangent {
-            stiffness: k,
+            stiffness: self.band().to_matrix(),
             damping: SMatrix::zeros(),
         })
     }
@@ -366,11 +360,7 @@ fn banded_products_equal_dense_ones() {
                 }
             }),
         };
-        let dense = SMatrix::<f64, 6, 6>::from_fn(|i, j| match i.abs_diff(j) {
-            0 => a.diagonal[i],
-            1 => a.off[i.max(j)],
-            _ => 0.0,
-        });
+        let dense = a.to_matrix();
         let x = SVector::<f64, 6>::from_fn(|_, _| range(&mut rng, -1.0, 1.0));
         assert_eq!(a.mul(&x), dense * x);
     }
@@ -392,16 +382,9 @@ fn banded_products_equal_dense_ones() {
         let trial = building.trial(&h, &u, &v);
         assert_eq!(banded, trial);
         let dense = building.tangent(&h, &u, &v).unwrap();
-        let full = |b: &SymTridiagonal<f64, 5>| {
-            SMatrix::<f64, 5, 5>::from_fn(|i, j| match i.abs_diff(j) {
-                0 => b.diagonal[i],
-                1 => b.off[i.max(j)],
-                _ => 0.0,
-            })
-        };
-        assert_eq!(full(&t.stiffness), dense.stiffness);
-        assert_eq!(full(&t.damping), dense.damping);
-        assert_eq!(full(&t.mass), building.mass());
+        assert_eq!(t.stiffness.to_matrix(), dense.stiffness);
+        assert_eq!(t.damping.to_matrix(), dense.damping);
+        assert_eq!(t.mass.to_matrix(), building.mass());
     }
     // A damping matrix with a coupling beyond the neighbours keeps the dense path.
     let (m, mut c, _) = models::five_storey_building();

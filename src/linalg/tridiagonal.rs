@@ -60,15 +60,6 @@ pub(crate) fn solve_positive<T: Real, const N: usize>(
 mod tests {
     use super::*;
     use crate::linalg::lu::solve_in_place;
-    use nalgebra::SMatrix;
-
-    fn dense<const N: usize>(a: &SymTridiagonal<f64, N>) -> SMatrix<f64, N, N> {
-        SMatrix::from_fn(|i, j| match i.abs_diff(j) {
-            0 => a.diagonal[i],
-            1 => a.off[i.max(j)],
-            _ => 0.0,
-        })
-    }
 
     /// A positive definite shear-building-like matrix: the solve agrees with pivoted LU to
     /// a few `κ ε` (here `κ(A) < 10`, so well under `1e-14`), and `A x` gives `b` back.
@@ -82,11 +73,11 @@ mod tests {
         let b = SVector::<f64, N>::from_fn(|i, _| (i as f64 * 0.7).sin());
         let mut x = b;
         assert!(solve_positive(&a, &mut x, 5.0));
-        let (mut lu, mut y) = (dense(&a), b);
+        let (mut lu, mut y) = (a.to_matrix(), b);
         assert!(solve_in_place(&mut lu, &mut y, 5.0));
         let err = (x - y).amax() / y.amax();
         assert!(err < 1e-14, "tridiagonal vs LU: {err:e}");
-        let back = (dense(&a) * x - b).amax();
+        let back = (a.to_matrix() * x - b).amax();
         assert!(back < 1e-14, "residual {back:e}");
     }
 

@@ -77,6 +77,15 @@ impl<T: Real, const N: usize> SymTridiagonal<T, N> {
         SVector::from(y)
     }
 
+    /// The same matrix laid out densely (`N×N`, zero off the three diagonals). Cost: `N²`.
+    pub fn to_matrix(&self) -> SMatrix<T, N, N> {
+        SMatrix::from_fn(|row, col| match row.abs_diff(col) {
+            0 => self.diagonal[row],
+            1 => self.off[row.max(col)],
+            _ => T::zero(),
+        })
+    }
+
     /// Every entry read (the diagonal and `off[1..]`) is finite. Cost: `2N`.
     fn is_finite(&self) -> bool {
         self.diagonal.iter().all(|x| x.is_finite())
@@ -670,12 +679,7 @@ impl<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>
         }
         // Not positive definite (a softening storey): pivot, on the same J.
         *r = rhs;
-        let mut dense = SMatrix::<T, N, N>::from_fn(|row, col| match row.abs_diff(col) {
-            0 => j.diagonal[row],
-            1 => j.off[row.max(col)],
-            _ => T::zero(),
-        });
-        if !solve_in_place(&mut dense, r, scale) {
+        if !solve_in_place(&mut j.to_matrix(), r, scale) {
             return Err(Error::SingularJacobian);
         }
         Ok(())
