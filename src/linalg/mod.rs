@@ -30,6 +30,19 @@ use nalgebra::SMatrix;
 
 use crate::Real;
 
+/// Run `f` (inlined loops over independent lanes, such as the spectrum bank's step over
+/// its oscillators) at the host's vector width: on x86-64, compiled with AVX when the CPU
+/// has it ([`avx::run`]: same bits, see its module docs); on every other target, as is.
+/// The one dispatch point, so callers hold no `cfg` pairs. Cost: on x86-64 a relaxed load,
+/// a branch and a call; elsewhere none.
+#[inline(always)]
+pub(crate) fn wide<R>(f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    return avx::run(f);
+    #[cfg(not(target_arch = "x86_64"))]
+    f()
+}
+
 /// A row-major `N×N` matrix of `f64` (`a[i][j]`: row `i`, column `j`), the form the
 /// `const fn` constructors (`from_rows`) take.
 ///

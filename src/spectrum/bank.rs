@@ -541,7 +541,9 @@ impl<T: Real, const P: usize> Bank<T, P> {
         // t = 0: at rest, u'' = −a_g, absolute acceleration 0; nothing to step.
         if let Some((a0, a1)) = super::take_sample(&mut r.last, &mut r.samples, &mut r.skipped, ag)
         {
-            self.advance_wide(r, a0, a1);
+            // On x86-64 with AVX, 4 `f64` or 8 `f32` oscillators a packed operation
+            // instead of 2 or 4 (same bits, `linalg::wide`).
+            crate::linalg::wide(|| self.advance(r, a0, a1));
         }
     }
 
@@ -555,10 +557,7 @@ impl<T: Real, const P: usize> Bank<T, P> {
         if r.samples == 0 {
             return;
         }
-        #[cfg(target_arch = "x86_64")]
-        crate::linalg::avx::run(|| self.ring_out(r, samples));
-        #[cfg(not(target_arch = "x86_64"))]
-        self.ring_out(r, samples);
+        crate::linalg::wide(|| self.ring_out(r, samples));
     }
 
     /// The loop of [`Bank::free_vibration`] (inlined where it is called).
@@ -578,17 +577,6 @@ impl<T: Real, const P: usize> Bank<T, P> {
     /// Cost: a scan of the periods.
     pub fn free_vibration_samples(&self) -> u32 {
         super::longest_period_samples(&self.period, self.time_step)
-    }
-
-    /// [`Bank::advance`], on x86-64 compiled with AVX when the CPU has it (4 `f64` or 8
-    /// `f32` oscillators a packed operation instead of 2 or 4; same bits, see
-    /// `linalg::avx::run`), elsewhere as is.
-    #[inline(always)]
-    fn advance_wide(&self, r: &mut Response<T, P>, a0: T, a1: T) {
-        #[cfg(target_arch = "x86_64")]
-        crate::linalg::avx::run(|| self.advance(r, a0, a1));
-        #[cfg(not(target_arch = "x86_64"))]
-        self.advance(r, a0, a1);
     }
 
     /// One sample interval `a0 → a1`: the peak search between the samples where needed,
@@ -724,7 +712,7 @@ impl<T: Real, const P: usize> Bank<T, P> {
 mod tests {
     use super::*;
 
-    /// The bank stepped through `Bank::step` (on x86-64 with AVX, the `linalg::avx::run`
+    /// The bank stepped through `Bank::step` (on x86-64 with AVX, the `linalg::wide`
     /// path) and through the plain `advance` give the same bits: state, peaks, walks.
     fn same_bits<T: Real>(rest: fn(&Bank<T, 37>) -> Response<T, 37>) {
         let per: [f64; 37] = core::array::from_fn(|i| 0.01 * 1.2f64.powi(i as i32));
