@@ -86,6 +86,14 @@ impl<T: Real, const N: usize> SymTridiagonal<T, N> {
         })
     }
 
+    /// The zero matrix.
+    pub(crate) fn zero() -> Self {
+        Self {
+            diagonal: SVector::zeros(),
+            off: SVector::zeros(),
+        }
+    }
+
     /// Every entry read (the diagonal and `off[1..]`) is finite. Cost: `2N`.
     fn is_finite(&self) -> bool {
         self.diagonal.iter().all(|x| x.is_finite())
@@ -484,10 +492,7 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         if !all_finite(p) {
             return Err(Error::NonFiniteInput);
         }
-        let zero = SymTridiagonal {
-            diagonal: SVector::zeros(),
-            off: SVector::zeros(),
-        };
+        let zero = SymTridiagonal::zero();
         let path = Linearization {
             model,
             committed,
@@ -660,10 +665,7 @@ impl<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>
         }
         let (m, d, k) = (&t.mass, &t.damping, &t.stiffness);
         let mut scale = T::zero();
-        let mut j = SymTridiagonal {
-            diagonal: SVector::zeros(),
-            off: SVector::zeros(),
-        };
+        let mut j = SymTridiagonal::zero();
         for i in 0..N {
             j.diagonal[i] = m.diagonal[i] + b * d.diagonal[i] + c * k.diagonal[i];
             scale =
