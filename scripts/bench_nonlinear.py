@@ -172,7 +172,7 @@ def main():
                              check=True, text=True, capture_output=True).stdout
         aem_drifts = np.loadtxt(path)
     rows = [json.loads(l) for l in out.splitlines() if l.startswith("{")]
-    peak = rows[0]["peak_flops"]
+    peak, chain = rows[0]["peak_flops"], rows[0]["solve_chain_ns"]
     cases = {(r["case"], r.get("n")): r for r in rows[1:]}
 
     second = {n: time_opensees(n, ag, reps, system) for n in ns}
@@ -241,6 +241,17 @@ def main():
               "parameters and its own local Newton) is not integrated as `aemstep::hysteresis::BoucWen`, so the "
               "histories would not be the same scheme. Friction storeys have no Steel01-like peer (OpenSees' "
               "friction models are bearing elements) and are aemstep only.", "",
+              "**The latency floor of one analysis.** A step that corrects its predictor evaluates the "
+              "storeys, solves `J δ = r`, updates `q` and evaluates them again, each part waiting for the last. "
+              f"The solve alone — the `L D Lᵀ` factor-and-solve of the 5×5 tridiagonal `J`, five divisions and two "
+              f"substitutions in one dependency chain — takes {chain:.1f} ns when chained as Newton chains it "
+              "(`solve_chain_ns` in `nonlinear_bench`, fastest of 20). 100× OpenSees' fastest step here is "
+              f"{min(os_pair(5)[0], 1e9) * 1e3 / 100:.1f} ns: the solve's chain is "
+              f"{100 * chain / (min(os_pair(5)[0], 1e9) * 10):.0f} % of it before either evaluation, the residual's "
+              f"norms or the state's checks, and the {cases[('bilinear', 5)]['flops_step']:.0f} flops of the step at "
+              f"the SSE2 rate below take {cases[('bilinear', 5)]['flops_step'] / peak * 1e9:.0f} ns. So one analysis "
+              "cannot step 100× faster than OpenSees on this machine; many analyses at once (a batch, an IDA) share "
+              "the cores instead.", "",
               f"Flops: `flops_per_step` in xtask/src/bin/nonlinear_bench.rs, counted from the code (the tridiagonal "
               f"path: k + 1 trials with their tangents, k solves of J on three diagonals by L D Lᵀ); the floor is that count at the "
               f"host's measured f64 multiply-add rate without AVX, {peak / 1e9:.1f} Gflop/s (24 independent "
