@@ -38,6 +38,8 @@
 //! - [`spectrum`]: response spectra: a bank of damped oscillators fed one
 //!   ground-acceleration sample at a time, RotD50/RotD100, and (feature `std`) many
 //!   records in parallel on the host.
+//! - [`records`]: ground-motion record readers, PEER AT2 and one-column text, into a
+//!   caller's buffer (`no_std`) or a `Vec` (feature `std`).
 //! - `batch` (feature `std`): many independent jobs (records, intensities, periods) on a
 //!   work-stealing pool of a chosen thread count, results in input order.
 //! - [`observer`]: virtual sensing — the discrete state-space form of the linear schemes,
@@ -171,6 +173,7 @@ pub mod hysteresis;
 pub mod modal;
 pub mod models;
 pub mod observer;
+pub mod records;
 
 // `defmt::Format` for the types that hold nalgebra data (feature `defmt`).
 #[cfg(feature = "defmt")]
