@@ -55,7 +55,7 @@
 //! at all (one column). Fortran fields that run together without a space
 //! (`-1.0E-03-2.0E-03`) and `D` exponents are not numbers here. A caller's buffer too
 //! short for the values is [`Error::InvalidParameter`] (size it with [`At2::npts`], or
-//! count [`column`]'s values first). Nothing here panics, on any bytes (a property test
+//! count [`column()`]'s values first). Nothing here panics, on any bytes (a property test
 //! feeds random text).
 //!
 //! **Cost**: one pass over the text, no allocation (except [`Record`]'s `Vec`); each value
@@ -160,13 +160,13 @@ pub fn column(text: &str) -> Values<'_> {
 /// The values of a one-column record into `out` (rounded once to `T`); returns how many.
 /// On an error `out` may be partly written.
 ///
-/// Errors: as [`column`]; [`Error::InvalidParameter`] if `out` is too short. Cost: one
+/// Errors: as [`column()`]; [`Error::InvalidParameter`] if `out` is too short. Cost: one
 /// pass over the text.
 pub fn column_into<T: Real>(text: &str, out: &mut [T]) -> Result<usize, Error> {
     fill(column(text), out)
 }
 
-/// The values of a record ([`At2::values`], [`column`]): an iterator over the text, no
+/// The values of a record ([`At2::values`], [`column()`]): an iterator over the text, no
 /// allocation.
 #[derive(Clone, Debug)]
 pub struct Values<'a> {
@@ -357,10 +357,10 @@ impl Record {
         })
     }
 
-    /// A record from one-column text ([`column`]) sampled every `dt` seconds.
+    /// A record from one-column text ([`column()`]) sampled every `dt` seconds.
     ///
     /// Errors: [`Error::InvalidTimeStep`] if `dt` is not finite and `> 0`;
-    /// [`Error::MalformedRecord`] as [`column`]. Cost: one pass over the text.
+    /// [`Error::MalformedRecord`] as [`column()`]. Cost: one pass over the text.
     pub fn from_column(text: &str, dt: f64) -> Result<Self, Error> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::InvalidTimeStep);

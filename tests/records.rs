@@ -160,6 +160,7 @@ fn one_column() {
     assert_eq!(records::column_into("1\n2\n", &mut out), Ok(2));
 }
 
+#[cfg(feature = "std")]
 #[test]
 fn std_records_from_text_and_files() {
     let r = records::Record::from_at2(AT2).unwrap();
