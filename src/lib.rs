@@ -251,3 +251,8 @@ pub struct DetectionDocDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/hybrid.md")]
 pub struct HybridDocDoctests;
+
+/// As [`ModalDocDoctests`] (its code needs the feature `std`).
+#[cfg(all(doctest, feature = "std"))]
+#[doc = include_str!("../docs/ida.md")]
+pub struct IdaDocDoctests;
