@@ -236,9 +236,12 @@ impl Curve {
         self.collapse.map(|c| c[0])
     }
 
-    /// The intensity at which the curve first reaches `edp` (see [`fractiles`]), and
-    /// whether it is censored (the curve never collapsed and never reached `edp`: then the
-    /// value is its highest non-collapsing intensity, a lower bound). Cost: `O(points)`.
+    /// The intensity at which the curve first reaches `edp` (EDP units, finite, `≥ 0`; `0`
+    /// for `edp ≤ 0`) on its non-collapsing points below its collapse joined by straight
+    /// lines from the origin (see [`fractiles`]), and whether it is censored (the curve
+    /// never collapsed and never reached `edp`: then the value is its highest
+    /// non-collapsing intensity, a lower bound). Past its last point a collapsed curve
+    /// gives that point's intensity (the flatline). Cost: `O(points)`.
     pub fn intensity_at(&self, edp: f64) -> (f64, bool) {
         let cap = self.collapse.map_or(f64::INFINITY, |c| c[1]);
         let (mut im0, mut e0) = (0.0f64, 0.0f64);
@@ -417,7 +420,7 @@ where
     settings.check()?;
     let p = Progress {
         done: AtomicUsize::new(0),
-        total: records.len() * settings.runs,
+        total: records.len().saturating_mul(settings.runs),
         report: progress,
     };
     let out = crate::batch::map(records, threads, |r| {

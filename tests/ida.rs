@@ -571,6 +571,9 @@ fn yielding_building_elastic_part_is_the_linear_analysis_scaled() {
     };
     let curves = ida::hunt_fill(&[ag], &settings, 2, analysis, None).unwrap();
     let c = &curves[0];
+    // The pool changes nothing: the record alone on the caller's thread, bit for bit.
+    let alone = ida::trace(&ag, &settings, analysis).unwrap();
+    assert_eq!(bits(std::slice::from_ref(&alone)), bits(&curves));
     let d1 = linear_peak_drift(ag);
     let yield_drift = ida_scene::FY / models::FIVE_STOREY_STIFFNESS;
     let mut elastic = 0;
