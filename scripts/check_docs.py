@@ -121,6 +121,9 @@ GENERATED = {
     "docs/detection.md": dict(cmd=example("detection_building", "{dir}"), out="file"),
     # About 400 runs of the 31 s record at 1024 Hz (the critical-delay searches): ~20 s.
     "docs/hybrid.md": dict(cmd=example("hybrid_building", "{dir}"), out="file"),
+    # 72 yielding-building runs of the whole record (about 670 000 steps) and 3
+    # constant-ductility spectra of 60 periods: about 2 s (release).
+    "docs/ida.md": dict(cmd=example("ida", "{dir}"), out="file"),
 }
 # Generated in place by a slower stage of the test command: compared with the git index.
 IN_PLACE = {

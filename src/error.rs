@@ -97,6 +97,16 @@ pub enum Error {
     /// force–displacement pair at `z = 1`, the drift), so the estimator has no stable
     /// steady state.
     InputNotIdentifiable,
+    /// A ground-motion record's text ([`records`](crate::records)) is malformed at this
+    /// line (1-based): a PEER AT2 header without a readable `NPTS`/`DT` (a count that is not
+    /// a whole number, a `DT` that is not finite and `> 0`), a value that is not a number,
+    /// more or fewer values than the header's `NPTS`, more than one value on a line of a
+    /// one-column record, or a record with no values at all.
+    MalformedRecord {
+        /// The line (1-based) where the problem was found; for a record that ends early,
+        /// the line after its last.
+        line: u32,
+    },
 }
 
 impl Error {
@@ -155,6 +165,9 @@ impl Error {
             Error::InputNotIdentifiable => {
                 "the unknown input is not identifiable from these sensors (count, rank or zeros)"
             }
+            Error::MalformedRecord { .. } => {
+                "malformed record: header, value count or a value that is not a number"
+            }
         }
     }
 }
@@ -164,6 +177,7 @@ impl fmt::Display for Error {
         f.write_str(self.as_str())?;
         match self {
             Error::SingularEffectiveMatrixAtStep { step } => write!(f, " (step {step})"),
+            Error::MalformedRecord { line } => write!(f, " (line {line})"),
             _ => Ok(()),
         }
     }

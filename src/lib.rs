@@ -38,6 +38,11 @@
 //! - [`spectrum`]: response spectra: a bank of damped oscillators fed one
 //!   ground-acceleration sample at a time, RotD50/RotD100, and (feature `std`) many
 //!   records in parallel on the host.
+//! - [`records`]: ground-motion record readers, PEER AT2 and one-column text, into a
+//!   caller's buffer (`no_std`) or a `Vec` (feature `std`).
+//! - `ida` (feature `std`): incremental dynamic analysis — hunt-and-fill tracing
+//!   (Vamvatsikos & Cornell 2002) or stripes over a suite of records on the batch pool,
+//!   IDA curves and their fractiles, for any analysis given as a closure (`docs/ida.md`).
 //! - `batch` (feature `std`): many independent jobs (records, intensities, periods) on a
 //!   work-stealing pool of a chosen thread count, results in input order.
 //! - [`observer`]: virtual sensing — the discrete state-space form of the linear schemes,
@@ -140,6 +145,11 @@ pub use macros::rows_to_columns as __rows_to_columns;
 #[cfg_attr(docsrs, doc(cfg(feature = "std")))]
 pub mod batch;
 
+// Incremental dynamic analysis over a suite of records on the batch pool (host only).
+#[cfg(feature = "std")]
+#[cfg_attr(docsrs, doc(cfg(feature = "std")))]
+pub mod ida;
+
 // The state and the interface every scheme shares.
 mod error;
 mod scalar;
@@ -171,6 +181,7 @@ pub mod hysteresis;
 pub mod modal;
 pub mod models;
 pub mod observer;
+pub mod records;
 
 // `defmt::Format` for the types that hold nalgebra data (feature `defmt`).
 #[cfg(feature = "defmt")]
@@ -240,3 +251,8 @@ pub struct DetectionDocDoctests;
 #[cfg(doctest)]
 #[doc = include_str!("../docs/hybrid.md")]
 pub struct HybridDocDoctests;
+
+/// As [`ModalDocDoctests`] (its code needs the feature `std`).
+#[cfg(all(doctest, feature = "std"))]
+#[doc = include_str!("../docs/ida.md")]
+pub struct IdaDocDoctests;

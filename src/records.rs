@@ -1,0 +1,409 @@
+//! Ground-motion record readers: PEER NGA **AT2** text and **one-column** text (one value a
+//! line), parsed from a `&str` by an iterator or into a caller's `&mut [T]` (`no_std`, no
+//! heap), and with the `std` feature into a [`Record`] (`Vec<f64>`) from text or a file.
+//!
+//! ```
+//! use aemstep::records;
+//!
+//! let text = "\
+//! PEER NGA STRONG MOTION DATABASE RECORD
+//! IMPERIAL VALLEY 5/19/40, EL CENTRO ARRAY #9, 180
+//! ACCELERATION TIME SERIES IN UNITS OF G
+//! NPTS=     5, DT=   .0100 SEC
+//!   .1000000E-02  .2000000E-02 -.3000000E-02
+//!   .4000000E-02 -.5000000E-02
+//! ";
+//! let at2 = records::at2(text)?;
+//! assert_eq!((at2.npts, at2.dt), (5, 0.01)); // samples, s
+//! let mut ag = [0.0f64; 5]; // in g, as in the file
+//! let n = at2.read_into(&mut ag)?;
+//! assert_eq!(&ag[..n], &[0.001, 0.002, -0.003, 0.004, -0.005]);
+//!
+//! // One value a line, `#` comments; the time step is the caller's.
+//! let mut buf = [0.0f32; 8];
+//! let n = records::column_into("# dt = 0.02 s\n0.5\n-0.25 # a comment\n\n1e-3\n", &mut buf)?;
+//! assert_eq!(&buf[..n], &[0.5, -0.25, 1e-3]);
+//!
+//! // Bad input is a typed error with the line, never a panic.
+//! assert_eq!(
+//!     records::at2("t\ne\nu\nNPTS= 2, DT= .01 SEC\n0.1 oops\n")?.read_into(&mut ag),
+//!     Err(aemstep::Error::MalformedRecord { line: 5 })
+//! );
+//! # Ok::<(), aemstep::Error>(())
+//! ```
+//!
+//! **AT2** (the PEER NGA flat-file format; the values are in g for the acceleration files):
+//!
+//! 1. lines 1–3: free text (title; event, date, station, component; the units line, e.g.
+//!    `ACCELERATION TIME SERIES IN UNITS OF G`), kept as [`At2::title`], [`At2::event`],
+//!    [`At2::units`] and not interpreted;
+//! 2. line 4: the count and the sample interval, in any of the spellings in use: keyword
+//!    then value (`NPTS=  4000, DT=   .0050 SEC`, `NPTS = 4000 DT = 0.005`, any case,
+//!    `=`/`,`/spaces between, `SEC` optional and possibly glued to the number) or values then
+//!    keywords (the older `4000    0.0050    NPTS, DT`);
+//! 3. then exactly `NPTS` numbers in free columns (any count a line, separated by white
+//!    space): Rust's `f64` syntax, which covers Fortran's `E` formats (`-.6403180E-02`).
+//!
+//! **One column**: one number a line; blank lines and everything from a `#` to the end of
+//! a line are ignored (so a `#` header is allowed); at least one value. The time step is
+//! not in the file: the caller gives it.
+//!
+//! **Bad input** is [`Error::MalformedRecord`] with the 1-based line: a line 4 with no
+//! readable `NPTS` (a whole number `> 0`) and `DT` (finite, `> 0`), fewer than 4 lines, a
+//! value that is not a finite number (also one that overflows the target type, e.g. `1e39`
+//! into `f32`), more or fewer values than `NPTS` (AT2), two values on a line or no value
+//! at all (one column). Fortran fields that run together without a space
+//! (`-1.0E-03-2.0E-03`) and `D` exponents are not numbers here. A caller's buffer too
+//! short for the values is [`Error::InvalidParameter`] (size it with [`At2::npts`], or
+//! count [`column()`]'s values first). Nothing here panics, on any bytes (a property test
+//! feeds random text).
+//!
+//! **Cost**: one pass over the text, no allocation (except [`Record`]'s `Vec`); each value
+//! is parsed by `core`'s correctly rounded `f64` parser (`str::parse`), so the values are
+//! exactly those of the text, rounded once (to `f32` from that `f64` for `f32` buffers).
+
+use crate::{Error, Real};
+
+/// Standard gravity (m/s²): multiply a PEER acceleration record (in g) by it for m/s².
+pub const G: f64 = 9.80665;
+
+/// The header of a PEER AT2 record and its values (not yet parsed): see the
+/// [module](self). Made by [`at2`]; borrows the text.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct At2<'a> {
+    /// Line 1, trimmed (the title).
+    pub title: &'a str,
+    /// Line 2, trimmed (event, date, station, component).
+    pub event: &'a str,
+    /// Line 3, trimmed (the units line, e.g. `ACCELERATION TIME SERIES IN UNITS OF G`).
+    pub units: &'a str,
+    /// The number of samples `NPTS` (`> 0`).
+    pub npts: usize,
+    /// The sample interval `DT` (s, finite, `> 0`).
+    pub dt: f64,
+    /// The text after line 4.
+    body: &'a str,
+}
+
+/// The header of a PEER AT2 record (its first four lines; see the [module](self)).
+///
+/// Errors: [`Error::MalformedRecord`] (`line: 4` for an unreadable count or interval; the
+/// line after the last for a text of fewer than 4 lines). Cost: a scan of the header.
+pub fn at2(text: &str) -> Result<At2<'_>, Error> {
+    let mut rest = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut lines = [""; 4];
+    for (i, slot) in lines.iter_mut().enumerate() {
+        if rest.is_empty() {
+            return Err(Error::MalformedRecord { line: i as u32 + 1 });
+        }
+        let (line, r) = split_line(rest);
+        *slot = line.trim();
+        rest = r;
+    }
+    let (npts, dt) = npts_dt(lines[3]).ok_or(Error::MalformedRecord { line: 4 })?;
+    Ok(At2 {
+        title: lines[0],
+        event: lines[1],
+        units: lines[2],
+        npts,
+        dt,
+        body: rest,
+    })
+}
+
+impl<'a> At2<'a> {
+    /// The values, in file order and units (g for an acceleration file): exactly
+    /// [`At2::npts`] `Ok` items, or an `Err` ([`Error::MalformedRecord`]) where the text
+    /// goes wrong (a value not a finite number, a value past `NPTS`, the end before
+    /// `NPTS`), after which the iterator ends. Cost: one pass over the values.
+    pub fn values(&self) -> Values<'a> {
+        Values {
+            rest: self.body,
+            line: "",
+            line_no: 4,
+            expected: Some(self.npts),
+            seen: 0,
+            one_per_line: false,
+            done: false,
+        }
+    }
+
+    /// The values into `out[..npts]` (rounded once to `T`), checked to be exactly `npts`;
+    /// returns `npts`. On an error `out` may be partly written.
+    ///
+    /// Errors: [`Error::InvalidParameter`] if `out.len() < npts` (nothing written), else as
+    /// [`At2::values`]. Cost: one pass over the values.
+    pub fn read_into<T: Real>(&self, out: &mut [T]) -> Result<usize, Error> {
+        if out.len() < self.npts {
+            return Err(Error::InvalidParameter);
+        }
+        fill(self.values(), out)
+    }
+}
+
+/// The values of a one-column record (see the [module](self)), in file order and units:
+/// `Ok` items, or one `Err` ([`Error::MalformedRecord`]) where the text goes wrong (two
+/// values on a line, a value not a finite number, no value at all), after which the
+/// iterator ends. Cost: one pass over the text.
+pub fn column(text: &str) -> Values<'_> {
+    Values {
+        rest: text.strip_prefix('\u{feff}').unwrap_or(text),
+        line: "",
+        line_no: 0,
+        expected: None,
+        seen: 0,
+        one_per_line: true,
+        done: false,
+    }
+}
+
+/// The values of a one-column record into `out` (rounded once to `T`); returns how many.
+/// On an error `out` may be partly written.
+///
+/// Errors: as [`column()`]; [`Error::InvalidParameter`] if `out` is too short. Cost: one
+/// pass over the text.
+pub fn column_into<T: Real>(text: &str, out: &mut [T]) -> Result<usize, Error> {
+    fill(column(text), out)
+}
+
+/// The values of a record ([`At2::values`], [`column()`]): an iterator over the text, no
+/// allocation.
+#[derive(Clone, Debug)]
+pub struct Values<'a> {
+    /// The text after the current line.
+    rest: &'a str,
+    /// What is left of the current line.
+    line: &'a str,
+    /// The current line (1-based).
+    line_no: u32,
+    /// AT2: `NPTS`.
+    expected: Option<usize>,
+    /// Values yielded so far.
+    seen: usize,
+    /// One column: a second value on a line is an error; `#` starts a comment.
+    one_per_line: bool,
+    /// An error was yielded, or the text ended.
+    done: bool,
+}
+
+impl Values<'_> {
+    /// The line (1-based) of the value yielded last (`0` before the first). Cost: none.
+    pub fn line(&self) -> u32 {
+        self.line_no
+    }
+
+    fn fail(&mut self, line: u32) -> Option<Result<f64, Error>> {
+        self.done = true;
+        Some(Err(Error::MalformedRecord { line }))
+    }
+}
+
+impl Iterator for Values<'_> {
+    type Item = Result<f64, Error>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.done {
+            return None;
+        }
+        loop {
+            let mut tokens = self.line.split_whitespace();
+            if let Some(tok) = tokens.next() {
+                if self.one_per_line && tokens.next().is_some() {
+                    return self.fail(self.line_no);
+                }
+                // What is left of the line after this token.
+                let at = tok.as_ptr() as usize - self.line.as_ptr() as usize + tok.len();
+                self.line = &self.line[at..];
+                if self.expected == Some(self.seen) {
+                    return self.fail(self.line_no);
+                }
+                return match tok.parse::<f64>() {
+                    Ok(v) if v.is_finite() => {
+                        self.seen += 1;
+                        Some(Ok(v))
+                    }
+                    _ => self.fail(self.line_no),
+                };
+            }
+            if self.rest.is_empty() {
+                self.done = true;
+                let short = match self.expected {
+                    Some(n) => self.seen < n,
+                    None => self.seen == 0,
+                };
+                return if short {
+                    self.fail(self.line_no.saturating_add(1))
+                } else {
+                    None
+                };
+            }
+            let (line, rest) = split_line(self.rest);
+            self.rest = rest;
+            self.line_no = self.line_no.saturating_add(1);
+            self.line = if self.one_per_line {
+                line.split('#').next().unwrap_or("")
+            } else {
+                line
+            };
+        }
+    }
+}
+
+impl core::iter::FusedIterator for Values<'_> {}
+
+/// `values` into `out`, rounded to `T`, each checked finite after rounding.
+fn fill<T: Real>(values: Values<'_>, out: &mut [T]) -> Result<usize, Error> {
+    let mut n = 0;
+    let mut values = values;
+    while let Some(v) = values.next() {
+        let v = v?;
+        let slot = out.get_mut(n).ok_or(Error::InvalidParameter)?;
+        let t = T::from_f64_rounded(v);
+        if !t.as_f64().is_finite() {
+            return Err(Error::MalformedRecord {
+                line: values.line(),
+            });
+        }
+        *slot = t;
+        n += 1;
+    }
+    Ok(n)
+}
+
+/// The first line of `s` (without its `\n` or `\r\n`) and the text after it.
+fn split_line(s: &str) -> (&str, &str) {
+    let (line, rest) = match s.find('\n') {
+        Some(i) => (&s[..i], &s[i + 1..]),
+        None => (s, ""),
+    };
+    (line.strip_suffix('\r').unwrap_or(line), rest)
+}
+
+/// `NPTS` and `DT` of an AT2 line 4, in either order of keywords and values.
+fn npts_dt(line: &str) -> Option<(usize, f64)> {
+    let mut tok = [""; 12];
+    let mut n = 0;
+    for t in line
+        .split(|c: char| c.is_whitespace() || c == ',' || c == '=')
+        .filter(|t| !t.is_empty())
+    {
+        *tok.get_mut(n)? = t;
+        n += 1;
+    }
+    let tok = &tok[..n];
+    let key = |k: &str| tok.iter().position(|t| t.eq_ignore_ascii_case(k));
+    let (ip, id) = (key("NPTS")?, key("DT")?);
+    let count = |t: &str| t.parse::<usize>().ok().filter(|&c| c > 0);
+    let step = |t: &str| {
+        let t = match t.len().checked_sub(3) {
+            Some(i) if t.is_char_boundary(i) && t[i..].eq_ignore_ascii_case("SEC") => &t[..i],
+            _ => t,
+        };
+        t.parse::<f64>().ok().filter(|d| d.is_finite() && *d > 0.0)
+    };
+    // Keyword then value: `NPTS= 4000, DT= .0050 SEC`.
+    if let (Some(c), Some(d)) = (
+        tok.get(ip + 1).and_then(|t| count(t)),
+        tok.get(id + 1).and_then(|t| step(t)),
+    ) {
+        return Some((c, d));
+    }
+    // Values then keywords: `4000  0.0050  NPTS, DT`.
+    if ip >= 2 && id > ip {
+        return Some((count(tok[0])?, step(tok[1])?));
+    }
+    None
+}
+
+/// A whole record in memory (feature `std`): its samples (in the file's units: g for a
+/// PEER acceleration record; times [`G`] for m/s²), sample interval and title.
+#[cfg(feature = "std")]
+#[cfg_attr(docsrs, doc(cfg(feature = "std")))]
+#[derive(Clone, Debug, PartialEq)]
+pub struct Record {
+    /// The title (AT2: line 1; one column: empty, or the file name from
+    /// [`Record::read_column`]).
+    pub title: std::string::String,
+    /// The sample interval (s, finite, `> 0`).
+    pub dt: f64,
+    /// The samples, in file order and units.
+    pub samples: std::vec::Vec<f64>,
+}
+
+#[cfg(feature = "std")]
+impl Record {
+    /// A record from PEER AT2 text ([`at2`], [`At2::values`]).
+    ///
+    /// Errors: [`Error::MalformedRecord`] as [`at2`] and [`At2::values`]. Cost: one pass
+    /// over the text; allocates `NPTS` values (once the header is read).
+    ///
+    /// ```
+    /// let r = aemstep::records::Record::from_at2("T\nE\nU\n3 0.02 NPTS, DT\n1 2\n3\n")?;
+    /// assert_eq!((r.dt, r.samples.as_slice()), (0.02, &[1.0, 2.0, 3.0][..]));
+    /// # Ok::<(), aemstep::Error>(())
+    /// ```
+    pub fn from_at2(text: &str) -> Result<Self, Error> {
+        let h = at2(text)?;
+        // The count is the header's word: allocate no more than the text could hold
+        // (a value takes at least two bytes with its separator).
+        let mut samples = std::vec::Vec::with_capacity(h.npts.min(text.len() / 2 + 1));
+        for v in h.values() {
+            samples.push(v?);
+        }
+        Ok(Record {
+            title: h.title.into(),
+            dt: h.dt,
+            samples,
+        })
+    }
+
+    /// A record from one-column text ([`column()`]) sampled every `dt` seconds.
+    ///
+    /// Errors: [`Error::InvalidTimeStep`] if `dt` is not finite and `> 0`;
+    /// [`Error::MalformedRecord`] as [`column()`]. Cost: one pass over the text.
+    pub fn from_column(text: &str, dt: f64) -> Result<Self, Error> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::InvalidTimeStep);
+        }
+        Ok(Record {
+            title: std::string::String::new(),
+            dt,
+            samples: column(text).collect::<Result<_, _>>()?,
+        })
+    }
+
+    /// [`Record::from_at2`] of a file.
+    ///
+    /// Errors: the file's I/O error; a parse error as an [`std::io::Error`] of kind
+    /// `InvalidData` whose `get_ref()` downcasts to the crate's [`Error`]. A file that is
+    /// not UTF-8 is `InvalidData` from the read. Cost: reads the file once.
+    pub fn read_at2(path: impl AsRef<std::path::Path>) -> std::io::Result<Self> {
+        let text = std::fs::read_to_string(path)?;
+        Self::from_at2(&text).map_err(invalid_data)
+    }
+
+    /// [`Record::from_column`] of a file; the title is the file name.
+    ///
+    /// Errors: as [`Record::read_at2`] (and [`Error::InvalidTimeStep`] for `dt`, as
+    /// `InvalidData`). Cost: reads the file once.
+    pub fn read_column(path: impl AsRef<std::path::Path>, dt: f64) -> std::io::Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path)?;
+        let mut r = Self::from_column(&text, dt).map_err(invalid_data)?;
+        if let Some(name) = path.file_name() {
+            r.title = name.to_string_lossy().into_owned();
+        }
+        Ok(r)
+    }
+
+    /// The samples times `factor` (e.g. [`G`] for a record in g to m/s²). Cost: one pass;
+    /// allocates the result.
+    pub fn scaled(&self, factor: f64) -> std::vec::Vec<f64> {
+        self.samples.iter().map(|&a| a * factor).collect()
+    }
+}
+
+#[cfg(feature = "std")]
+fn invalid_data(e: Error) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidData, e)
+}
