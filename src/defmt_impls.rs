@@ -20,6 +20,7 @@ use crate::hysteresis::{EnergyAccount, Law, ShearBuilding, Trial};
 use crate::observer::{
     Estimate, Kalman, KalmanState, Measurement, Observer, Outputs, Readout, StateSpace, SteadyState,
 };
+use crate::records::{At2, Values};
 use crate::spectrum::Bank;
 use crate::{
     AForm, Coefficients, CompensatedLinear, CompensatedState, Exact, GeneralizedAlpha, KrAlpha,
@@ -502,5 +503,21 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize> Fo
             "FixedLag {{ S: {=usize}, I: {=usize}, O: {=usize}, L: {=usize} }}",
             S, I, O, L
         )
+    }
+}
+
+impl Format for At2<'_> {
+    fn format(&self, f: Formatter) {
+        write!(
+            f,
+            "At2 {{ title: {=str}, npts: {=usize}, dt: {=f64} }}",
+            self.title, self.npts, self.dt
+        )
+    }
+}
+
+impl Format for Values<'_> {
+    fn format(&self, f: Formatter) {
+        write!(f, "Values {{ line: {=u32} }}", self.line())
     }
 }

@@ -21,6 +21,14 @@ const SKIP: &[(&str, &str)] = &[
     ("EstimationDocDoctests", "cfg(doctest) marker"),
     ("DetectionDocDoctests", "cfg(doctest) marker"),
     ("HybridDocDoctests", "cfg(doctest) marker"),
+    ("IdaDocDoctests", "cfg(doctest) marker"),
+    // Feature `std` only (host: heap-held records and IDA results); `defmt` is for firmware.
+    ("Record", "std only"),
+    ("OnFailure", "std only"),
+    ("Collapse", "std only"),
+    ("HuntFill", "std only"),
+    ("Point", "std only"),
+    ("Curve", "std only"),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
