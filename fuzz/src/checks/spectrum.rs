@@ -1,7 +1,9 @@
 //! Fuzz target `spectrum` (`fuzz_targets/spectrum.rs`): checks Bank::new, Bank::with (both
 //! schemes, every sub-step rule), RotD, the host batch, and the yielding bank
 //! (`inelastic::Yielding`: construction, streaming, constant strength and constant
-//! ductility); f32 and f64.
+//! ductility); f32 and f64. Also what feeds them on the host: the record readers
+//! (`records::at2`, `records::column`, on the input read as text) and IDA tracing
+//! (`ida::trace`, `ida::fractiles`) with decoded settings and an analytic analysis.
 //!
 //! The decoder and the checks every target shares are in `common.rs`.
 
@@ -79,6 +81,8 @@ pub fn spectrum(data: &[u8]) {
     let y64 = inelastic_typed::<f64>(&period, &damping, dt, sub, &samples, &yielding, r64);
     let y32 = inelastic_typed::<f32>(&period, &damping, dt, sub, &samples, &yielding, r32);
     same_kind(SP, "Yielding f64 vs f32", &y64, &y32);
+    records_checks(&String::from_utf8_lossy(data));
+    ida_checks(&mut b);
     count(SP, "inputs");
     count(SP, b.category());
 }
@@ -412,4 +416,224 @@ fn inelastic_typed<T: Real>(
         }
     }
     None
+}
+
+/// The record readers on any text: typed errors only; a header read `Ok` has `npts > 0`
+/// and a finite `dt > 0`; a whole read gives exactly `npts` finite values (AT2), equal to
+/// the iterator's, and the `f32` read holds each of them rounded once (or fails where one
+/// overflows `f32`); the iterator ends after its first error.
+fn records_checks(text: &str) {
+    use aemstep::records;
+    let typed = |e: &Error| matches!(e, Error::MalformedRecord { .. } | Error::InvalidParameter);
+    let values = |it: records::Values<'_>| {
+        let mut out = Vec::new();
+        let mut it = it;
+        while let Some(v) = it.next() {
+            match v {
+                Ok(x) => {
+                    check!(x.is_finite(), "records: a non-finite value {x} yielded");
+                    out.push(x);
+                }
+                Err(e) => {
+                    check!(typed(&e), "records: untyped error {e:?}");
+                    check!(it.next().is_none(), "records: values after an error");
+                    return Err(e);
+                }
+            }
+        }
+        Ok(out)
+    };
+    match records::at2(text) {
+        Ok(h) => {
+            check!(
+                h.npts > 0 && h.dt.is_finite() && h.dt > 0.0,
+                "records: header {h:?}"
+            );
+            let it = values(h.values());
+            // Bounded buffers: a header may claim any count.
+            if h.npts <= 1 << 16 {
+                let mut buf = vec![0.0f64; h.npts];
+                let read = h.read_into(&mut buf);
+                match (&read, &it) {
+                    (Ok(n), Ok(v)) => {
+                        check!(*n == h.npts && v.len() == h.npts, "records: AT2 count {n}");
+                        check!(
+                            buf.iter().zip(v).all(|(a, b)| a.to_bits() == b.to_bits()),
+                            "records: read_into differs from the iterator"
+                        );
+                        let mut b32 = vec![0.0f32; h.npts];
+                        match h.read_into(&mut b32) {
+                            Ok(m) => check!(
+                                m == h.npts && b32.iter().zip(v).all(|(a, b)| *a == *b as f32),
+                                "records: f32 read is not the values rounded once"
+                            ),
+                            Err(e) => check!(
+                                matches!(e, Error::MalformedRecord { .. })
+                                    && v.iter().any(|x| !(*x as f32).is_finite()),
+                                "records: f32 read failed ({e:?}) with every value in range"
+                            ),
+                        }
+                    }
+                    (Err(a), Err(b)) => {
+                        check!(a == b, "records: {a:?} from read_into, {b:?} iterated")
+                    }
+                    _ => check!(false, "records: read_into {read:?} but iterated {it:?}"),
+                }
+            }
+            count(SP, "records: AT2 headers read");
+        }
+        Err(e) => check!(typed(&e), "records: untyped header error {e:?}"),
+    }
+    let col = values(records::column(text));
+    if let Ok(v) = &col {
+        let mut buf = vec![0.0f64; v.len()];
+        let n = records::column_into(text, &mut buf);
+        check!(
+            n == Ok(v.len()),
+            "records: column_into {n:?} for {} values",
+            v.len()
+        );
+        if !v.is_empty() {
+            check!(
+                records::column_into(text, &mut buf[..v.len() - 1]) == Err(Error::InvalidParameter),
+                "records: a short buffer is not InvalidParameter"
+            );
+        }
+        count(SP, "records: columns read");
+    }
+}
+
+/// Hunt-and-fill on an analytic IDA curve (EDP = intensity below a capacity, collapse
+/// above it, by an EDP limit or a failed analysis): settings out of range are
+/// `InvalidParameter` before any run; otherwise at most `runs` analyses, points sorted by
+/// intensity with finite positive intensities, the collapse bracket `[lo, hi]` with
+/// `lo < capacity ≤ hi` (each end a run that stayed up or collapsed); fractiles of the
+/// curve are typed errors or values.
+fn ida_checks(b: &mut Bytes) {
+    use aemstep::ida::{self, Collapse, HuntFill, OnFailure};
+    use std::cell::Cell;
+    // The run budget: out of range (0, 10 001), long (up to 400: the fill's bookkeeping
+    // grows as runs² log runs, so 10 000 is left to the tests), or a usual one.
+    let runs = match b.pick(8) {
+        0 => [0, 10_001][b.pick(2) as usize],
+        1 => 1 + b.u16() as usize % 400,
+        _ => 1 + b.u16() as usize % 40,
+    };
+    let settings = HuntFill {
+        first: match b.pick(4) {
+            0 => b.value(),
+            _ => b.param(1e-3, 2.0),
+        },
+        step: match b.pick(4) {
+            0 => b.value(),
+            _ => b.param(1e-3, 2.0),
+        },
+        step_increment: match b.pick(4) {
+            0 => b.value(),
+            _ => b.param(0.0, 1.0),
+        },
+        resolution: match b.pick(4) {
+            0 => b.value(),
+            _ => b.param(1e-6, 0.5),
+        },
+        runs,
+        collapse: Collapse {
+            edp: match b.pick(3) {
+                0 => b.value(),
+                1 => f64::INFINITY,
+                _ => b.param(0.1, 10.0),
+            },
+            on_failure: if b.flag() {
+                OnFailure::Collapse
+            } else {
+                OnFailure::Abort
+            },
+        },
+    };
+    // `param` may leave its range (the decoder's extremes): the capacity is kept in it.
+    let capacity = match b.param(0.01, 10.0) {
+        c if c > 0.01 && c < 10.0 => c,
+        _ => 1.0,
+    };
+    let by_error = b.flag();
+    set_context(format!(
+        "ida: settings = {settings:?}, capacity = {capacity}, by_error = {by_error}"
+    ));
+    let calls = Cell::new(0usize);
+    let analysis = |_: &(), x: f64| {
+        calls.set(calls.get() + 1);
+        check!(
+            x.is_finite() && x > 0.0,
+            "ida: analysis asked at intensity {x}"
+        );
+        if x < capacity {
+            Ok(x)
+        } else if by_error {
+            Err(Error::NotConverged)
+        } else {
+            Ok(f64::INFINITY)
+        }
+    };
+    let curve = ida::trace(&(), &settings, analysis);
+    let valid = settings.first.is_finite()
+        && settings.first > 0.0
+        && settings.step.is_finite()
+        && settings.step > 0.0
+        && settings.step_increment.is_finite()
+        && settings.step_increment >= 0.0
+        && settings.resolution.is_finite()
+        && settings.resolution > 0.0
+        && (1..=10_000).contains(&settings.runs)
+        && settings.collapse.edp > 0.0;
+    match curve {
+        Err(Error::InvalidParameter) => {
+            check!(
+                calls.get() == 0,
+                "ida: {} runs before InvalidParameter",
+                calls.get()
+            );
+            count(SP, "ida: settings refused");
+        }
+        Err(e) => check!(
+            valid
+                && by_error
+                && settings.collapse.on_failure == OnFailure::Abort
+                && e == Error::NotConverged,
+            "ida: unexpected error {e:?}"
+        ),
+        Ok(c) => {
+            check!(valid, "ida: settings out of range accepted");
+            check!(
+                c.points.len() <= settings.runs && calls.get() == c.points.len(),
+                "ida: {} points, {} runs",
+                c.points.len(),
+                calls.get()
+            );
+            check!(
+                c.points
+                    .windows(2)
+                    .all(|w| w[0].intensity <= w[1].intensity),
+                "ida: points not sorted"
+            );
+            // Collapse from the capacity on (a failed or infinite run), or where the EDP
+            // (= the intensity) reaches the collapse EDP: from `min(capacity, edp)` on.
+            let onset = capacity.min(settings.collapse.edp);
+            if let Some([lo, hi]) = c.collapse {
+                check!(
+                    lo < onset && onset <= hi,
+                    "ida: bracket [{lo}, {hi}] misses the collapse onset {onset}"
+                );
+            }
+            let edp = [b.value(), b.param(0.0, 5.0)];
+            let q = [b.value(), b.param(0.0, 1.0)];
+            match ida::fractiles(core::slice::from_ref(&c), &edp, &q) {
+                Ok(f) => check!(
+                    f.len() == 2 && f.iter().all(|r| r.len() == 2),
+                    "ida: fractile shape"
+                ),
+                Err(e) => check!(e == Error::InvalidParameter, "ida: fractiles {e:?}"),
+            }
+            count(SP, "ida: curves traced");
+        }
+    }
 }
