@@ -19,6 +19,7 @@ cargo fmt --all -- --check || fail "cargo fmt: run 'cargo fmt --all'"
 cargo clippy --all-targets -- -D warnings || fail "clippy"
 cargo clippy --all-targets --features std -- -D warnings || fail "clippy (std)"
 cargo clippy -p xtask --all-targets -- -D warnings || fail "clippy (xtask: page generators, benchmarks)"
+cargo clippy -p aemstep-python --all-targets -- -D warnings || fail "clippy (python/: the Python bindings)"
 
 step "host tests (debug: overflow checks on)"
 tests cargo test --all-targets --features std || fail "host tests (with the host-only std feature)"
