@@ -89,3 +89,31 @@ def test_shapes_are_checked_before_anything_runs():
     with pytest.raises(aemstep.UnsupportedSize):
         aemstep.observe(np.eye(5), np.eye(5), np.eye(5), 0.01, np.zeros(3), np.zeros((3, 4)),
                         [0, 1, 2, 3], sigma_f=1.0, sigma_y=1.0)
+
+
+def test_empty_and_degenerate_inputs_raise_typed_errors_never_crash():
+    ag = np.sin(np.arange(100) * 0.3)
+    with pytest.raises(aemstep.ShapeError):
+        aemstep.spectrum([], 0.05, 0.02, ag)
+    with pytest.raises(aemstep.ShapeError):
+        aemstep.constant_strength([], 0.05, 0.02, ag, [])
+    with pytest.raises(aemstep.ShapeError):
+        aemstep.shear_building([1e5], [[0.0]], 0.01, [], k=1e8, fy=1e5)
+    with pytest.raises(aemstep.ShapeError):
+        aemstep.shear_building([], np.zeros((0, 0)), 0.01, ag, k=1e8, fy=1e5)
+    with pytest.raises(aemstep.InvalidParameter):
+        aemstep.constant_strength([1.0], 0.05, 0.02, [], 4.0)  # no record: at rest
+    with pytest.raises(aemstep.InvalidParameter):
+        aemstep.constant_strength([1.0], 0.05, 0.02, ag, 4.0, points_per_period=0)
+    with pytest.raises(aemstep.ShapeError):
+        aemstep.observe(ONE, ONE, ONE, 0.01, [], np.zeros((0, 1)), [0], sigma_f=1.0, sigma_y=1.0)
+    with pytest.raises(aemstep.UnsupportedSize):
+        aemstep.linear_response(np.zeros((0, 0)), np.zeros((0, 0)), np.zeros((0, 0)), 0.01,
+                                p=np.zeros((3, 0)))
+    # An empty record gives zero spectra, an empty list of records empty arrays.
+    assert np.all(aemstep.spectrum([1.0], 0.05, 0.02, []).sd == 0)
+    assert aemstep.spectra([1.0], 0.05, 0.02, []).sd.shape == (0, 1)
+    # NaN samples are skipped (held at the last finite one), not errors, in spectra.
+    bad = ag.copy()
+    bad[5] = np.nan
+    assert np.all(np.isfinite(aemstep.spectrum([0.5, 1.0], 0.05, 0.02, bad).sd))
