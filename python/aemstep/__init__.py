@@ -38,6 +38,7 @@ from ._aemstep import (  # noqa: F401  (re-exported)
     CHUNK,
     ERROR_VARIANTS,
     MAX_SENSORS,
+    MAX_TRUNCATED_MODES,
     ROTD_ANGLES,
     SIZES,
     AemstepError,
@@ -134,6 +135,7 @@ def linear_response(
     gamma: float = 0.5,
     rho_inf: float = 1.0,
     alpha: float = 0.0,
+    modes: int = 0,
 ) -> LinearResponse:
     """Step ``M u'' + C u' + K u = p(t)`` over a record; one interface for every scheme.
 
@@ -142,8 +144,9 @@ def linear_response(
     ``ground_acceleration`` (m/s², length ``steps``) with ``influence`` ``ι`` (default all
     ones): ``p = −M ι a_g``, ``u`` then relative to the ground. ``u0``, ``v0``: initial
     state (m, m/s; default rest). ``scheme``: ``"aem"`` (the analog equation method;
-    identical to Newmark average acceleration for linear systems), ``"modal"`` (all modes;
-    ``M`` SPD, ``K`` symmetric, ``C`` classical), ``"newmark"`` (``beta``, ``gamma``),
+    identical to Newmark average acceleration for linear systems), ``"modal"`` (the
+    ``modes`` lowest modes, 0 for all, else 1 to ``MAX_TRUNCATED_MODES``; ``M`` SPD, ``K``
+    symmetric, ``C`` classical), ``"newmark"`` (``beta``, ``gamma``),
     ``"generalized_alpha"`` (``rho_inf`` ∈ [0, 1]), ``"hht"`` (``alpha`` ∈ [−1/3, 0]),
     ``"exact"`` (matrix exponential, load linear between samples).
     """
@@ -161,7 +164,7 @@ def linear_response(
     u0 = np.zeros(n) if u0 is None else _vec(u0, "u0")
     v0 = np.zeros(n) if v0 is None else _vec(v0, "v0")
     u, v, a = _aemstep.linear_response(
-        m, c, k, float(h), p, u0, v0, scheme, beta, gamma, rho_inf, alpha
+        m, c, k, float(h), p, u0, v0, scheme, beta, gamma, rho_inf, alpha, int(modes)
     )
     return LinearResponse(u, v, a)
 
@@ -592,6 +595,7 @@ __all__ = [
     "SIZES",
     "CHUNK",
     "MAX_SENSORS",
+    "MAX_TRUNCATED_MODES",
     "ROTD_ANGLES",
     "SCHEMES",
     "LAWS",

@@ -17,6 +17,8 @@ F64 = npt.NDArray[np.float64]
 SIZES: List[int]
 #: Oscillators per spectrum bank (periods are stepped in banks of this many, padded).
 CHUNK: int
+#: Most modes a truncated modal run keeps (``modes=0`` keeps all).
+MAX_TRUNCATED_MODES: int
 #: Most sensors an observer takes.
 MAX_SENSORS: int
 #: Rotation angles of RotD (180: 1° apart).
@@ -74,12 +76,14 @@ def linear_response(
     gamma: float = 0.5,
     rho_inf: float = 1.0,
     alpha: float = 0.0,
+    modes: int = 0,
 ) -> Tuple[F64, F64, F64]:
     """Step ``M u'' + C u' + K u = p(t)`` over a load history.
 
     m, c, k: ``n×n`` mass (kg), damping (N·s/m), stiffness (N/m); h: time step (s);
     p: loads (N), ``steps×n``, row i at t = i·h; u0 (m), v0 (m/s): initial state;
-    scheme: ``"aem"``, ``"modal"`` (every mode; M SPD, K symmetric, C classical),
+    scheme: ``"aem"``, ``"modal"`` (the ``modes`` lowest modes, 0 for all, else 1 to 3;
+    M SPD, K symmetric, C classical),
     ``"newmark"`` (beta, gamma), ``"generalized_alpha"`` (rho_inf in [0, 1]), ``"hht"``
     (alpha in [−1/3, 0]), ``"exact"``.
     Returns (u m, v m/s, a m/s²), each ``steps×n``, row 0 the initial state.

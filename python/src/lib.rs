@@ -43,6 +43,9 @@ pub const SIZES: [usize; 13] = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 12, 15, 20];
 /// Oscillators per spectrum bank: periods are stepped in banks of this many.
 pub const CHUNK: usize = 16;
 
+/// The most modes a truncated modal run keeps (besides all of them).
+pub const MAX_TRUNCATED_MODES: usize = 3;
+
 /// The largest number of sensors an observer takes.
 pub const MAX_SENSORS: usize = 3;
 
@@ -250,7 +253,8 @@ fn out1(py: Python<'_>, v: Vec<f64>) -> Bound<'_, PyArray1<f64>> {
 #[derive(Clone, Copy)]
 enum LinearScheme {
     Aem,
-    Modal,
+    /// The `R` lowest modes (`0`: all).
+    Modal(usize),
     Newmark(f64, f64),
     GeneralizedAlpha(f64),
     Hht(f64),
@@ -319,20 +323,35 @@ fn linear_n<const N: usize, const S: usize>(job: &LinearJob) -> Res<Histories> {
             drive::<N, _>(&GeneralizedAlpha::<f64, N>::hht(&m, &c, &k, h, alpha)?, job)
         }
         LinearScheme::Exact => drive::<N, _>(&Exact::<f64, N>::new(&m, &c, &k, h)?, job),
-        LinearScheme::Modal => {
-            // Every mode kept, the loads as N inputs (B = I), the DOFs as outputs.
-            let eye = SMatrix::<f64, N, N>::identity();
-            let modal = Modal::<f64, N, N, N, N>::new(
-                &m,
-                &k,
-                &Damping::Matrix(rows::<N>(&job.c)),
-                &eye,
-                &eye,
-                h,
-            )?;
-            drive::<N, _>(&modal, job)
-        }
+        LinearScheme::Modal(r) => match r {
+            // Every mode, or the R lowest: R in 1..=MAX_TRUNCATED_MODES (a copy of the
+            // modal stepper per (n, R), so the list is short; R > n is the library's error).
+            0 => modal_run::<N, N>(job),
+            r if r == N => modal_run::<N, N>(job),
+            r if r > N => Err(Error::InvalidModeSelection.into()),
+            1 => modal_run::<N, 1>(job),
+            2 => modal_run::<N, 2>(job),
+            3 => modal_run::<N, 3>(job),
+            r => Err(Fail::Size(format!(
+                "{r} modes of {N}: this build keeps 1 to {MAX_TRUNCATED_MODES} modes or all of them"
+            ))),
+        },
     }
+}
+
+/// The `R` lowest modes of the job's model, the loads as `N` inputs (`B = I`), the DOFs as
+/// outputs; the full state rebuilt from the modes at every step.
+fn modal_run<const N: usize, const R: usize>(job: &LinearJob) -> Res<Histories> {
+    let eye = SMatrix::<f64, N, N>::identity();
+    let modal = Modal::<f64, N, R, N, N>::new(
+        &matrix::<N>(&job.m),
+        &matrix::<N>(&job.k),
+        &Damping::Matrix(rows::<N>(&job.c)),
+        &eye,
+        &eye,
+        job.h,
+    )?;
+    drive::<N, _>(&modal, job)
 }
 
 /// Step the linear model `M u'' + C u' + K u = p(t)` over a load history.
@@ -340,8 +359,9 @@ fn linear_n<const N: usize, const S: usize>(job: &LinearJob) -> Res<Histories> {
 /// Arguments: `m`, `c`, `k` — mass (kg), damping (N·s/m) and stiffness (N/m) matrices,
 /// `n×n`; `h` — time step (s); `p` — loads (N), `steps×n`, row `i` at `t = i·h` (row 0 the
 /// load at the start); `u0`, `v0` — initial displacements (m) and velocities (m/s);
-/// `scheme` — `"aem"` (the analog equation method, `Linear`), `"modal"` (every mode,
-/// `Modal`: `M` SPD, `K` symmetric, `C` classical), `"newmark"` (`beta`, `gamma`),
+/// `scheme` — `"aem"` (the analog equation method, `Linear`), `"modal"` (`Modal`: the
+/// `modes` lowest modes, `0` for all, else 1 to 3; `M` SPD, `K` symmetric, `C` classical;
+/// `u` is then the modes' part of the response), `"newmark"` (`beta`, `gamma`),
 /// `"generalized_alpha"` (`rho_inf` in [0, 1]), `"hht"` (`alpha` in [−1/3, 0]), `"exact"`
 /// (matrix exponential, load linear between samples).
 ///
@@ -350,7 +370,7 @@ fn linear_n<const N: usize, const S: usize>(job: &LinearJob) -> Res<Histories> {
 /// `SingularEffectiveMatrix`, `NonFiniteInput`, `NonClassicalDamping`), `ShapeError`,
 /// `UnsupportedSize`. The GIL is released while stepping.
 #[pyfunction]
-#[pyo3(signature = (m, c, k, h, p, u0, v0, scheme="aem", beta=0.25, gamma=0.5, rho_inf=1.0, alpha=0.0))]
+#[pyo3(signature = (m, c, k, h, p, u0, v0, scheme="aem", beta=0.25, gamma=0.5, rho_inf=1.0, alpha=0.0, modes=0))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn linear_response<'py>(
     py: Python<'py>,
@@ -366,6 +386,7 @@ fn linear_response<'py>(
     gamma: f64,
     rho_inf: f64,
     alpha: f64,
+    modes: usize,
 ) -> PyResult<(
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
@@ -373,7 +394,7 @@ fn linear_response<'py>(
 )> {
     let scheme = match scheme {
         "aem" | "linear" => LinearScheme::Aem,
-        "modal" => LinearScheme::Modal,
+        "modal" => LinearScheme::Modal(modes),
         "newmark" => LinearScheme::Newmark(beta, gamma),
         "generalized_alpha" => LinearScheme::GeneralizedAlpha(rho_inf),
         "hht" => LinearScheme::Hht(alpha),
@@ -1160,6 +1181,7 @@ fn _aemstep(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SIZES", SIZES.to_vec())?;
     m.add("CHUNK", CHUNK)?;
     m.add("MAX_SENSORS", MAX_SENSORS)?;
+    m.add("MAX_TRUNCATED_MODES", MAX_TRUNCATED_MODES)?;
     m.add("ROTD_ANGLES", ROTD_ANGLES)?;
     m.add_function(wrap_pyfunction!(linear_response, m)?)?;
     m.add_function(wrap_pyfunction!(shear_building, m)?)?;
