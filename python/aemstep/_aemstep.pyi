@@ -98,6 +98,7 @@ def shear_building(
     ag: F64,
     max_iterations: int = 20,
     tolerance: float = 1e-10,
+    energy: bool = True,
 ) -> Dict[str, Union[F64, float]]:
     """A hysteretic shear building (Nonlinear AEM stepper, Newton) over a record.
 
@@ -108,7 +109,8 @@ def shear_building(
     t = i·h; Newton at most max_iterations a step to the relative tolerance.
     Returns ``u`` (m), ``v`` (m/s), ``a`` (m/s²) relative to the ground (``steps×n``),
     ``energy`` (``steps×6``: input, kinetic, recoverable, viscous, hysteretic, balance
-    error; J), ``initial_energy`` (J), ``iterations`` (per step).
+    error; J) and ``initial_energy`` (J), both only with energy=True (the account costs
+    about one law evaluation per storey a step), ``iterations`` (per step).
     """
 
 def spectra(

@@ -448,6 +448,8 @@ struct BuildingJob {
     h: f64,
     ag: Vec<f64>,
     settings: NewtonSettings<f64>,
+    /// Keep the energy account (`N` law trials and `N²` more a step).
+    energy: bool,
 }
 
 /// The histories of a building run (row-major).
@@ -455,7 +457,7 @@ struct BuildingOut {
     u: Vec<f64>,
     v: Vec<f64>,
     a: Vec<f64>,
-    /// E_in, E_k, E_s, E_v, E_h, balance error (J) per step.
+    /// E_in, E_k, E_s, E_v, E_h, balance error (J) per step (empty without the account).
     energy: Vec<f64>,
     iterations: Vec<f64>,
     initial_energy: f64,
@@ -471,41 +473,47 @@ fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) ->
     let (mut s, mut history) = stepper
         .start_with_history(&building, &zero, &zero, &p0, &building.initial_history())
         .map_err(at(0))?;
-    let mut account = EnergyAccount::start(&building, &s, &history, &p0);
+    let mut account = job
+        .energy
+        .then(|| EnergyAccount::start(&building, &s, &history, &p0));
     let mut o = BuildingOut {
         u: Vec::with_capacity(steps * N),
         v: Vec::with_capacity(steps * N),
         a: Vec::with_capacity(steps * N),
-        energy: Vec::with_capacity(steps * 6),
+        energy: Vec::with_capacity(if job.energy { steps * 6 } else { 0 }),
         iterations: Vec::with_capacity(steps),
-        initial_energy: account.initial,
+        initial_energy: account.as_ref().map_or(f64::NAN, |e| e.initial),
     };
     let keep = |o: &mut BuildingOut,
                 s: &aemstep::State<f64, N>,
-                e: &EnergyAccount<f64, N>,
+                e: Option<&EnergyAccount<f64, N>>,
                 iterations: u32| {
         o.u.extend_from_slice(s.u().as_slice());
         o.v.extend_from_slice(s.v().as_slice());
         o.a.extend_from_slice(s.a().as_slice());
-        o.energy.extend_from_slice(&[
-            e.input,
-            e.kinetic,
-            e.recoverable,
-            e.viscous,
-            e.hysteretic,
-            e.balance_error(),
-        ]);
+        if let Some(e) = e {
+            o.energy.extend_from_slice(&[
+                e.input,
+                e.kinetic,
+                e.recoverable,
+                e.viscous,
+                e.hysteretic,
+                e.balance_error(),
+            ]);
+        }
         o.iterations.push(f64::from(iterations));
     };
-    keep(&mut o, &s, &account, 0);
+    keep(&mut o, &s, account.as_ref(), 0);
     for n in 1..steps {
         let p = building.ground_load(job.ag[n]);
         let previous = history;
         let report = stepper
             .try_step_with_history(&building, &mut s, &mut history, &p)
             .map_err(at(n))?;
-        account.step(&building, &previous, &s, &history, &p);
-        keep(&mut o, &s, &account, report.iterations);
+        if let Some(e) = account.as_mut() {
+            e.step(&building, &previous, &s, &history, &p);
+        }
+        keep(&mut o, &s, account.as_ref(), report.iterations);
     }
     Ok(o)
 }
@@ -559,15 +567,17 @@ fn building_n<const N: usize, const S: usize>(law: &str, job: &BuildingJob) -> R
 /// damper in parallel: k N/m, fy N, alpha, fs N, vr m/s); `params` — one row per storey;
 /// `c` — damping matrix (N·s/m), `n×n`; `h` — time step (s); `ag` — ground acceleration
 /// (m/s²) at `t = i·h`; `max_iterations`, `tolerance` — Newton budget and relative
-/// tolerance.
+/// tolerance; `energy` — keep the energy account (about `N` law trials and `N²`
+/// multiply-adds more a step; `False` for the bare stepping speed).
 ///
 /// Returns a dict: `u`, `v`, `a` — floor displacements (m), velocities (m/s),
 /// accelerations (m/s²) relative to the ground, `steps×n`; `energy` — `steps×6`: input,
 /// kinetic, recoverable strain, viscous, hysteretic energies and the balance error (J);
-/// `initial_energy` (J); `iterations` — Newton iterations per step. Raises the library's
+/// `initial_energy` (J) — both absent without `energy`; `iterations` — Newton iterations
+/// per step. Raises the library's
 /// errors (`NotConverged` with `.step`, `InvalidMaterial`, `InvalidNewtonSettings`, …).
 #[pyfunction]
-#[pyo3(signature = (masses, law, params, c, h, ag, max_iterations=20, tolerance=1e-10))]
+#[pyo3(signature = (masses, law, params, c, h, ag, max_iterations=20, tolerance=1e-10, energy=true))]
 #[allow(clippy::too_many_arguments)]
 fn shear_building<'py>(
     py: Python<'py>,
@@ -579,6 +589,7 @@ fn shear_building<'py>(
     ag: PyReadonlyArray1<'py, f64>,
     max_iterations: u32,
     tolerance: f64,
+    energy: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let width = match law {
         "bilinear" => 3,
@@ -612,6 +623,7 @@ fn shear_building<'py>(
                 h,
                 ag,
                 settings: NewtonSettings::up_to(max_iterations, tolerance),
+                energy,
             },
             n,
         ))
@@ -624,8 +636,10 @@ fn shear_building<'py>(
     d.set_item("u", out2(py, o.u, n))?;
     d.set_item("v", out2(py, o.v, n))?;
     d.set_item("a", out2(py, o.a, n))?;
-    d.set_item("energy", out2(py, o.energy, 6))?;
-    d.set_item("initial_energy", o.initial_energy)?;
+    if energy {
+        d.set_item("energy", out2(py, o.energy, 6))?;
+        d.set_item("initial_energy", o.initial_energy)?;
+    }
     d.set_item("iterations", out1(py, o.iterations))?;
     Ok(d)
 }

@@ -146,3 +146,13 @@ def test_newton_failure_and_bad_laws_are_typed_errors(elcentro):
         bad = ag.copy()
         bad[10] = np.nan
         aemstep.shear_building(masses, c, dt, bad, k=1e8, fy=1e5)
+
+
+def test_without_the_energy_account_the_run_is_the_same(elcentro):
+    ag, dt = elcentro
+    masses, m, k, c = three_storey()
+    kw = dict(k=1e8, fy=[6e5, 5e5, 3.5e5], alpha=0.05)
+    a = aemstep.shear_building(masses, c, dt, ag, **kw)
+    b = aemstep.shear_building(masses, c, dt, ag, energy=False, **kw)
+    assert b.energy is None and a.energy is not None
+    assert np.array_equal(a.u, b.u) and np.array_equal(a.iterations, b.iterations)
