@@ -19,6 +19,7 @@ cargo fmt --all -- --check || fail "cargo fmt: run 'cargo fmt --all'"
 cargo clippy --all-targets -- -D warnings || fail "clippy"
 cargo clippy --all-targets --features std -- -D warnings || fail "clippy (std)"
 cargo clippy -p xtask --all-targets -- -D warnings || fail "clippy (xtask: page generators, benchmarks)"
+cargo clippy -p aemstep-python --all-targets -- -D warnings || fail "clippy (python/: the Python bindings)"
 
 step "host tests (debug: overflow checks on)"
 tests cargo test --all-targets --features std || fail "host tests (with the host-only std feature)"
@@ -51,6 +52,26 @@ cargo run -q --release --example spectrum_csv > "$out" || fail "spectrum_csv exa
 cargo run -q --release --example observer > "$out" || fail "observer example"
 grep -q 'RMS drift error (m)' "$out" || fail "observer: RMS drift errors (m) expected"
 rm -f "$out"
+
+step "the Python package: pip install ./python in a fresh virtual environment, pytest python/tests"
+# A clean environment every run (only the pip cache is shared); maturin builds the extension
+# (release) into this repository's target directory, so a later run reuses the build.
+venv=$(mktemp -d)
+trap 'rm -f "$log"; rm -rf "$venv"' EXIT
+python3 -m venv "$venv" || fail "python3 -m venv (Debian: apt-get install python3-venv)"
+"$venv/bin/pip" install -q --upgrade "pip>=23" || fail "pip upgrade in the fresh venv"
+"$venv/bin/pip" install -q "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" ||
+    fail "pip install maturin numpy pytest"
+CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}" "$venv/bin/pip" install -q ./python ||
+    fail "pip install ./python (the maturin build of python/)"
+pyout=$(mktemp)
+"$venv/bin/python" -m pytest python/tests -q -p no:cacheprovider 2>&1 | tee "$pyout" ||
+    { rm -f "$pyout"; fail "pytest python/tests"; }
+# Its count in the total below, in the form the sum reads.
+awk '/ passed/ { p = 0; f = 0; for (i = 2; i <= NF; i++) { if ($i ~ /^passed/) p = $(i - 1);
+    if ($i ~ /^failed/) f = $(i - 1) } } END { printf "test result: pytest. %d passed; %d failed;\n", p, f }' \
+    "$pyout" >> "$log"
+rm -f "$pyout"
 
 step "no_std builds for thumb targets"
 for t in thumbv7em-none-eabihf thumbv6m-none-eabi thumbv7m-none-eabi thumbv8m.main-none-eabihf; do

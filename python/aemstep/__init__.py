@@ -1,0 +1,628 @@
+"""aemstep from Python: structural time stepping by the analog equation method.
+
+numpy arrays in (anything ``numpy.asarray`` takes; copied to contiguous ``float64``) and
+out; the GIL is released while a record runs. Units are SI: m, s, kg, N; ground
+accelerations in m/s² (``G`` converts from g).
+
+- ``linear_response``: a linear model ``M u'' + C u' + K u = p`` over a load history or a
+  ground-acceleration record, by the AEM (``"aem"``), modal superposition (``"modal"``),
+  Newmark, generalized-α, HHT-α or the exact (matrix exponential) scheme.
+- ``shear_building``: a yielding shear building (bilinear, Bouc–Wen, or bilinear with a
+  friction damper in every storey) over a record, with its energy account.
+- ``spectrum``, ``spectra``, ``rotd``: elastic response spectra of one record, of many
+  records on threads, RotD50/RotD100 of two components.
+- ``constant_strength``, ``constant_ductility``: inelastic spectra.
+- ``observe``: a steady-state (Kalman-gain) observer or a Kalman filter of a building's
+  state from measured floor accelerations.
+- ``read_at2``: a PEER NGA ``.AT2`` record (accelerations in g and their time step).
+
+Every ``aemstep::Error`` variant of the Rust library is an exception of the same name
+(``aemstep.NotConverged``, ``aemstep.InvalidTimeStep``, …), subclass of ``AemstepError``
+(a ``ValueError``); ``ShapeError`` is a wrong array shape, ``UnsupportedSize`` a number of
+degrees of freedom the package is not compiled for (``SIZES``).
+
+See docs/python.md in the repository.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from typing import Any, Callable, List, NamedTuple, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _aemstep
+from ._aemstep import (  # noqa: F401  (re-exported)
+    CHUNK,
+    ERROR_VARIANTS,
+    MAX_SENSORS,
+    MAX_TRUNCATED_MODES,
+    ROTD_ANGLES,
+    SIZES,
+    AemstepError,
+    EigenNotConverged,
+    InputNotIdentifiable,
+    InvalidCovariance,
+    InvalidDamping,
+    InvalidMaterial,
+    InvalidModeSelection,
+    InvalidNewtonSettings,
+    InvalidParameter,
+    InvalidPeriod,
+    InvalidTimeStep,
+    MassNotSpd,
+    NonClassicalDamping,
+    NonFiniteForce,
+    NonFiniteInput,
+    NonFiniteState,
+    NotConverged,
+    OperatorOverflow,
+    OperatorUnderflow,
+    RiccatiNotConverged,
+    ShapeError,
+    SingularEffectiveMatrix,
+    SingularEffectiveMatrixAtStep,
+    SingularJacobian,
+    SingularMass,
+    StateSizeMismatch,
+    StiffnessNotSymmetric,
+    UnsupportedSize,
+)
+
+__version__ = "0.1.0"
+
+#: Standard gravity (m/s² per g): AT2 records are in g.
+G = 9.80665
+
+ArrayLike = Any
+
+
+def _vec(x: ArrayLike, name: str) -> np.ndarray:
+    a = np.asarray(x, dtype=np.float64)
+    if a.ndim != 1:
+        raise ShapeError(f"{name} must be 1-D, got shape {a.shape}")
+    return np.ascontiguousarray(a)
+
+
+def _mat(x: ArrayLike, name: str) -> np.ndarray:
+    a = np.asarray(x, dtype=np.float64)
+    if a.ndim != 2:
+        raise ShapeError(f"{name} must be 2-D, got shape {a.shape}")
+    return np.ascontiguousarray(a)
+
+
+def _per_period(x: ArrayLike, count: int, name: str) -> np.ndarray:
+    """A scalar broadcast to every period, or one value per period."""
+    a = np.asarray(x, dtype=np.float64)
+    if a.ndim == 0:
+        return np.full(count, float(a))
+    a = np.ascontiguousarray(a)
+    if a.shape != (count,):
+        raise ShapeError(f"{name} must be a scalar or have one value per period ({count})")
+    return a
+
+
+# ---------------------------------------------------------------------------------------
+# Linear models.
+
+
+class LinearResponse(NamedTuple):
+    """Histories of a linear run, each ``steps×n``, row 0 the initial state."""
+
+    u: np.ndarray  #: displacements (m; relative to the ground under ground acceleration)
+    v: np.ndarray  #: velocities (m/s)
+    a: np.ndarray  #: accelerations (m/s²; relative)
+
+
+SCHEMES = ("aem", "modal", "newmark", "generalized_alpha", "hht", "exact")
+
+
+def linear_response(
+    m: ArrayLike,
+    c: ArrayLike,
+    k: ArrayLike,
+    h: float,
+    p: Optional[ArrayLike] = None,
+    *,
+    ground_acceleration: Optional[ArrayLike] = None,
+    influence: Optional[ArrayLike] = None,
+    scheme: str = "aem",
+    u0: Optional[ArrayLike] = None,
+    v0: Optional[ArrayLike] = None,
+    beta: float = 0.25,
+    gamma: float = 0.5,
+    rho_inf: float = 1.0,
+    alpha: float = 0.0,
+    modes: int = 0,
+) -> LinearResponse:
+    """Step ``M u'' + C u' + K u = p(t)`` over a record; one interface for every scheme.
+
+    ``m``, ``c``, ``k``: ``n×n`` mass (kg), damping (N·s/m), stiffness (N/m). ``h``: time
+    step (s). Loads either ``p`` (N, ``steps×n``, row ``i`` at ``t = i·h``) or
+    ``ground_acceleration`` (m/s², length ``steps``) with ``influence`` ``ι`` (default all
+    ones): ``p = −M ι a_g``, ``u`` then relative to the ground. ``u0``, ``v0``: initial
+    state (m, m/s; default rest). ``scheme``: ``"aem"`` (the analog equation method;
+    identical to Newmark average acceleration for linear systems), ``"modal"`` (the
+    ``modes`` lowest modes, 0 for all, else 1 to ``MAX_TRUNCATED_MODES``; ``M`` SPD, ``K``
+    symmetric, ``C`` classical), ``"newmark"`` (``beta``, ``gamma``),
+    ``"generalized_alpha"`` (``rho_inf`` ∈ [0, 1]), ``"hht"`` (``alpha`` ∈ [−1/3, 0]),
+    ``"exact"`` (matrix exponential, load linear between samples).
+    """
+    m, c, k = _mat(m, "m"), _mat(c, "c"), _mat(k, "k")
+    n = m.shape[0]
+    if (p is None) == (ground_acceleration is None):
+        raise ShapeError("give exactly one of p and ground_acceleration")
+    if p is None:
+        ag = _vec(ground_acceleration, "ground_acceleration")
+        iota = np.ones(n) if influence is None else _vec(influence, "influence")
+        if iota.shape != (n,):
+            raise ShapeError(f"influence must have length {n}")
+        p = np.outer(ag, -(m @ iota))
+    p = _mat(p, "p")
+    u0 = np.zeros(n) if u0 is None else _vec(u0, "u0")
+    v0 = np.zeros(n) if v0 is None else _vec(v0, "v0")
+    u, v, a = _aemstep.linear_response(
+        m, c, k, float(h), p, u0, v0, scheme, beta, gamma, rho_inf, alpha, int(modes)
+    )
+    return LinearResponse(u, v, a)
+
+
+# ---------------------------------------------------------------------------------------
+# The yielding shear building.
+
+
+class Energy(NamedTuple):
+    """The energy account of a building run (J), one value per step:
+    ``E0 + input = kinetic + recoverable + viscous + hysteretic + balance_error``."""
+
+    input: np.ndarray  #: work of the loads ∫ p·du
+    kinetic: np.ndarray  #: ½ vᵀ M v
+    recoverable: np.ndarray  #: strain energy recoverable by elastic unloading
+    viscous: np.ndarray  #: dissipated by the damping matrix ∫ (C v)·du
+    hysteretic: np.ndarray  #: dissipated by the storey laws
+    balance_error: np.ndarray  #: E0 + input − the rest (Newton tolerance and rounding)
+    initial: float  #: E0, kinetic plus recoverable at the start
+
+
+class BuildingResponse(NamedTuple):
+    """A yielding building's run. Histories ``steps×n`` (floor ``i``, ground storey first)."""
+
+    u: np.ndarray  #: floor displacements relative to the ground (m)
+    v: np.ndarray  #: floor velocities (m/s)
+    a: np.ndarray  #: floor accelerations relative to the ground (m/s²)
+    drifts: np.ndarray  #: storey drifts u_i − u_{i−1} (m)
+    peak_drifts: np.ndarray  #: max |drift| per storey (m)
+    energy: Optional[Energy]  #: the energy account (None with energy=False)
+    iterations: np.ndarray  #: Newton iterations of each step
+
+
+LAWS = ("bilinear", "bouc_wen", "bilinear_friction")
+
+
+def shear_building(
+    masses: ArrayLike,
+    c: ArrayLike,
+    h: float,
+    ground_acceleration: ArrayLike,
+    *,
+    k: ArrayLike,
+    fy: ArrayLike,
+    alpha: ArrayLike = 0.0,
+    law: str = "bilinear",
+    beta: ArrayLike = 0.5,
+    gamma: ArrayLike = 0.5,
+    n: ArrayLike = 1.0,
+    fs: Optional[ArrayLike] = None,
+    vr: Optional[ArrayLike] = None,
+    max_iterations: int = 20,
+    tolerance: float = 1e-10,
+    energy: bool = True,
+) -> BuildingResponse:
+    """Step a hysteretic shear building over a ground-acceleration record.
+
+    ``masses``: floor masses (kg), ground storey first (``n`` storeys, ``n`` in
+    ``SIZES``). ``c``: damping matrix (N·s/m, ``n×n``; e.g. Rayleigh). ``h``: time step
+    (s). ``ground_acceleration``: m/s² at ``t = i·h``. Storey laws (scalars or one value
+    per storey): ``k`` elastic stiffness (N/m), ``fy`` yield force (N), ``alpha``
+    post-yield ratio; ``law="bouc_wen"`` adds ``beta``, ``gamma``, ``n``;
+    ``law="bilinear_friction"`` adds a friction damper with slip force ``fs`` (N) and
+    regularization velocity ``vr`` (m/s). Newton: at most ``max_iterations`` a step,
+    relative ``tolerance``; a step that does not converge raises ``NotConverged`` (its
+    ``.step`` attribute says which). ``energy=False`` skips the energy account (about one
+    more law evaluation per storey a step) for the bare stepping speed.
+    """
+    masses = _vec(masses, "masses")
+    count = masses.shape[0]
+    cols = [k, fy, alpha]
+    if law == "bouc_wen":
+        cols += [beta, gamma, n]
+    elif law == "bilinear_friction":
+        if fs is None or vr is None:
+            raise ShapeError("law='bilinear_friction' needs fs (N) and vr (m/s)")
+        cols += [fs, vr]
+    elif law != "bilinear":
+        raise ValueError(f"unknown law {law!r}: one of {LAWS}")
+    params = np.column_stack([_per_period(x, count, "a storey parameter") for x in cols])
+    d = _aemstep.shear_building(
+        masses,
+        law,
+        params,
+        _mat(c, "c"),
+        float(h),
+        _vec(ground_acceleration, "ground_acceleration"),
+        int(max_iterations),
+        float(tolerance),
+        bool(energy),
+    )
+    u = d["u"]
+    drifts = np.diff(u, axis=1, prepend=0.0)
+    account = None
+    if energy:
+        e = d["energy"]
+        account = Energy(e[:, 0], e[:, 1], e[:, 2], e[:, 3], e[:, 4], e[:, 5], d["initial_energy"])
+    return BuildingResponse(
+        u, d["v"], d["a"], drifts, np.abs(drifts).max(axis=0), account, d["iterations"]
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# Elastic spectra.
+
+
+class Spectrum(NamedTuple):
+    """Elastic spectra; one value per period (``spectrum``) or ``records×periods``
+    (``spectra``)."""
+
+    periods: np.ndarray  #: s
+    sd: np.ndarray  #: peak relative displacement (m)
+    sv: np.ndarray  #: peak relative velocity (m/s)
+    sa: np.ndarray  #: peak absolute acceleration (m/s²)
+    psv: np.ndarray  #: pseudo-velocity ω·sd (m/s)
+    psa: np.ndarray  #: pseudo-acceleration ω²·sd (m/s²)
+
+
+Progress = Union[bool, Callable[[int, int], Any], None]
+
+
+def _progress(progress: Progress, total: int) -> Tuple[Callable[[int], None], Callable[[], None]]:
+    """``(update(done), close())`` for a callable ``progress(done, total)``, for
+    ``True`` (tqdm when installed, else nothing), or nothing."""
+    if progress is None or progress is False:
+        return (lambda done: None), (lambda: None)
+    if progress is True:
+        try:
+            from tqdm import tqdm  # optional
+        except ImportError:
+            return (lambda done: None), (lambda: None)
+        bar = tqdm(total=total, unit="record")
+        state = {"done": 0}
+
+        def update(done: int) -> None:
+            bar.update(done - state["done"])
+            state["done"] = done
+
+        return update, bar.close
+    return (lambda done: progress(done, total)), (lambda: None)
+
+
+def spectra(
+    periods: ArrayLike,
+    damping: ArrayLike,
+    h: float,
+    records: Sequence[ArrayLike],
+    *,
+    scheme: str = "exact",
+    free_vibration: bool = True,
+    threads: int = 0,
+    progress: Progress = None,
+) -> Spectrum:
+    """Elastic spectra of many records on ``threads`` threads (0: every core).
+
+    ``periods`` (s, non-decreasing, any count), ``damping`` (ratio: a scalar or one per
+    period), ``h`` the records' sample interval (s), ``records`` ground accelerations
+    (m/s², each 1-D, any lengths). Results are bit for bit those of one thread.
+    ``progress``: a callable ``progress(done, total)`` or ``True`` for a tqdm bar (if tqdm
+    is installed); the records then run in batches, the GIL released during each.
+    """
+    periods = _vec(periods, "periods")
+    damping = _per_period(damping, periods.shape[0], "damping")
+    recs = [_vec(r, "a record") for r in records]
+    threads = int(threads)
+    if progress is None or progress is False:
+        batches = [recs]
+    else:
+        size = max(1, 4 * (threads if threads > 0 else (os.cpu_count() or 1)))
+        batches = [recs[i : i + size] for i in range(0, len(recs), size)]
+    update, close = _progress(progress, len(recs))
+    parts = []
+    done = 0
+    try:
+        for b in batches:
+            parts.append(
+                _aemstep.spectra(periods, damping, float(h), b, scheme, free_vibration, threads)
+            )
+            done += len(b)
+            update(done)
+    finally:
+        close()
+    if not parts:
+        empty = np.zeros((0, periods.shape[0]))
+        return Spectrum(periods, empty, empty, empty, empty, empty)
+    cols = [np.concatenate([p[q] for p in parts]) for q in range(5)]
+    return Spectrum(periods, *cols)
+
+
+def spectrum(
+    periods: ArrayLike,
+    damping: ArrayLike,
+    h: float,
+    ground_acceleration: ArrayLike,
+    *,
+    scheme: str = "exact",
+    free_vibration: bool = True,
+    threads: int = 1,
+) -> Spectrum:
+    """Elastic spectra of one record: as ``spectra`` with one record, one value per period."""
+    s = spectra(
+        periods,
+        damping,
+        h,
+        [ground_acceleration],
+        scheme=scheme,
+        free_vibration=free_vibration,
+        threads=threads,
+    )
+    return Spectrum(s.periods, *(x[0] for x in s[1:]))
+
+
+class RotDSpectrum(NamedTuple):
+    """RotD50/RotD100 of two horizontal components (180 angles, 1° apart)."""
+
+    periods: np.ndarray  #: s
+    rotd50: np.ndarray  #: median over the angles of the peak displacement (m)
+    rotd100: np.ndarray  #: largest over the angles (m)
+    psa50: np.ndarray  #: ω²·rotd50 (m/s²)
+    psa100: np.ndarray  #: ω²·rotd100 (m/s²)
+
+
+def rotd(
+    periods: ArrayLike,
+    damping: ArrayLike,
+    h: float,
+    ax: ArrayLike,
+    ay: ArrayLike,
+    *,
+    scheme: str = "exact",
+    free_vibration: bool = True,
+    threads: int = 0,
+) -> RotDSpectrum:
+    """RotD50 and RotD100 of the components ``ax``, ``ay`` (m/s², same length, sample
+    interval ``h`` s); ``periods`` (s), ``damping`` as ``spectra``."""
+    periods = _vec(periods, "periods")
+    damping = _per_period(damping, periods.shape[0], "damping")
+    out = _aemstep.rotd(
+        periods,
+        damping,
+        float(h),
+        _vec(ax, "ax"),
+        _vec(ay, "ay"),
+        scheme,
+        free_vibration,
+        int(threads),
+    )
+    return RotDSpectrum(periods, *out)
+
+
+# ---------------------------------------------------------------------------------------
+# Inelastic spectra.
+
+
+class ConstantStrength(NamedTuple):
+    """Constant-strength spectrum, one value per period."""
+
+    periods: np.ndarray  #: initial periods (s)
+    elastic: np.ndarray  #: elastic strength per unit mass ω² u_o (m/s²)
+    yield_acceleration: np.ndarray  #: f_y/m = elastic/R (m/s²)
+    ductility: np.ndarray  #: μ = max|u| / u_y
+    plastic_work: np.ndarray  #: hysteretic work per unit mass (m²/s²)
+
+
+def constant_strength(
+    periods: ArrayLike,
+    damping: ArrayLike,
+    h: float,
+    ground_acceleration: ArrayLike,
+    reduction: ArrayLike,
+    *,
+    alpha: float = 0.0,
+    points_per_period: int = 40,
+    threads: int = 0,
+) -> ConstantStrength:
+    """Ductility demand of bilinear oscillators (post-yield ratio ``alpha``, 0:
+    elastic–perfectly plastic) whose strength is the elastic strength over ``reduction``
+    (R, scalar or per period). ``periods`` (s), ``damping`` (ratio), ``h`` (s), record in
+    m/s². Sub-steps: at least ``points_per_period`` per initial period."""
+    periods = _vec(periods, "periods")
+    count = periods.shape[0]
+    out = _aemstep.constant_strength(
+        periods,
+        _per_period(damping, count, "damping"),
+        float(alpha),
+        float(h),
+        _vec(ground_acceleration, "ground_acceleration"),
+        _per_period(reduction, count, "reduction"),
+        int(points_per_period),
+        int(threads),
+    )
+    return ConstantStrength(periods, *out)
+
+
+class ConstantDuctility(NamedTuple):
+    """Constant-ductility spectrum, one value per period."""
+
+    periods: np.ndarray  #: initial periods (s)
+    yield_acceleration: np.ndarray  #: largest f_y/m giving the target ductility (m/s²)
+    elastic: np.ndarray  #: elastic strength per unit mass (m/s²)
+    reduction: np.ndarray  #: R_y = elastic / yield_acceleration
+    bracket: np.ndarray  #: final bracket [lo, hi] of the strength (m/s², periods×2)
+    bracket_ductility: np.ndarray  #: μ at the bracket's ends (periods×2)
+    outcome: List[str]  #: "converged", "no_crossing" or "not_converged" per period
+    passes: int  #: record passes of the slowest bank
+
+
+def constant_ductility(
+    periods: ArrayLike,
+    damping: ArrayLike,
+    h: float,
+    ground_acceleration: ArrayLike,
+    target: float,
+    *,
+    alpha: float = 0.0,
+    points: int = 60,
+    lowest: float = 0.01,
+    tol: float = 1e-6,
+    points_per_period: int = 40,
+    threads: int = 0,
+) -> ConstantDuctility:
+    """The largest yield strength per unit mass (m/s²) giving the ductility ``target``
+    (> 1) at each period: a geometric grid of ``points`` strengths from the elastic one
+    down to ``lowest`` times it brackets the largest crossing, a safeguarded false
+    position refines it to ``tol`` (relative, on the strength)."""
+    periods = _vec(periods, "periods")
+    d = _aemstep.constant_ductility(
+        periods,
+        _per_period(damping, periods.shape[0], "damping"),
+        float(alpha),
+        float(h),
+        _vec(ground_acceleration, "ground_acceleration"),
+        float(target),
+        int(points),
+        float(lowest),
+        float(tol),
+        int(points_per_period),
+        int(threads),
+    )
+    ay = d["yield_acceleration"]
+    return ConstantDuctility(
+        periods,
+        ay,
+        d["elastic"],
+        d["elastic"] / ay,
+        d["bracket"],
+        d["bracket_ductility"],
+        list(d["outcome"]),
+        int(d["passes"]),
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# Observers.
+
+
+class Estimate(NamedTuple):
+    """State estimates, ``steps×n``, relative to the ground."""
+
+    u: np.ndarray  #: displacements (m)
+    v: np.ndarray  #: velocities (m/s)
+    drifts: np.ndarray  #: storey drifts u_i − u_{i−1} (m)
+    gain: np.ndarray  #: steady-state gain (2n×sensors; empty for the Kalman filter)
+
+
+def observe(
+    m: ArrayLike,
+    c: ArrayLike,
+    k: ArrayLike,
+    h: float,
+    ground_acceleration: ArrayLike,
+    measured: ArrayLike,
+    sensors: Sequence[int],
+    *,
+    sigma_f: float,
+    sigma_y: float,
+    kalman: bool = False,
+) -> Estimate:
+    """Estimate a building's state from measured absolute floor accelerations.
+
+    ``m``, ``c``, ``k``: the model (kg, N·s/m, N/m; ``n×n``). ``h``: sample interval (s).
+    ``ground_acceleration``: the measured ground motion (m/s²), the model's input.
+    ``measured``: absolute accelerations (m/s², ``steps×len(sensors)``; NaN for a missing
+    sample) of the floors ``sensors`` (0-based). ``sigma_f``: white-force process noise on
+    every floor (N, standard deviation); ``sigma_y``: accelerometer noise (m/s²).
+    ``kalman``: the full Kalman filter instead of the fixed steady-state gain.
+    """
+    meas = np.ascontiguousarray(measured, dtype=np.float64)
+    if meas.ndim == 1:
+        meas = meas[:, None]
+    u, v, gain = _aemstep.observe(
+        _mat(m, "m"),
+        _mat(c, "c"),
+        _mat(k, "k"),
+        float(h),
+        _vec(ground_acceleration, "ground_acceleration"),
+        _mat(meas, "measured"),
+        [int(s) for s in sensors],
+        float(sigma_f),
+        float(sigma_y),
+        bool(kalman),
+    )
+    return Estimate(u, v, np.diff(u, axis=1, prepend=0.0), gain)
+
+
+# ---------------------------------------------------------------------------------------
+# Records.
+
+
+def read_at2(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, float]:
+    """A PEER NGA ``.AT2`` record: ``(accelerations in g, dt in s)``. Multiply by ``G``
+    for m/s²."""
+    with open(path) as f:
+        lines = f.read().splitlines()
+    if len(lines) < 4:
+        raise ValueError(f"{path}: not an AT2 record (fewer than 4 lines)")
+    header = lines[3].upper()
+    dt_match = re.search(r"DT\s*=\s*([-+0-9.E]+)", header)
+    npts_match = re.search(r"NPTS\s*=\s*(\d+)", header)
+    dt = float(dt_match.group(1)) if dt_match else float("nan")
+    if not (math.isfinite(dt) and dt > 0):
+        raise ValueError(f"{path}: no positive DT on the fourth line")
+    values = np.array(" ".join(lines[4:]).split(), dtype=np.float64)
+    if npts_match and values.shape[0] != int(npts_match.group(1)):
+        raise ValueError(
+            f"{path}: {values.shape[0]} samples, the header says NPTS={npts_match.group(1)}"
+        )
+    return values, dt
+
+
+__all__ = [
+    "G",
+    "SIZES",
+    "CHUNK",
+    "MAX_SENSORS",
+    "MAX_TRUNCATED_MODES",
+    "ROTD_ANGLES",
+    "SCHEMES",
+    "LAWS",
+    "ERROR_VARIANTS",
+    "AemstepError",
+    "ShapeError",
+    "UnsupportedSize",
+    "LinearResponse",
+    "linear_response",
+    "Energy",
+    "BuildingResponse",
+    "shear_building",
+    "Spectrum",
+    "spectra",
+    "spectrum",
+    "RotDSpectrum",
+    "rotd",
+    "ConstantStrength",
+    "constant_strength",
+    "ConstantDuctility",
+    "constant_ductility",
+    "Estimate",
+    "observe",
+    "read_at2",
+] + list(ERROR_VARIANTS)

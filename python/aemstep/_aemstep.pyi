@@ -1,0 +1,192 @@
+"""Type stubs of the native module ``aemstep._aemstep`` (Rust, PyO3, stable ABI).
+
+Arrays are ``float64`` numpy arrays (the wrapper ``aemstep`` converts anything else);
+units SI: m, s, kg, N, ground accelerations in m/s². The GIL is released while a record
+runs. Library errors are raised as the exception classes below, one per
+``aemstep::Error`` variant, message the Rust ``Display``; a failed step sets ``.step``.
+"""
+
+from typing import Dict, List, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+F64 = npt.NDArray[np.float64]
+
+#: Numbers of degrees of freedom (storeys) compiled in: 1–10, 12, 15, 20.
+SIZES: List[int]
+#: Oscillators per spectrum bank (periods are stepped in banks of this many, padded).
+CHUNK: int
+#: Most modes a truncated modal run keeps (``modes=0`` keeps all).
+MAX_TRUNCATED_MODES: int
+#: Most sensors an observer takes.
+MAX_SENSORS: int
+#: Rotation angles of RotD (180: 1° apart).
+ROTD_ANGLES: int
+#: The names of the ``aemstep::Error`` variants, in declaration order.
+ERROR_VARIANTS: List[str]
+
+class AemstepError(ValueError):
+    """Base of every aemstep error."""
+
+    step: int  # set when a step failed: its index (0: the start)
+
+class ShapeError(AemstepError):
+    """An array has the wrong shape or length."""
+
+class UnsupportedSize(ShapeError):
+    """A number of degrees of freedom or sensors outside those compiled in."""
+
+class NonFiniteInput(AemstepError): ...
+class InvalidTimeStep(AemstepError): ...
+class SingularEffectiveMatrix(AemstepError): ...
+class SingularMass(AemstepError): ...
+class NonFiniteState(AemstepError): ...
+class NotConverged(AemstepError): ...
+class SingularJacobian(AemstepError): ...
+class NonFiniteForce(AemstepError): ...
+class InvalidNewtonSettings(AemstepError): ...
+class SingularEffectiveMatrixAtStep(AemstepError): ...
+class MassNotSpd(AemstepError): ...
+class StiffnessNotSymmetric(AemstepError): ...
+class InvalidModeSelection(AemstepError): ...
+class NonClassicalDamping(AemstepError): ...
+class EigenNotConverged(AemstepError): ...
+class OperatorOverflow(AemstepError): ...
+class OperatorUnderflow(AemstepError): ...
+class InvalidParameter(AemstepError): ...
+class InvalidPeriod(AemstepError): ...
+class InvalidDamping(AemstepError): ...
+class InvalidMaterial(AemstepError): ...
+class InvalidCovariance(AemstepError): ...
+class RiccatiNotConverged(AemstepError): ...
+class StateSizeMismatch(AemstepError): ...
+class InputNotIdentifiable(AemstepError): ...
+
+def linear_response(
+    m: F64,
+    c: F64,
+    k: F64,
+    h: float,
+    p: F64,
+    u0: F64,
+    v0: F64,
+    scheme: str = "aem",
+    beta: float = 0.25,
+    gamma: float = 0.5,
+    rho_inf: float = 1.0,
+    alpha: float = 0.0,
+    modes: int = 0,
+) -> Tuple[F64, F64, F64]:
+    """Step ``M u'' + C u' + K u = p(t)`` over a load history.
+
+    m, c, k: ``n×n`` mass (kg), damping (N·s/m), stiffness (N/m); h: time step (s);
+    p: loads (N), ``steps×n``, row i at t = i·h; u0 (m), v0 (m/s): initial state;
+    scheme: ``"aem"``, ``"modal"`` (the ``modes`` lowest modes, 0 for all, else 1 to 3;
+    M SPD, K symmetric, C classical),
+    ``"newmark"`` (beta, gamma), ``"generalized_alpha"`` (rho_inf in [0, 1]), ``"hht"``
+    (alpha in [−1/3, 0]), ``"exact"``.
+    Returns (u m, v m/s, a m/s²), each ``steps×n``, row 0 the initial state.
+    """
+
+def shear_building(
+    masses: F64,
+    law: str,
+    params: F64,
+    c: F64,
+    h: float,
+    ag: F64,
+    max_iterations: int = 20,
+    tolerance: float = 1e-10,
+    energy: bool = True,
+) -> Dict[str, Union[F64, float]]:
+    """A hysteretic shear building (Nonlinear AEM stepper, Newton) over a record.
+
+    masses: floor masses (kg), ground storey first; law: ``"bilinear"`` (params columns
+    k N/m, fy N, alpha), ``"bouc_wen"`` (k, fy, alpha, beta, gamma, n) or
+    ``"bilinear_friction"`` (k, fy, alpha, fs N, vr m/s); params: one row per storey;
+    c: damping (N·s/m, ``n×n``); h: time step (s); ag: ground acceleration (m/s²) at
+    t = i·h; Newton at most max_iterations a step to the relative tolerance.
+    Returns ``u`` (m), ``v`` (m/s), ``a`` (m/s²) relative to the ground (``steps×n``),
+    ``energy`` (``steps×6``: input, kinetic, recoverable, viscous, hysteretic, balance
+    error; J) and ``initial_energy`` (J), both only with energy=True (the account costs
+    about one law evaluation per storey a step), ``iterations`` (per step).
+    """
+
+def spectra(
+    periods: F64,
+    damping: F64,
+    h: float,
+    records: List[F64],
+    scheme: str = "exact",
+    free_vibration: bool = True,
+    threads: int = 1,
+) -> Tuple[F64, F64, F64, F64, F64]:
+    """Elastic spectra of records (m/s², sample interval h s) at periods (s,
+    non-decreasing) with damping ratios (one per period), on threads (0: all cores; bit
+    for bit the same on any count). Returns (sd m, sv m/s, sa m/s², psv m/s, psa m/s²),
+    each ``records×periods``.
+    """
+
+def rotd(
+    periods: F64,
+    damping: F64,
+    h: float,
+    ax: F64,
+    ay: F64,
+    scheme: str = "exact",
+    free_vibration: bool = True,
+    threads: int = 1,
+) -> Tuple[F64, F64, F64, F64]:
+    """RotD50/RotD100 of two components (m/s²): (rotd50 m, rotd100 m, psa50 m/s²,
+    psa100 m/s²), one value per period."""
+
+def constant_strength(
+    periods: F64,
+    damping: F64,
+    alpha: float,
+    h: float,
+    ag: F64,
+    reduction: F64,
+    points_per_period: int = 40,
+    threads: int = 1,
+) -> Tuple[F64, F64, F64, F64]:
+    """Constant-strength spectrum of bilinear oscillators (post-yield ratio alpha in
+    [0, 1)): strength = elastic / reduction (R per period). Returns (elastic m/s²,
+    yield_acceleration m/s², ductility, plastic_work m²/s²) per period."""
+
+def constant_ductility(
+    periods: F64,
+    damping: F64,
+    alpha: float,
+    h: float,
+    ag: F64,
+    target: float,
+    points: int = 60,
+    lowest: float = 0.01,
+    tol: float = 1e-6,
+    points_per_period: int = 40,
+    threads: int = 1,
+) -> Dict[str, object]:
+    """Constant-ductility spectrum: the largest yield strength per unit mass (m/s²)
+    giving the ductility target (> 1). Returns ``yield_acceleration``, ``elastic``
+    (m/s²), ``bracket`` (``periods×2``, m/s²), ``bracket_ductility`` (``periods×2``),
+    ``outcome`` (list of str), ``passes`` (int)."""
+
+def observe(
+    m: F64,
+    c: F64,
+    k: F64,
+    h: float,
+    ag: F64,
+    measured: F64,
+    sensors: List[int],
+    sigma_f: float,
+    sigma_y: float,
+    kalman: bool = False,
+) -> Tuple[F64, F64, F64]:
+    """State of a linear building from measured absolute floor accelerations (m/s²,
+    ``steps×sensors``; NaN: missing) and the ground acceleration (m/s²): steady-state
+    Kalman-gain observer or full Kalman filter; process noise sigma_f (N, white forces
+    on every floor), sensor noise sigma_y (m/s²). Returns (u m, v m/s, gain
+    ``2n×sensors``, empty for the Kalman filter)."""

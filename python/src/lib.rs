@@ -1,0 +1,1208 @@
+//! `aemstep._aemstep`: the native half of the Python package `aemstep` (PyO3, stable ABI
+//! `abi3-py39`, numpy arrays through rust-numpy).
+//!
+//! Every function copies its arrays in (`float64`; the pure-Python wrapper `aemstep/`
+//! converts lists, integers and non-contiguous arrays first), checks shapes and sizes
+//! (a typed exception, never a panic), then runs the record with the GIL released
+//! (`Python::detach`) and hands fresh numpy arrays back. Units are SI throughout: m, s,
+//! kg, N, ground accelerations in m/s².
+//!
+//! **Sizes.** The library's sizes are const generics. Structures (`n` degrees of freedom,
+//! storeys) are dispatched over [`SIZES`] (1 to 10, 12, 15, 20); any other `n` raises
+//! `UnsupportedSize`. Spectra take any number of periods: they are stepped in banks of
+//! [`CHUNK`] oscillators, the last bank padded with copies of the longest period. Observers
+//! take 1 to [`MAX_SENSORS`] sensors.
+//!
+//! **Errors.** Every `aemstep::Error` variant is a Python exception of the same name,
+//! subclass of `AemstepError` (itself a `ValueError`), with the Rust `Display` as message;
+//! a step that fails sets the exception's `step` attribute to its index.
+//!
+//! Incremental dynamic analysis is written in the library on another branch; its binding
+//! goes beside [`shear_building`] (same building, many records and intensities).
+
+use aemstep::hysteresis::{
+    Bilinear, BoucWen, EnergyAccount, Friction, HistoryModel, Law, Parallel, ShearBuilding,
+};
+use aemstep::nalgebra::{SMatrix, SVector};
+use aemstep::observer::{Kalman, Observer, Outputs, StateSpace, SteadyState};
+use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
+use aemstep::spectrum::{Bank, RotD, Scheme, Substeps};
+use aemstep::{
+    Damping, Error, Exact, GeneralizedAlpha, Linear, Modal, Newmark, NewtonSettings, Nonlinear,
+    Stepper, batch,
+};
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The numbers of degrees of freedom (storeys) the package is compiled for.
+pub const SIZES: [usize; 13] = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 12, 15, 20];
+
+/// Oscillators per spectrum bank: periods are stepped in banks of this many.
+pub const CHUNK: usize = 16;
+
+/// The most modes a truncated modal run keeps (besides all of them).
+pub const MAX_TRUNCATED_MODES: usize = 3;
+
+/// The largest number of sensors an observer takes.
+pub const MAX_SENSORS: usize = 3;
+
+/// Rotation angles of RotD50/RotD100 (1° increments over 180°).
+pub const ROTD_ANGLES: usize = 180;
+
+pyo3::create_exception!(
+    _aemstep,
+    AemstepError,
+    PyValueError,
+    "Base of every aemstep error (a ValueError)."
+);
+pyo3::create_exception!(
+    _aemstep,
+    ShapeError,
+    AemstepError,
+    "An array has the wrong shape or length for the call."
+);
+pyo3::create_exception!(
+    _aemstep,
+    UnsupportedSize,
+    ShapeError,
+    "A number of degrees of freedom or sensors outside those compiled in."
+);
+
+/// One Python exception per `aemstep::Error` variant, same name, subclass of
+/// `AemstepError`; `variants!` also writes the mapping and the registration.
+macro_rules! variants {
+    ($($name:ident),* $(,)?) => {
+        $(pyo3::create_exception!(
+            _aemstep,
+            $name,
+            AemstepError,
+            concat!("aemstep::Error::", stringify!($name), " (see the Rust docs).")
+        );)*
+
+        /// The Python exception of a library error, its message the Rust `Display`.
+        fn exception(e: Error) -> PyErr {
+            let msg = e.to_string();
+            match e {
+                $(Error::$name { .. } => $name::new_err(msg),)*
+                // `Error` is non-exhaustive: a variant added later is still an AemstepError.
+                _ => AemstepError::new_err(msg),
+            }
+        }
+
+        /// Register the exception classes in the module.
+        fn register_exceptions(m: &Bound<'_, PyModule>) -> PyResult<()> {
+            let py = m.py();
+            m.add("AemstepError", py.get_type::<AemstepError>())?;
+            m.add("ShapeError", py.get_type::<ShapeError>())?;
+            m.add("UnsupportedSize", py.get_type::<UnsupportedSize>())?;
+            $(m.add(stringify!($name), py.get_type::<$name>())?;)*
+            m.add("ERROR_VARIANTS", vec![$(stringify!($name)),*])?;
+            Ok(())
+        }
+    };
+}
+
+variants!(
+    NonFiniteInput,
+    InvalidTimeStep,
+    SingularEffectiveMatrix,
+    SingularMass,
+    NonFiniteState,
+    NotConverged,
+    SingularJacobian,
+    NonFiniteForce,
+    InvalidNewtonSettings,
+    SingularEffectiveMatrixAtStep,
+    MassNotSpd,
+    StiffnessNotSymmetric,
+    InvalidModeSelection,
+    NonClassicalDamping,
+    EigenNotConverged,
+    OperatorOverflow,
+    OperatorUnderflow,
+    InvalidParameter,
+    InvalidPeriod,
+    InvalidDamping,
+    InvalidMaterial,
+    InvalidCovariance,
+    RiccatiNotConverged,
+    StateSizeMismatch,
+    InputNotIdentifiable,
+);
+
+/// Why a run stopped: a library error (at a step, if a step failed) or a bad argument.
+enum Fail {
+    Lib(Error, Option<usize>),
+    Shape(String),
+    Size(String),
+}
+
+impl From<Error> for Fail {
+    fn from(e: Error) -> Self {
+        Fail::Lib(e, None)
+    }
+}
+
+/// A library error at step `n`.
+fn at(n: usize) -> impl Fn(Error) -> Fail {
+    move |e| Fail::Lib(e, Some(n))
+}
+
+impl Fail {
+    fn raise(self, py: Python<'_>) -> PyErr {
+        match self {
+            Fail::Lib(e, step) => {
+                let err = exception(e);
+                if let Some(n) = step {
+                    // Best effort: the message already says what failed.
+                    let _ = err.value(py).setattr("step", n);
+                }
+                err
+            }
+            Fail::Shape(m) => ShapeError::new_err(m),
+            Fail::Size(m) => UnsupportedSize::new_err(m),
+        }
+    }
+}
+
+type Res<T> = Result<T, Fail>;
+
+fn shape<T>(msg: String) -> Res<T> {
+    Err(Fail::Shape(msg))
+}
+
+/// Call `$f::<N, 2N>(args…)` for the run-time size `$n`, or fail with `UnsupportedSize`.
+macro_rules! by_size {
+    ($n:expr, $f:ident ( $($arg:expr),* $(,)? )) => {
+        match $n {
+            1 => $f::<1, 2>($($arg),*),
+            2 => $f::<2, 4>($($arg),*),
+            3 => $f::<3, 6>($($arg),*),
+            4 => $f::<4, 8>($($arg),*),
+            5 => $f::<5, 10>($($arg),*),
+            6 => $f::<6, 12>($($arg),*),
+            7 => $f::<7, 14>($($arg),*),
+            8 => $f::<8, 16>($($arg),*),
+            9 => $f::<9, 18>($($arg),*),
+            10 => $f::<10, 20>($($arg),*),
+            12 => $f::<12, 24>($($arg),*),
+            15 => $f::<15, 30>($($arg),*),
+            20 => $f::<20, 40>($($arg),*),
+            n => Err(Fail::Size(format!(
+                "{n} degrees of freedom: this build supports n in {:?}",
+                SIZES
+            ))),
+        }
+    };
+}
+
+// ---------------------------------------------------------------------------------------
+// Arrays in and out.
+
+/// A 2-D array copied into a row-major `Vec` with its shape.
+fn read2(a: &PyReadonlyArray2<'_, f64>) -> (Vec<f64>, usize, usize) {
+    let v = a.as_array();
+    let (r, c) = v.dim();
+    (v.iter().copied().collect(), r, c)
+}
+
+/// A 1-D array copied into a `Vec`.
+fn read1(a: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
+    a.as_array().iter().copied().collect()
+}
+
+/// An `n×n` matrix, checked square of size `n`.
+fn square(a: &PyReadonlyArray2<'_, f64>, n: usize, name: &str) -> Res<Vec<f64>> {
+    let (v, r, c) = read2(a);
+    if r != n || c != n {
+        return shape(format!("{name} must be {n}x{n}, got {r}x{c}"));
+    }
+    Ok(v)
+}
+
+fn matrix<const N: usize>(v: &[f64]) -> SMatrix<f64, N, N> {
+    SMatrix::from_fn(|i, j| v[i * N + j])
+}
+
+fn rows<const N: usize>(v: &[f64]) -> [[f64; N]; N] {
+    core::array::from_fn(|i| core::array::from_fn(|j| v[i * N + j]))
+}
+
+fn vector<const N: usize>(v: &[f64]) -> SVector<f64, N> {
+    SVector::from_column_slice(v)
+}
+
+fn out2(py: Python<'_>, v: Vec<f64>, cols: usize) -> Bound<'_, PyArray2<f64>> {
+    let r = v.len().checked_div(cols).unwrap_or(0);
+    Array2::from_shape_vec((r, cols), v)
+        .expect("length is rows × cols by construction")
+        .into_pyarray(py)
+}
+
+fn out1(py: Python<'_>, v: Vec<f64>) -> Bound<'_, PyArray1<f64>> {
+    Array1::from_vec(v).into_pyarray(py)
+}
+
+// ---------------------------------------------------------------------------------------
+// Linear models over a record.
+
+/// Which linear scheme, with its parameters.
+#[derive(Clone, Copy)]
+enum LinearScheme {
+    Aem,
+    /// The `R` lowest modes (`0`: all).
+    Modal(usize),
+    Newmark(f64, f64),
+    GeneralizedAlpha(f64),
+    Hht(f64),
+    Exact,
+}
+
+struct LinearJob {
+    m: Vec<f64>,
+    c: Vec<f64>,
+    k: Vec<f64>,
+    h: f64,
+    p: Vec<f64>,
+    u0: Vec<f64>,
+    v0: Vec<f64>,
+    scheme: LinearScheme,
+}
+
+/// The histories `u, v, a` (row-major, steps × n).
+type Histories = (Vec<f64>, Vec<f64>, Vec<f64>);
+
+fn drive<const N: usize, S>(sys: &S, job: &LinearJob) -> Res<Histories>
+where
+    S: Stepper<f64, N, Input = SVector<f64, N>>,
+{
+    let steps = job.p.len() / N;
+    let load = |n: usize| vector::<N>(&job.p[n * N..(n + 1) * N]);
+    let (mut u, mut v, mut a) = (
+        Vec::with_capacity(steps * N),
+        Vec::with_capacity(steps * N),
+        Vec::with_capacity(steps * N),
+    );
+    let mut keep = |s: &S::State| {
+        let f = sys.full_state(s);
+        u.extend_from_slice(f.u().as_slice());
+        v.extend_from_slice(f.v().as_slice());
+        a.extend_from_slice(f.a().as_slice());
+    };
+    let mut s = sys
+        .start(&vector(&job.u0), &vector(&job.v0), &load(0))
+        .map_err(at(0))?;
+    keep(&s);
+    for n in 1..steps {
+        sys.try_step_with_previous_input(&mut s, &load(n - 1), &load(n))
+            .map_err(at(n))?;
+        keep(&s);
+    }
+    Ok((u, v, a))
+}
+
+fn linear_n<const N: usize, const S: usize>(job: &LinearJob) -> Res<Histories> {
+    let (m, c, k) = (
+        matrix::<N>(&job.m),
+        matrix::<N>(&job.c),
+        matrix::<N>(&job.k),
+    );
+    let h = job.h;
+    match job.scheme {
+        LinearScheme::Aem => drive::<N, _>(&Linear::<f64, N>::new(&m, &c, &k, h)?, job),
+        LinearScheme::Newmark(beta, gamma) => {
+            drive::<N, _>(&Newmark::<f64, N>::new(&m, &c, &k, h, beta, gamma)?, job)
+        }
+        LinearScheme::GeneralizedAlpha(rho) => {
+            drive::<N, _>(&GeneralizedAlpha::<f64, N>::new(&m, &c, &k, h, rho)?, job)
+        }
+        LinearScheme::Hht(alpha) => {
+            drive::<N, _>(&GeneralizedAlpha::<f64, N>::hht(&m, &c, &k, h, alpha)?, job)
+        }
+        LinearScheme::Exact => drive::<N, _>(&Exact::<f64, N>::new(&m, &c, &k, h)?, job),
+        LinearScheme::Modal(r) => match r {
+            // Every mode, or the R lowest: R in 1..=MAX_TRUNCATED_MODES (a copy of the
+            // modal stepper per (n, R), so the list is short; R > n is the library's error).
+            0 => modal_run::<N, N>(job),
+            r if r == N => modal_run::<N, N>(job),
+            r if r > N => Err(Error::InvalidModeSelection.into()),
+            1 => modal_run::<N, 1>(job),
+            2 => modal_run::<N, 2>(job),
+            3 => modal_run::<N, 3>(job),
+            r => Err(Fail::Size(format!(
+                "{r} modes of {N}: this build keeps 1 to {MAX_TRUNCATED_MODES} modes or all of them"
+            ))),
+        },
+    }
+}
+
+/// The `R` lowest modes of the job's model, the loads as `N` inputs (`B = I`), the DOFs as
+/// outputs; the full state rebuilt from the modes at every step.
+fn modal_run<const N: usize, const R: usize>(job: &LinearJob) -> Res<Histories> {
+    let eye = SMatrix::<f64, N, N>::identity();
+    let modal = Modal::<f64, N, R, N, N>::new(
+        &matrix::<N>(&job.m),
+        &matrix::<N>(&job.k),
+        &Damping::Matrix(rows::<N>(&job.c)),
+        &eye,
+        &eye,
+        job.h,
+    )?;
+    drive::<N, _>(&modal, job)
+}
+
+/// Step the linear model `M u'' + C u' + K u = p(t)` over a load history.
+///
+/// Arguments: `m`, `c`, `k` — mass (kg), damping (N·s/m) and stiffness (N/m) matrices,
+/// `n×n`; `h` — time step (s); `p` — loads (N), `steps×n`, row `i` at `t = i·h` (row 0 the
+/// load at the start); `u0`, `v0` — initial displacements (m) and velocities (m/s);
+/// `scheme` — `"aem"` (the analog equation method, `Linear`), `"modal"` (`Modal`: the
+/// `modes` lowest modes, `0` for all, else 1 to 3; `M` SPD, `K` symmetric, `C` classical;
+/// `u` is then the modes' part of the response), `"newmark"` (`beta`, `gamma`),
+/// `"generalized_alpha"` (`rho_inf` in [0, 1]), `"hht"` (`alpha` in [−1/3, 0]), `"exact"`
+/// (matrix exponential, load linear between samples).
+///
+/// Returns `(u, v, a)`: displacements (m), velocities (m/s), accelerations (m/s²), each
+/// `steps×n`, row 0 the initial state. Raises the library's errors (e.g. `InvalidTimeStep`,
+/// `SingularEffectiveMatrix`, `NonFiniteInput`, `NonClassicalDamping`), `ShapeError`,
+/// `UnsupportedSize`. The GIL is released while stepping.
+#[pyfunction]
+#[pyo3(signature = (m, c, k, h, p, u0, v0, scheme="aem", beta=0.25, gamma=0.5, rho_inf=1.0, alpha=0.0, modes=0))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn linear_response<'py>(
+    py: Python<'py>,
+    m: PyReadonlyArray2<'py, f64>,
+    c: PyReadonlyArray2<'py, f64>,
+    k: PyReadonlyArray2<'py, f64>,
+    h: f64,
+    p: PyReadonlyArray2<'py, f64>,
+    u0: PyReadonlyArray1<'py, f64>,
+    v0: PyReadonlyArray1<'py, f64>,
+    scheme: &str,
+    beta: f64,
+    gamma: f64,
+    rho_inf: f64,
+    alpha: f64,
+    modes: usize,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+)> {
+    let scheme = match scheme {
+        "aem" | "linear" => LinearScheme::Aem,
+        "modal" => LinearScheme::Modal(modes),
+        "newmark" => LinearScheme::Newmark(beta, gamma),
+        "generalized_alpha" => LinearScheme::GeneralizedAlpha(rho_inf),
+        "hht" => LinearScheme::Hht(alpha),
+        "exact" => LinearScheme::Exact,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "unknown scheme {other:?}: one of aem, modal, newmark, generalized_alpha, hht, exact"
+            )));
+        }
+    };
+    let run = || -> Res<(LinearJob, usize)> {
+        let n = m.as_array().dim().0;
+        let job = LinearJob {
+            m: square(&m, n, "m")?,
+            c: square(&c, n, "c")?,
+            k: square(&k, n, "k")?,
+            h,
+            p: {
+                let (v, r, cols) = read2(&p);
+                if cols != n || r == 0 {
+                    return shape(format!(
+                        "p must be steps x {n} with at least one row, got {r}x{cols}"
+                    ));
+                }
+                v
+            },
+            u0: read1(&u0),
+            v0: read1(&v0),
+            scheme,
+        };
+        if job.u0.len() != n || job.v0.len() != n {
+            return shape(format!("u0 and v0 must have length {n}"));
+        }
+        Ok((job, n))
+    };
+    let (job, n) = run().map_err(|f| f.raise(py))?;
+    let (u, v, a) = py
+        .detach(|| by_size!(n, linear_n(&job)))
+        .map_err(|f| f.raise(py))?;
+    Ok((out2(py, u, n), out2(py, v, n), out2(py, a, n)))
+}
+
+// ---------------------------------------------------------------------------------------
+// The yielding shear building.
+
+struct BuildingJob {
+    masses: Vec<f64>,
+    params: Vec<f64>,
+    width: usize,
+    c: Vec<f64>,
+    h: f64,
+    ag: Vec<f64>,
+    settings: NewtonSettings<f64>,
+    /// Keep the energy account (`N` law trials and `N²` more a step).
+    energy: bool,
+}
+
+/// The histories of a building run (row-major).
+struct BuildingOut {
+    u: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    /// E_in, E_k, E_s, E_v, E_h, balance error (J) per step (empty without the account).
+    energy: Vec<f64>,
+    iterations: Vec<f64>,
+    initial_energy: f64,
+}
+
+fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) -> Res<BuildingOut> {
+    let masses: [f64; N] = core::array::from_fn(|i| job.masses[i]);
+    let building = ShearBuilding::<f64, L, N>::new(masses, laws, &rows::<N>(&job.c))?;
+    let stepper = Nonlinear::<f64, N>::new(job.h, job.settings)?;
+    let steps = job.ag.len();
+    let zero = SVector::<f64, N>::zeros();
+    let p0 = building.ground_load(job.ag[0]);
+    let (mut s, mut history) = stepper
+        .start_with_history(&building, &zero, &zero, &p0, &building.initial_history())
+        .map_err(at(0))?;
+    let mut account = job
+        .energy
+        .then(|| EnergyAccount::start(&building, &s, &history, &p0));
+    let mut o = BuildingOut {
+        u: Vec::with_capacity(steps * N),
+        v: Vec::with_capacity(steps * N),
+        a: Vec::with_capacity(steps * N),
+        energy: Vec::with_capacity(if job.energy { steps * 6 } else { 0 }),
+        iterations: Vec::with_capacity(steps),
+        initial_energy: account.as_ref().map_or(f64::NAN, |e| e.initial),
+    };
+    let keep = |o: &mut BuildingOut,
+                s: &aemstep::State<f64, N>,
+                e: Option<&EnergyAccount<f64, N>>,
+                iterations: u32| {
+        o.u.extend_from_slice(s.u().as_slice());
+        o.v.extend_from_slice(s.v().as_slice());
+        o.a.extend_from_slice(s.a().as_slice());
+        if let Some(e) = e {
+            o.energy.extend_from_slice(&[
+                e.input,
+                e.kinetic,
+                e.recoverable,
+                e.viscous,
+                e.hysteretic,
+                e.balance_error(),
+            ]);
+        }
+        o.iterations.push(f64::from(iterations));
+    };
+    keep(&mut o, &s, account.as_ref(), 0);
+    for n in 1..steps {
+        let p = building.ground_load(job.ag[n]);
+        let previous = history;
+        let report = stepper
+            .try_step_with_history(&building, &mut s, &mut history, &p)
+            .map_err(at(n))?;
+        if let Some(e) = account.as_mut() {
+            e.step(&building, &previous, &s, &history, &p);
+        }
+        keep(&mut o, &s, account.as_ref(), report.iterations);
+    }
+    Ok(o)
+}
+
+/// The storey laws from the parameter rows, then the run.
+fn building_n<const N: usize, const S: usize>(law: &str, job: &BuildingJob) -> Res<BuildingOut> {
+    let row = |i: usize| &job.params[i * job.width..(i + 1) * job.width];
+    fn laws<const N: usize, L>(f: impl Fn(usize) -> Result<L, Error>) -> Result<[L; N], Error> {
+        let mut v = Vec::with_capacity(N);
+        for i in 0..N {
+            v.push(f(i)?);
+        }
+        Ok(v.try_into()
+            .unwrap_or_else(|_| unreachable!("N laws pushed")))
+    }
+    match law {
+        "bilinear" => building_run::<N, _>(
+            laws::<N, _>(|i| {
+                let r = row(i);
+                Bilinear::<f64>::new(r[0], r[1], r[2])
+            })?,
+            job,
+        ),
+        "bouc_wen" => building_run::<N, _>(
+            laws::<N, _>(|i| {
+                let r = row(i);
+                BoucWen::<f64>::new(r[0], r[1], r[2], r[3], r[4], r[5])
+            })?,
+            job,
+        ),
+        "bilinear_friction" => building_run::<N, _>(
+            laws::<N, _>(|i| {
+                let r = row(i);
+                Ok(Parallel(
+                    Bilinear::<f64>::new(r[0], r[1], r[2])?,
+                    Friction::<f64>::new(r[3], r[4])?,
+                ))
+            })?,
+            job,
+        ),
+        _ => unreachable!("law checked by the caller"),
+    }
+}
+
+/// Step a hysteretic shear building (`ShearBuilding` with the `Nonlinear` AEM stepper and
+/// Newton) over a ground-acceleration record, with its energy account.
+///
+/// Arguments: `masses` — floor masses (kg), ground storey first, length `n`; `law` —
+/// `"bilinear"` (`params` columns: k N/m, fy N, alpha), `"bouc_wen"` (k N/m, fy N, alpha,
+/// beta, gamma, n) or `"bilinear_friction"` (a bilinear frame and a Coulomb friction
+/// damper in parallel: k N/m, fy N, alpha, fs N, vr m/s); `params` — one row per storey;
+/// `c` — damping matrix (N·s/m), `n×n`; `h` — time step (s); `ag` — ground acceleration
+/// (m/s²) at `t = i·h`; `max_iterations`, `tolerance` — Newton budget and relative
+/// tolerance; `energy` — keep the energy account (about `N` law trials and `N²`
+/// multiply-adds more a step; `False` for the bare stepping speed).
+///
+/// Returns a dict: `u`, `v`, `a` — floor displacements (m), velocities (m/s),
+/// accelerations (m/s²) relative to the ground, `steps×n`; `energy` — `steps×6`: input,
+/// kinetic, recoverable strain, viscous, hysteretic energies and the balance error (J);
+/// `initial_energy` (J) — both absent without `energy`; `iterations` — Newton iterations
+/// per step. Raises the library's
+/// errors (`NotConverged` with `.step`, `InvalidMaterial`, `InvalidNewtonSettings`, …).
+#[pyfunction]
+#[pyo3(signature = (masses, law, params, c, h, ag, max_iterations=20, tolerance=1e-10, energy=true))]
+#[allow(clippy::too_many_arguments)]
+fn shear_building<'py>(
+    py: Python<'py>,
+    masses: PyReadonlyArray1<'py, f64>,
+    law: &str,
+    params: PyReadonlyArray2<'py, f64>,
+    c: PyReadonlyArray2<'py, f64>,
+    h: f64,
+    ag: PyReadonlyArray1<'py, f64>,
+    max_iterations: u32,
+    tolerance: f64,
+    energy: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let width = match law {
+        "bilinear" => 3,
+        "bouc_wen" => 6,
+        "bilinear_friction" => 5,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "unknown law {other:?}: one of bilinear, bouc_wen, bilinear_friction"
+            )));
+        }
+    };
+    let prepare = || -> Res<(BuildingJob, usize)> {
+        let masses = read1(&masses);
+        let n = masses.len();
+        let (p, r, cols) = read2(&params);
+        if r != n || cols != width {
+            return shape(format!(
+                "params must be {n}x{width} for law {law:?} and {n} storeys, got {r}x{cols}"
+            ));
+        }
+        let ag = read1(&ag);
+        if ag.is_empty() {
+            return shape("ag must have at least one sample".into());
+        }
+        Ok((
+            BuildingJob {
+                masses,
+                params: p,
+                width,
+                c: square(&c, n, "c")?,
+                h,
+                ag,
+                settings: NewtonSettings::up_to(max_iterations, tolerance),
+                energy,
+            },
+            n,
+        ))
+    };
+    let (job, n) = prepare().map_err(|f| f.raise(py))?;
+    let o = py
+        .detach(|| by_size!(n, building_n(law, &job)))
+        .map_err(|f| f.raise(py))?;
+    let d = PyDict::new(py);
+    d.set_item("u", out2(py, o.u, n))?;
+    d.set_item("v", out2(py, o.v, n))?;
+    d.set_item("a", out2(py, o.a, n))?;
+    if energy {
+        d.set_item("energy", out2(py, o.energy, 6))?;
+        d.set_item("initial_energy", o.initial_energy)?;
+    }
+    d.set_item("iterations", out1(py, o.iterations))?;
+    Ok(d)
+}
+
+// ---------------------------------------------------------------------------------------
+// Spectra: periods in banks of CHUNK.
+
+/// Periods and damping checked (same length, periods non-decreasing) and cut into banks of
+/// `CHUNK`, the last padded with copies of the last period.
+fn chunks(periods: &[f64], damping: &[f64]) -> Res<Vec<([f64; CHUNK], [f64; CHUNK])>> {
+    if periods.is_empty() || periods.len() != damping.len() {
+        return shape(format!(
+            "periods ({}) and damping ({}) must have the same nonzero length",
+            periods.len(),
+            damping.len()
+        ));
+    }
+    // Across banks too (each bank checks its own): the order is the library's rule.
+    if periods
+        .windows(2)
+        .any(|w| w[0].partial_cmp(&w[1]).is_none_or(|o| o.is_gt()))
+    {
+        return Err(Error::InvalidPeriod.into());
+    }
+    let last = periods.len() - 1;
+    Ok(periods
+        .chunks(CHUNK)
+        .enumerate()
+        .map(|(b, _)| {
+            let at = |j: usize| (b * CHUNK + j).min(last);
+            (
+                core::array::from_fn(|j| periods[at(j)]),
+                core::array::from_fn(|j| damping[at(j)]),
+            )
+        })
+        .collect())
+}
+
+fn scheme_of(s: &str) -> PyResult<Scheme> {
+    match s {
+        "exact" => Ok(Scheme::Exact),
+        "aem" => Ok(Scheme::Aem),
+        other => Err(PyValueError::new_err(format!(
+            "unknown spectrum scheme {other:?}: exact or aem"
+        ))),
+    }
+}
+
+/// `[sd, sv, sa, psv, psa]` of one record, one value per period.
+type Spectrum = [Vec<f64>; 5];
+
+/// Elastic response spectra of one or more records.
+///
+/// Arguments: `periods` — oscillator periods (s), non-decreasing, any count (stepped in
+/// banks of 16); `damping` — damping ratios, one per period; `h` — sample interval of the
+/// records (s); `records` — a list of 1-D arrays of ground acceleration (m/s²); `scheme` —
+/// `"exact"` (piecewise exact, default) or `"aem"`; `free_vibration` — continue each
+/// record in free vibration for one longest period (catches late peaks); `threads` —
+/// threads of the work-stealing pool (0: all cores). Results are bit for bit the same on
+/// any thread count.
+///
+/// Returns `(sd, sv, sa, psv, psa)`, each `records×periods`: peak relative displacement
+/// (m), peak relative velocity (m/s), peak absolute acceleration (m/s²), pseudo-velocity
+/// `ω·sd` (m/s), pseudo-acceleration `ω²·sd` (m/s²).
+#[pyfunction]
+#[pyo3(signature = (periods, damping, h, records, scheme="exact", free_vibration=true, threads=1))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn spectra<'py>(
+    py: Python<'py>,
+    periods: PyReadonlyArray1<'py, f64>,
+    damping: PyReadonlyArray1<'py, f64>,
+    h: f64,
+    records: Vec<PyReadonlyArray1<'py, f64>>,
+    scheme: &str,
+    free_vibration: bool,
+    threads: usize,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+)> {
+    let scheme = scheme_of(scheme)?;
+    let periods = read1(&periods);
+    let damping = read1(&damping);
+    let records: Vec<Vec<f64>> = records.iter().map(read1).collect();
+    let np = periods.len();
+    let run = || -> Res<Vec<Spectrum>> {
+        let banks = chunks(&periods, &damping)?
+            .into_iter()
+            .map(|(t, z)| Bank::<f64, CHUNK>::with(t, z, h, scheme, Substeps::AUTO))
+            .collect::<Result<Vec<_>, _>>()?;
+        // One longest period of free vibration for every bank: the result of a period
+        // does not depend on the bank it falls in.
+        let fv = if free_vibration {
+            banks.last().map_or(0, |b| b.free_vibration_samples())
+        } else {
+            0
+        };
+        let jobs: Vec<(usize, usize)> = (0..records.len())
+            .flat_map(|r| (0..banks.len()).map(move |b| (r, b)))
+            .collect();
+        let parts = batch::map(&jobs, threads, |&(r, b)| {
+            let bank = &banks[b];
+            let mut resp = bank.at_rest();
+            for &a in &records[r] {
+                bank.step(&mut resp, a);
+            }
+            bank.free_vibration(&mut resp, fv);
+            let sd = *resp.sd();
+            (sd, *resp.sv(), *resp.sa(), bank.psv(&sd), bank.psa(&sd))
+        });
+        let mut out: Vec<Spectrum> = (0..records.len()).map(|_| Default::default()).collect();
+        for (&(r, _), part) in jobs.iter().zip(parts) {
+            let o = &mut out[r];
+            o[0].extend_from_slice(&part.0);
+            o[1].extend_from_slice(&part.1);
+            o[2].extend_from_slice(&part.2);
+            o[3].extend_from_slice(&part.3);
+            o[4].extend_from_slice(&part.4);
+        }
+        for o in &mut out {
+            o.iter_mut().for_each(|v| v.truncate(np));
+        }
+        Ok(out)
+    };
+    let out = py.detach(run).map_err(|f| f.raise(py))?;
+    let take = |q: usize| {
+        let v: Vec<f64> = out.iter().flat_map(|o| o[q].iter().copied()).collect();
+        out2(py, v, np)
+    };
+    Ok((take(0), take(1), take(2), take(3), take(4)))
+}
+
+/// RotD50 and RotD100 of two horizontal components.
+///
+/// Arguments: `periods` (s, non-decreasing), `damping` (one ratio per period), `h` (s),
+/// `ax`, `ay` — the two components (m/s², same length and sample interval), `scheme`,
+/// `free_vibration`, `threads` as `spectra`. Rotation angles: 180 (1°).
+///
+/// Returns `(rotd50, rotd100, psa50, psa100)`: spectral displacements (m), the median and
+/// the largest over the angles, and their pseudo-accelerations `ω²·sd` (m/s²).
+#[pyfunction]
+#[pyo3(signature = (periods, damping, h, ax, ay, scheme="exact", free_vibration=true, threads=1))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn rotd<'py>(
+    py: Python<'py>,
+    periods: PyReadonlyArray1<'py, f64>,
+    damping: PyReadonlyArray1<'py, f64>,
+    h: f64,
+    ax: PyReadonlyArray1<'py, f64>,
+    ay: PyReadonlyArray1<'py, f64>,
+    scheme: &str,
+    free_vibration: bool,
+    threads: usize,
+) -> PyResult<(
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+)> {
+    let scheme = scheme_of(scheme)?;
+    let (periods, damping, ax, ay) = (read1(&periods), read1(&damping), read1(&ax), read1(&ay));
+    let np = periods.len();
+    let run = || -> Res<[Vec<f64>; 4]> {
+        if ax.len() != ay.len() {
+            return shape(format!(
+                "ax ({}) and ay ({}) must have the same length",
+                ax.len(),
+                ay.len()
+            ));
+        }
+        let banks = chunks(&periods, &damping)?
+            .into_iter()
+            .map(|(t, z)| Bank::<f64, CHUNK>::with(t, z, h, scheme, Substeps::AUTO))
+            .collect::<Result<Vec<_>, _>>()?;
+        let fv = if free_vibration {
+            banks.last().map_or(0, |b| b.free_vibration_samples())
+        } else {
+            0
+        };
+        let angles = RotD::<f64, ROTD_ANGLES>::new();
+        let parts = batch::map(&banks, threads, |bank| {
+            let mut r = angles.at_rest(bank);
+            for (&x, &y) in ax.iter().zip(&ay) {
+                angles.step(bank, &mut r, x, y);
+            }
+            angles.free_vibration(bank, &mut r, fv);
+            let (d50, d100) = (r.rotd50(), r.rotd100());
+            (d50, d100, bank.psa(&d50), bank.psa(&d100))
+        });
+        let mut out: [Vec<f64>; 4] = Default::default();
+        for p in parts {
+            out[0].extend_from_slice(&p.0);
+            out[1].extend_from_slice(&p.1);
+            out[2].extend_from_slice(&p.2);
+            out[3].extend_from_slice(&p.3);
+        }
+        out.iter_mut().for_each(|v| v.truncate(np));
+        Ok(out)
+    };
+    let [a, b, c, d] = py.detach(run).map_err(|f| f.raise(py))?;
+    Ok((out1(py, a), out1(py, b), out1(py, c), out1(py, d)))
+}
+
+// ---------------------------------------------------------------------------------------
+// Inelastic spectra.
+
+fn yielding_banks(
+    periods: &[f64],
+    damping: &[f64],
+    alpha: f64,
+    h: f64,
+    points_per_period: u16,
+) -> Res<Vec<Yielding<f64, CHUNK>>> {
+    Ok(chunks(periods, damping)?
+        .into_iter()
+        .map(|(t, z)| {
+            Yielding::<f64, CHUNK>::with(
+                t,
+                z,
+                alpha,
+                h,
+                Substeps::PointsPerPeriod(points_per_period),
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?)
+}
+
+/// The constant-strength inelastic spectrum: ductility demand for given
+/// strength-reduction factors.
+///
+/// Arguments: `periods` (s, initial, non-decreasing), `damping` (ratios on the initial
+/// stiffness, one per period), `alpha` — post-yield stiffness ratio in [0, 1) (0:
+/// elastic–perfectly plastic), `h` — sample interval (s), `ag` — ground acceleration
+/// (m/s²), `reduction` — `R` per period (> 0), `points_per_period` — sub-steps rule (at
+/// least this many points per initial period; 40 by default), `threads`.
+///
+/// Returns `(elastic, yield_acceleration, ductility, plastic_work)` per period: elastic
+/// strength per unit mass `ω² u_o` (m/s²), yield strength per unit mass `elastic/R`
+/// (m/s²), ductility `max|u|/u_y`, plastic work per unit mass (m²/s²).
+#[pyfunction]
+#[pyo3(signature = (periods, damping, alpha, h, ag, reduction, points_per_period=40, threads=1))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn constant_strength<'py>(
+    py: Python<'py>,
+    periods: PyReadonlyArray1<'py, f64>,
+    damping: PyReadonlyArray1<'py, f64>,
+    alpha: f64,
+    h: f64,
+    ag: PyReadonlyArray1<'py, f64>,
+    reduction: PyReadonlyArray1<'py, f64>,
+    points_per_period: u16,
+    threads: usize,
+) -> PyResult<(
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+)> {
+    let (periods, damping, ag, reduction) = (
+        read1(&periods),
+        read1(&damping),
+        read1(&ag),
+        read1(&reduction),
+    );
+    let np = periods.len();
+    let run = || -> Res<[Vec<f64>; 4]> {
+        if reduction.len() != np {
+            return shape(format!(
+                "reduction must have one factor per period ({np}), got {}",
+                reduction.len()
+            ));
+        }
+        let banks = yielding_banks(&periods, &damping, alpha, h, points_per_period)?;
+        let jobs: Vec<usize> = (0..banks.len()).collect();
+        let last = np - 1;
+        let parts = batch::map(&jobs, threads, |&b| {
+            let r: [f64; CHUNK] = core::array::from_fn(|j| reduction[(b * CHUNK + j).min(last)]);
+            banks[b].constant_strength(&ag, &r)
+        });
+        let mut out: [Vec<f64>; 4] = Default::default();
+        for p in parts {
+            let p = p?;
+            out[0].extend_from_slice(&p.elastic);
+            out[1].extend_from_slice(&p.yield_acceleration);
+            out[2].extend_from_slice(&p.ductility);
+            out[3].extend_from_slice(&p.plastic_work);
+        }
+        out.iter_mut().for_each(|v| v.truncate(np));
+        Ok(out)
+    };
+    let [a, b, c, d] = py.detach(run).map_err(|f| f.raise(py))?;
+    Ok((out1(py, a), out1(py, b), out1(py, c), out1(py, d)))
+}
+
+/// `yield_acceleration, elastic, bracket, bracket ductility, outcome, passes` (row-major).
+type DuctilityOut = (
+    Vec<f64>,
+    Vec<f64>,
+    Vec<f64>,
+    Vec<f64>,
+    Vec<&'static str>,
+    u32,
+);
+
+/// The constant-ductility inelastic spectrum: the largest strength giving a target
+/// ductility (Chopra's convention when several do), by a grid bracket then a safeguarded
+/// false-position refinement.
+///
+/// Arguments: as `constant_strength`, with `target` — the ductility `μ_t > 1` — instead of
+/// `reduction`; `points`, `lowest`, `tol` — the search grid (points from the elastic
+/// strength down to `lowest` times it) and the relative tolerance on the strength.
+///
+/// Returns a dict: `yield_acceleration` (m/s²), `elastic` (m/s²), `bracket` (`periods×2`,
+/// m/s²), `bracket_ductility` (`periods×2`), `outcome` (list of `"converged"`,
+/// `"no_crossing"`, `"not_converged"`), `passes` (record passes of the slowest bank).
+#[pyfunction]
+#[pyo3(signature = (periods, damping, alpha, h, ag, target, points=60, lowest=0.01, tol=1e-6, points_per_period=40, threads=1))]
+#[allow(clippy::too_many_arguments)]
+fn constant_ductility<'py>(
+    py: Python<'py>,
+    periods: PyReadonlyArray1<'py, f64>,
+    damping: PyReadonlyArray1<'py, f64>,
+    alpha: f64,
+    h: f64,
+    ag: PyReadonlyArray1<'py, f64>,
+    target: f64,
+    points: u16,
+    lowest: f64,
+    tol: f64,
+    points_per_period: u16,
+    threads: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (periods, damping, ag) = (read1(&periods), read1(&damping), read1(&ag));
+    let np = periods.len();
+    let search = Search {
+        points,
+        lowest,
+        tol,
+    };
+    let run = || -> Res<DuctilityOut> {
+        let banks = yielding_banks(&periods, &damping, alpha, h, points_per_period)?;
+        let parts = batch::map(&banks, threads, |bank| {
+            bank.constant_ductility(&ag, target, &search)
+        });
+        let (mut ay, mut el, mut br, mut mu, mut oc, mut passes) =
+            (vec![], vec![], vec![], vec![], vec![], 0);
+        for p in parts {
+            let p = p?;
+            ay.extend_from_slice(&p.yield_acceleration);
+            el.extend_from_slice(&p.elastic);
+            br.extend(p.bracket.iter().flatten());
+            mu.extend(p.ductility.iter().flatten());
+            oc.extend(p.outcome.iter().map(|o| match o {
+                Outcome::Converged => "converged",
+                Outcome::NoCrossing => "no_crossing",
+                Outcome::NotConverged => "not_converged",
+            }));
+            passes = passes.max(p.passes);
+        }
+        ay.truncate(np);
+        el.truncate(np);
+        br.truncate(2 * np);
+        mu.truncate(2 * np);
+        oc.truncate(np);
+        Ok((ay, el, br, mu, oc, passes))
+    };
+    let (ay, el, br, mu, oc, passes) = py.detach(run).map_err(|f| f.raise(py))?;
+    let d = PyDict::new(py);
+    d.set_item("yield_acceleration", out1(py, ay))?;
+    d.set_item("elastic", out1(py, el))?;
+    d.set_item("bracket", out2(py, br, 2))?;
+    d.set_item("bracket_ductility", out2(py, mu, 2))?;
+    d.set_item("outcome", oc)?;
+    d.set_item("passes", passes)?;
+    Ok(d)
+}
+
+// ---------------------------------------------------------------------------------------
+// Observers on recorded data.
+
+struct ObserveJob {
+    m: Vec<f64>,
+    c: Vec<f64>,
+    k: Vec<f64>,
+    h: f64,
+    ag: Vec<f64>,
+    y: Vec<f64>,
+    sensors: Vec<usize>,
+    sigma_f: f64,
+    sigma_y: f64,
+    kalman: bool,
+}
+
+/// Estimates `x̂ = [u; v]` per step (row-major, steps × 2n) and the steady-state gain
+/// (2n × sensors; empty for the Kalman filter).
+type ObserveOut = (Vec<f64>, Vec<f64>);
+
+fn observe_no<const N: usize, const S: usize, const O: usize>(job: &ObserveJob) -> Res<ObserveOut> {
+    let (m, c, k) = (
+        matrix::<N>(&job.m),
+        matrix::<N>(&job.c),
+        matrix::<N>(&job.k),
+    );
+    let b = SMatrix::<f64, N, 1>::from_fn(|i, _| -(0..N).map(|j| m[(i, j)]).sum::<f64>());
+    let model = StateSpace::<N, S, 1>::aem(&m, &c, &k, &b, job.h)?;
+    let sensors: [usize; O] = core::array::from_fn(|o| job.sensors[o]);
+    let meas = model.outputs(&Outputs::absolute_accelerations(
+        Outputs::<N, 1, O>::select(sensors),
+        0,
+    ))?;
+    // Process noise: white forces of standard deviation sigma_f on every floor.
+    let forces = StateSpace::<N, S, N>::aem(&m, &c, &k, &SMatrix::identity(), job.h)?;
+    let mut qf = [[0.0; N]; N];
+    (0..N).for_each(|i| qf[i][i] = job.sigma_f * job.sigma_f);
+    let q = SMatrix::<f64, S, S>::from_fn(|i, j| forces.input_noise(&qf)[i][j]);
+    let r = SMatrix::<f64, O, O>::identity() * (job.sigma_y * job.sigma_y);
+    let steps = job.ag.len();
+    let w = |n: usize| SVector::<f64, 1>::from([job.ag[n]]);
+    let y = |n: usize| SVector::<f64, O>::from_column_slice(&job.y[n * O..(n + 1) * O]);
+    let mut x = Vec::with_capacity(steps * S);
+    if job.kalman {
+        let filter = Kalman::<f64, S, 1, O>::new(&model, &meas, &q, &r)?;
+        let mut s = filter
+            .start(&SVector::zeros(), &SMatrix::zeros(), &w(0))
+            .map_err(at(0))?;
+        x.extend_from_slice(s.estimate().x().as_slice());
+        for n in 1..steps {
+            filter.try_step(&mut s, &w(n), &y(n)).map_err(at(n))?;
+            x.extend_from_slice(s.estimate().x().as_slice());
+        }
+        Ok((x, vec![]))
+    } else {
+        let gain = SteadyState::new(&model, &meas, &q, &r)?;
+        let obs = Observer::<f64, S, 1, O>::new(&model, &meas, &gain.gain_matrix())?;
+        let mut e = obs.start_at_rest(&w(0)).map_err(at(0))?;
+        x.extend_from_slice(e.x().as_slice());
+        for n in 1..steps {
+            obs.try_step(&mut e, &w(n), &y(n)).map_err(at(n))?;
+            x.extend_from_slice(e.x().as_slice());
+        }
+        Ok((x, gain.gain.iter().flatten().copied().collect()))
+    }
+}
+
+fn observe_n<const N: usize, const S: usize>(job: &ObserveJob) -> Res<ObserveOut> {
+    match job.sensors.len() {
+        1 => observe_no::<N, S, 1>(job),
+        2 if N >= 2 => observe_no::<N, S, 2>(job),
+        3 if N >= 3 => observe_no::<N, S, 3>(job),
+        o => Err(Fail::Size(format!(
+            "{o} sensors on {N} floors: this build takes 1 to {} sensors, at most one per floor",
+            MAX_SENSORS.min(N)
+        ))),
+    }
+}
+
+/// Estimate the state of a linear building from measured absolute floor accelerations:
+/// the AEM model's fixed-gain observer with the steady-state Kalman gain, or the full
+/// Kalman filter (covariance propagated; started at rest with zero covariance).
+///
+/// Arguments: `m`, `c`, `k` (kg, N·s/m, N/m; `n×n`), `h` — sample interval (s), `ag` —
+/// the measured ground acceleration (m/s², the model's input), `measured` — absolute
+/// accelerations (m/s²) of the floors `sensors` (0-based DOF indices), `steps×sensors`
+/// (NaN: a missing sample, the correction skipped); `sigma_f` — process noise, the
+/// standard deviation of white forces on every floor (N); `sigma_y` — accelerometer noise
+/// (m/s²); `kalman` — the full filter instead of the steady-state gain.
+///
+/// Returns `(u, v, gain)`: estimated displacements (m) and velocities (m/s), `steps×n`,
+/// relative to the ground, and the steady-state gain (`2n×sensors`; empty for the
+/// Kalman filter). Raises `InvalidCovariance`, `RiccatiNotConverged`, …
+#[pyfunction]
+#[pyo3(signature = (m, c, k, h, ag, measured, sensors, sigma_f, sigma_y, kalman=false))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn observe<'py>(
+    py: Python<'py>,
+    m: PyReadonlyArray2<'py, f64>,
+    c: PyReadonlyArray2<'py, f64>,
+    k: PyReadonlyArray2<'py, f64>,
+    h: f64,
+    ag: PyReadonlyArray1<'py, f64>,
+    measured: PyReadonlyArray2<'py, f64>,
+    sensors: Vec<usize>,
+    sigma_f: f64,
+    sigma_y: f64,
+    kalman: bool,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+)> {
+    let prepare = || -> Res<(ObserveJob, usize)> {
+        let n = m.as_array().dim().0;
+        let ag = read1(&ag);
+        let (y, r, cols) = read2(&measured);
+        if ag.is_empty() || r != ag.len() || cols != sensors.len() {
+            return shape(format!(
+                "measured must be {} x {} (one row per ground-acceleration sample, one column per sensor), got {r}x{cols}",
+                ag.len(),
+                sensors.len()
+            ));
+        }
+        if sensors.is_empty() || sensors.iter().any(|&s| s >= n) {
+            return shape(format!(
+                "sensors must be 1 or more floor indices in 0..{n}, got {sensors:?}"
+            ));
+        }
+        let mut sorted = sensors.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        if sorted.len() != sensors.len() {
+            return shape(format!("sensors must be distinct, got {sensors:?}"));
+        }
+        Ok((
+            ObserveJob {
+                m: square(&m, n, "m")?,
+                c: square(&c, n, "c")?,
+                k: square(&k, n, "k")?,
+                h,
+                ag,
+                y,
+                sensors: sensors.clone(),
+                sigma_f,
+                sigma_y,
+                kalman,
+            },
+            n,
+        ))
+    };
+    let (job, n) = prepare().map_err(|f| f.raise(py))?;
+    let (x, gain) = py
+        .detach(|| by_size!(n, observe_n(&job)))
+        .map_err(|f| f.raise(py))?;
+    let steps = job.ag.len();
+    let (mut u, mut v) = (Vec::with_capacity(steps * n), Vec::with_capacity(steps * n));
+    for row in x.chunks(2 * n) {
+        u.extend_from_slice(&row[..n]);
+        v.extend_from_slice(&row[n..]);
+    }
+    Ok((
+        out2(py, u, n),
+        out2(py, v, n),
+        out2(py, gain, job.sensors.len()),
+    ))
+}
+
+/// The native module: functions, exception classes and the compiled limits.
+#[pymodule]
+fn _aemstep(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    register_exceptions(m)?;
+    m.add("SIZES", SIZES.to_vec())?;
+    m.add("CHUNK", CHUNK)?;
+    m.add("MAX_SENSORS", MAX_SENSORS)?;
+    m.add("MAX_TRUNCATED_MODES", MAX_TRUNCATED_MODES)?;
+    m.add("ROTD_ANGLES", ROTD_ANGLES)?;
+    m.add_function(wrap_pyfunction!(linear_response, m)?)?;
+    m.add_function(wrap_pyfunction!(shear_building, m)?)?;
+    m.add_function(wrap_pyfunction!(spectra, m)?)?;
+    m.add_function(wrap_pyfunction!(rotd, m)?)?;
+    m.add_function(wrap_pyfunction!(constant_strength, m)?)?;
+    m.add_function(wrap_pyfunction!(constant_ductility, m)?)?;
+    m.add_function(wrap_pyfunction!(observe, m)?)?;
+    Ok(())
+}
