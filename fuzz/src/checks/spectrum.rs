@@ -82,6 +82,7 @@ pub fn spectrum(data: &[u8]) {
     let y32 = inelastic_typed::<f32>(&period, &damping, dt, sub, &samples, &yielding, r32);
     same_kind(SP, "Yielding f64 vs f32", &y64, &y32);
     records_checks(&String::from_utf8_lossy(data));
+    #[cfg(feature = "std")]
     ida_checks(&mut b);
     count(SP, "inputs");
     count(SP, b.category());
@@ -508,7 +509,8 @@ fn records_checks(text: &str) {
 /// `InvalidParameter` before any run; otherwise at most `runs` analyses, points sorted by
 /// intensity with finite positive intensities, the collapse bracket `[lo, hi]` with
 /// `lo < capacity ≤ hi` (each end a run that stayed up or collapsed); fractiles of the
-/// curve are typed errors or values.
+/// curve are typed errors or values. (`ida` is host-only: feature `std`.)
+#[cfg(feature = "std")]
 fn ida_checks(b: &mut Bytes) {
     use aemstep::ida::{self, Collapse, HuntFill, OnFailure};
     use std::cell::Cell;
