@@ -6,7 +6,7 @@ runs. Library errors are raised as the exception classes below, one per
 ``aemstep::Error`` variant, message the Rust ``Display``; a failed step sets ``.step``.
 """
 
-from typing import Dict, List, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -62,6 +62,11 @@ class InvalidCovariance(AemstepError): ...
 class RiccatiNotConverged(AemstepError): ...
 class StateSizeMismatch(AemstepError): ...
 class InputNotIdentifiable(AemstepError): ...
+
+class MalformedRecord(AemstepError):
+    """A record's text is malformed (``aemstep::records``)."""
+
+    line: int  # the 1-based line where the problem was found
 
 def linear_response(
     m: F64,
@@ -190,3 +195,11 @@ def observe(
     Kalman-gain observer or full Kalman filter; process noise sigma_f (N, white forces
     on every floor), sensor noise sigma_y (m/s²). Returns (u m, v m/s, gain
     ``2n×sensors``, empty for the Kalman filter)."""
+
+def parse_at2(text: str) -> Tuple[str, float, F64]:
+    """PEER NGA AT2 text parsed by ``aemstep::records``: (title, dt s, the NPTS values in
+    the file's units, g for acceleration). Raises ``MalformedRecord`` (``.line``)."""
+
+def parse_column(text: str, dt: float) -> F64:
+    """One-column text (one number a line, ``#`` comments) sampled every dt s (> 0):
+    the values. Raises ``InvalidTimeStep``, ``MalformedRecord`` (``.line``)."""
