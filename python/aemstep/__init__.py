@@ -16,6 +16,8 @@ accelerations in m/s² (``G`` converts from g).
   state from measured floor accelerations.
 - ``read_at2``, ``read_column``: PEER NGA ``.AT2`` and one-column records (the library's
   readers).
+- ``ida_stripes``, ``ida_hunt_fill``, ``ida_fractiles``: incremental dynamic analysis of
+  the yielding shear building over a suite of records, on threads, with a progress bar.
 
 Every ``aemstep::Error`` variant of the Rust library is an exception of the same name
 (``aemstep.NotConverged``, ``aemstep.InvalidTimeStep``, …), subclass of ``AemstepError``
@@ -602,6 +604,8 @@ def read_column(path_or_text: Union[str, "os.PathLike[str]"], dt: float) -> Tupl
     return values, float(dt)
 
 
+from ._ida import ida_fractiles, ida_hunt_fill, ida_stripes  # noqa: E402
+
 __all__ = [
     "G",
     "SIZES",
@@ -633,4 +637,7 @@ __all__ = [
     "observe",
     "read_at2",
     "read_column",
+    "ida_stripes",
+    "ida_hunt_fill",
+    "ida_fractiles",
 ] + list(ERROR_VARIANTS)

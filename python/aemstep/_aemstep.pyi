@@ -203,3 +203,56 @@ def parse_at2(text: str) -> Tuple[str, float, F64]:
 def parse_column(text: str, dt: float) -> F64:
     """One-column text (one number a line, ``#`` comments) sampled every dt s (> 0):
     the values. Raises ``InvalidTimeStep``, ``MalformedRecord`` (``.line``)."""
+
+def ida_stripes(
+    records: List[F64],
+    h: float,
+    intensities: F64,
+    masses: F64,
+    law: str,
+    params: F64,
+    c: F64,
+    max_iterations: int = 20,
+    tolerance: float = 1e-10,
+    collapse_drift: Optional[float] = None,
+    on_failure: str = "collapse",
+    threads: int = 0,
+    progress: Optional[Callable[[int, int], Any]] = None,
+) -> List[Dict[str, Any]]:
+    """IDA on fixed stripes: every record (m/s², sampled every h s) times every scale
+    factor, the yielding shear building of ``shear_building``; per record a dict of
+    ``intensity``, ``drift`` (peak storey drift, m; inf for a failed run), ``collapsed``,
+    ``error``, ``collapse`` ((lo, hi) or None). The GIL released; progress(done, total)
+    called from the calling thread about every 0.1 s."""
+
+def ida_hunt_fill(
+    records: List[F64],
+    h: float,
+    masses: F64,
+    law: str,
+    params: F64,
+    c: F64,
+    max_iterations: int = 20,
+    tolerance: float = 1e-10,
+    first: float = 0.1,
+    step: float = 0.2,
+    step_increment: float = 0.1,
+    resolution: float = 0.05,
+    runs: int = 12,
+    collapse_drift: Optional[float] = None,
+    on_failure: str = "collapse",
+    threads: int = 0,
+    progress: Optional[Callable[[int, int], Any]] = None,
+) -> List[Dict[str, Any]]:
+    """IDA traced by hunt-and-fill (Vamvatsikos & Cornell 2002), at most ``runs``
+    analyses a record; the dicts of ``ida_stripes``."""
+
+def ida_fractiles(
+    intensity: List[F64],
+    drift: List[F64],
+    collapsed: List[npt.NDArray[np.bool_]],
+    drifts: F64,
+    q: F64,
+) -> npt.NDArray[np.float64]:
+    """Fractile IDA curves, intensity given drift: ``len(q) × len(drifts)``; NaN where
+    censored curves decide the quantile."""

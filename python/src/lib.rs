@@ -1163,6 +1163,7 @@ fn observe<'py>(
 }
 
 // Sections in their own files (after the macros above, which they use).
+mod ida;
 mod laws;
 mod records;
 
@@ -1183,5 +1184,6 @@ fn _aemstep(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(constant_ductility, m)?)?;
     m.add_function(wrap_pyfunction!(observe, m)?)?;
     records::register(m)?;
+    ida::register(m)?;
     Ok(())
 }
