@@ -18,6 +18,7 @@ accelerations in m/s² (``G`` converts from g).
   readers).
 - ``ida_stripes``, ``ida_hunt_fill``, ``ida_fractiles``: incremental dynamic analysis of
   the yielding shear building over a suite of records, on threads, with a progress bar.
+- ``aemstep.distributed``: the batch functions on a Dask cluster (imported on use).
 
 Every ``aemstep::Error`` variant of the Rust library is an exception of the same name
 (``aemstep.NotConverged``, ``aemstep.InvalidTimeStep``, …), subclass of ``AemstepError``
