@@ -60,8 +60,10 @@ venv=$(mktemp -d)
 trap 'rm -f "$log"; rm -rf "$venv"' EXIT
 python3 -m venv "$venv" || fail "python3 -m venv (Debian: apt-get install python3-venv)"
 "$venv/bin/pip" install -q --upgrade "pip>=23" || fail "pip upgrade in the fresh venv"
-"$venv/bin/pip" install -q "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" ||
-    fail "pip install maturin numpy pytest"
+# dask[distributed] and tqdm: the cluster and progress-bar tests (optional at run time).
+"$venv/bin/pip" install -q "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" \
+    "dask[distributed]>=2023.1" "tqdm>=4.60" ||
+    fail "pip install maturin numpy pytest dask[distributed] tqdm"
 CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}" "$venv/bin/pip" install -q ./python ||
     fail "pip install ./python (the maturin build of python/)"
 pyout=$(mktemp)

@@ -14,7 +14,11 @@ accelerations in m/s² (``G`` converts from g).
 - ``constant_strength``, ``constant_ductility``: inelastic spectra.
 - ``observe``: a steady-state (Kalman-gain) observer or a Kalman filter of a building's
   state from measured floor accelerations.
-- ``read_at2``: a PEER NGA ``.AT2`` record (accelerations in g and their time step).
+- ``read_at2``, ``read_column``: PEER NGA ``.AT2`` and one-column records (the library's
+  readers).
+- ``ida_stripes``, ``ida_hunt_fill``, ``ida_fractiles``: incremental dynamic analysis of
+  the yielding shear building over a suite of records, on threads, with a progress bar.
+- ``aemstep.distributed``: the batch functions on a Dask cluster (imported on use).
 
 Every ``aemstep::Error`` variant of the Rust library is an exception of the same name
 (``aemstep.NotConverged``, ``aemstep.InvalidTimeStep``, …), subclass of ``AemstepError``
@@ -26,9 +30,7 @@ See docs/python.md in the repository.
 
 from __future__ import annotations
 
-import math
 import os
-import re
 from typing import Any, Callable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -52,6 +54,7 @@ from ._aemstep import (  # noqa: F401  (re-exported)
     InvalidParameter,
     InvalidPeriod,
     InvalidTimeStep,
+    MalformedRecord,
     MassNotSpd,
     NonClassicalDamping,
     NonFiniteForce,
@@ -574,26 +577,35 @@ def observe(
 # Records.
 
 
-def read_at2(path: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, float]:
-    """A PEER NGA ``.AT2`` record: ``(accelerations in g, dt in s)``. Multiply by ``G``
-    for m/s²."""
-    with open(path) as f:
-        lines = f.read().splitlines()
-    if len(lines) < 4:
-        raise ValueError(f"{path}: not an AT2 record (fewer than 4 lines)")
-    header = lines[3].upper()
-    dt_match = re.search(r"DT\s*=\s*([-+0-9.E]+)", header)
-    npts_match = re.search(r"NPTS\s*=\s*(\d+)", header)
-    dt = float(dt_match.group(1)) if dt_match else float("nan")
-    if not (math.isfinite(dt) and dt > 0):
-        raise ValueError(f"{path}: no positive DT on the fourth line")
-    values = np.array(" ".join(lines[4:]).split(), dtype=np.float64)
-    if npts_match and values.shape[0] != int(npts_match.group(1)):
-        raise ValueError(
-            f"{path}: {values.shape[0]} samples, the header says NPTS={npts_match.group(1)}"
-        )
+def _text(path_or_text: Union[str, "os.PathLike[str]"]) -> str:
+    """The text itself (a ``str`` with a line break), else the file's text (UTF-8)."""
+    if isinstance(path_or_text, str) and "\n" in path_or_text:
+        return path_or_text
+    with open(path_or_text, encoding="utf-8") as f:
+        return f.read()
+
+
+def read_at2(path_or_text: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, float]:
+    """A PEER NGA ``.AT2`` record (a path, or the text itself: a ``str`` with a line
+    break): ``(accelerations in the file's units (g), dt in s)``. Multiply by ``G`` for
+    m/s². Parsed by the library's reader (``aemstep::records``): a header without a
+    readable ``NPTS``/``DT``, a value that is not a number, or more or fewer values than
+    ``NPTS`` raise ``MalformedRecord`` (its ``.line`` is the 1-based line)."""
+    _title, dt, values = _aemstep.parse_at2(_text(path_or_text))
     return values, dt
 
+
+def read_column(path_or_text: Union[str, "os.PathLike[str]"], dt: float) -> Tuple[np.ndarray, float]:
+    """A one-column record (one number a line; blank lines and ``#`` comments ignored), a
+    path or the text itself (a ``str`` with a line break), sampled every ``dt`` s (not in
+    the file): ``(values in the file's units, dt)``. Raises ``InvalidTimeStep`` for a
+    ``dt`` not finite and > 0, ``MalformedRecord`` (with ``.line``) for a line that is not
+    one number, or no value at all."""
+    values = _aemstep.parse_column(_text(path_or_text), float(dt))
+    return values, float(dt)
+
+
+from ._ida import ida_fractiles, ida_hunt_fill, ida_stripes  # noqa: E402
 
 __all__ = [
     "G",
@@ -625,4 +637,8 @@ __all__ = [
     "Estimate",
     "observe",
     "read_at2",
+    "read_column",
+    "ida_stripes",
+    "ida_hunt_fill",
+    "ida_fractiles",
 ] + list(ERROR_VARIANTS)

@@ -6,7 +6,7 @@ runs. Library errors are raised as the exception classes below, one per
 ``aemstep::Error`` variant, message the Rust ``Display``; a failed step sets ``.step``.
 """
 
-from typing import Dict, List, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -62,6 +62,11 @@ class InvalidCovariance(AemstepError): ...
 class RiccatiNotConverged(AemstepError): ...
 class StateSizeMismatch(AemstepError): ...
 class InputNotIdentifiable(AemstepError): ...
+
+class MalformedRecord(AemstepError):
+    """A record's text is malformed (``aemstep::records``)."""
+
+    line: int  # the 1-based line where the problem was found
 
 def linear_response(
     m: F64,
@@ -190,3 +195,64 @@ def observe(
     Kalman-gain observer or full Kalman filter; process noise sigma_f (N, white forces
     on every floor), sensor noise sigma_y (m/s²). Returns (u m, v m/s, gain
     ``2n×sensors``, empty for the Kalman filter)."""
+
+def parse_at2(text: str) -> Tuple[str, float, F64]:
+    """PEER NGA AT2 text parsed by ``aemstep::records``: (title, dt s, the NPTS values in
+    the file's units, g for acceleration). Raises ``MalformedRecord`` (``.line``)."""
+
+def parse_column(text: str, dt: float) -> F64:
+    """One-column text (one number a line, ``#`` comments) sampled every dt s (> 0):
+    the values. Raises ``InvalidTimeStep``, ``MalformedRecord`` (``.line``)."""
+
+def ida_stripes(
+    records: List[F64],
+    h: float,
+    intensities: F64,
+    masses: F64,
+    law: str,
+    params: F64,
+    c: F64,
+    max_iterations: int = 20,
+    tolerance: float = 1e-10,
+    collapse_drift: Optional[float] = None,
+    on_failure: str = "collapse",
+    threads: int = 0,
+    progress: Optional[Callable[[int, int], Any]] = None,
+) -> List[Dict[str, Any]]:
+    """IDA on fixed stripes: every record (m/s², sampled every h s) times every scale
+    factor, the yielding shear building of ``shear_building``; per record a dict of
+    ``intensity``, ``drift`` (peak storey drift, m; inf for a failed run), ``collapsed``,
+    ``error``, ``collapse`` ((lo, hi) or None). The GIL released; progress(done, total)
+    called from the calling thread about every 0.1 s."""
+
+def ida_hunt_fill(
+    records: List[F64],
+    h: float,
+    masses: F64,
+    law: str,
+    params: F64,
+    c: F64,
+    max_iterations: int = 20,
+    tolerance: float = 1e-10,
+    first: float = 0.1,
+    step: float = 0.2,
+    step_increment: float = 0.1,
+    resolution: float = 0.05,
+    runs: int = 12,
+    collapse_drift: Optional[float] = None,
+    on_failure: str = "collapse",
+    threads: int = 0,
+    progress: Optional[Callable[[int, int], Any]] = None,
+) -> List[Dict[str, Any]]:
+    """IDA traced by hunt-and-fill (Vamvatsikos & Cornell 2002), at most ``runs``
+    analyses a record; the dicts of ``ida_stripes``."""
+
+def ida_fractiles(
+    intensity: List[F64],
+    drift: List[F64],
+    collapsed: List[npt.NDArray[np.bool_]],
+    drifts: F64,
+    q: F64,
+) -> npt.NDArray[np.float64]:
+    """Fractile IDA curves, intensity given drift: ``len(q) × len(drifts)``; NaN where
+    censored curves decide the quantile."""

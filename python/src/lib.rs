@@ -17,12 +17,10 @@
 //! subclass of `AemstepError` (itself a `ValueError`), with the Rust `Display` as message;
 //! a step that fails sets the exception's `step` attribute to its index.
 //!
-//! Incremental dynamic analysis is written in the library on another branch; its binding
-//! goes beside [`shear_building`] (same building, many records and intensities).
+//! Incremental dynamic analysis (`ida.rs`) runs the building of [`shear_building`] (its laws
+//! built by `laws.rs`) over many records and intensities; `records.rs` reads records.
 
-use aemstep::hysteresis::{
-    Bilinear, BoucWen, EnergyAccount, Friction, HistoryModel, Law, Parallel, ShearBuilding,
-};
+use aemstep::hysteresis::{EnergyAccount, HistoryModel, Law, ShearBuilding};
 use aemstep::nalgebra::{SMatrix, SVector};
 use aemstep::observer::{Kalman, Observer, Outputs, StateSpace, SteadyState};
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
@@ -131,6 +129,7 @@ variants!(
     RiccatiNotConverged,
     StateSizeMismatch,
     InputNotIdentifiable,
+    MalformedRecord,
 );
 
 /// Why a run stopped: a library error (at a step, if a step failed) or a bad argument.
@@ -159,6 +158,9 @@ impl Fail {
                 if let Some(n) = step {
                     // Best effort: the message already says what failed.
                     let _ = err.value(py).setattr("step", n);
+                }
+                if let Error::MalformedRecord { line } = e {
+                    let _ = err.value(py).setattr("line", line);
                 }
                 err
             }
@@ -518,44 +520,16 @@ fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) ->
     Ok(o)
 }
 
-/// The storey laws from the parameter rows, then the run.
+/// The storey laws from the parameter rows (`laws.rs`), then the run.
 fn building_n<const N: usize, const S: usize>(law: &str, job: &BuildingJob) -> Res<BuildingOut> {
-    let row = |i: usize| &job.params[i * job.width..(i + 1) * job.width];
-    fn laws<const N: usize, L>(f: impl Fn(usize) -> Result<L, Error>) -> Result<[L; N], Error> {
-        let mut v = Vec::with_capacity(N);
-        for i in 0..N {
-            v.push(f(i)?);
+    struct Run<'a>(&'a BuildingJob);
+    impl<const N: usize> laws::WithLaws<N> for Run<'_> {
+        type Out = BuildingOut;
+        fn run<L: Law<f64> + Send + Sync>(self, laws: [L; N]) -> Res<BuildingOut> {
+            building_run::<N, L>(laws, self.0)
         }
-        Ok(v.try_into()
-            .unwrap_or_else(|_| unreachable!("N laws pushed")))
     }
-    match law {
-        "bilinear" => building_run::<N, _>(
-            laws::<N, _>(|i| {
-                let r = row(i);
-                Bilinear::<f64>::new(r[0], r[1], r[2])
-            })?,
-            job,
-        ),
-        "bouc_wen" => building_run::<N, _>(
-            laws::<N, _>(|i| {
-                let r = row(i);
-                BoucWen::<f64>::new(r[0], r[1], r[2], r[3], r[4], r[5])
-            })?,
-            job,
-        ),
-        "bilinear_friction" => building_run::<N, _>(
-            laws::<N, _>(|i| {
-                let r = row(i);
-                Ok(Parallel(
-                    Bilinear::<f64>::new(r[0], r[1], r[2])?,
-                    Friction::<f64>::new(r[3], r[4])?,
-                ))
-            })?,
-            job,
-        ),
-        _ => unreachable!("law checked by the caller"),
-    }
+    laws::with_laws::<N, _>(law, &job.params, job.width, Run(job))
 }
 
 /// Step a hysteretic shear building (`ShearBuilding` with the `Nonlinear` AEM stepper and
@@ -1188,6 +1162,11 @@ fn observe<'py>(
     ))
 }
 
+// Sections in their own files (after the macros above, which they use).
+mod ida;
+mod laws;
+mod records;
+
 /// The native module: functions, exception classes and the compiled limits.
 #[pymodule]
 fn _aemstep(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -1204,5 +1183,7 @@ fn _aemstep(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(constant_strength, m)?)?;
     m.add_function(wrap_pyfunction!(constant_ductility, m)?)?;
     m.add_function(wrap_pyfunction!(observe, m)?)?;
+    records::register(m)?;
+    ida::register(m)?;
     Ok(())
 }

@@ -1,0 +1,523 @@
+//! Incremental dynamic analysis of the yielding shear building (`aemstep::ida`): every
+//! record of a suite scaled by an intensity (the record scale factor), the peak absolute
+//! storey drift of each run, the runs on fixed stripes or traced by hunt-and-fill, and the
+//! fractile curves.
+//!
+//! **Progress without the GIL.** The library calls its progress callback on the worker
+//! threads, where Python must not be called. The batch runs instead on a scoped background
+//! thread (which drives the library's pool) while the Python thread waits with the GIL
+//! released, waking every [`POLL`] to read an atomic counter, call the user's
+//! `progress(done, total)` and check for signals (Ctrl-C). A raised exception (from the
+//! callback or a `KeyboardInterrupt`) sets a cancel flag that makes every later run of the
+//! batch return at once; the exception is raised when the batch has wound down. The runs
+//! and their order are the library's: the curves are those of the serial run, bit for bit.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
+
+use aemstep::hysteresis::{HistoryModel, Law, ShearBuilding};
+use aemstep::ida::{self, Collapse, Curve, HuntFill, OnFailure, Point};
+use aemstep::nalgebra::SVector;
+use aemstep::{Error, NewtonSettings, Nonlinear};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::laws::{self, WithLaws};
+use crate::{Fail, Res, SIZES, out1, out2, read1, read2, rows, shape, square};
+
+/// How often the waiting Python thread reports progress and checks for signals.
+const POLL: Duration = Duration::from_millis(100);
+
+/// Steps between two looks at the cancel flag within a run.
+const CANCEL_EVERY: usize = 1024;
+
+/// The intensities to run: fixed stripes, or a hunt-and-fill trace.
+enum Plan {
+    Stripes(Vec<f64>),
+    HuntFill(HuntFill),
+}
+
+/// One IDA batch: the building (as `shear_building` takes it), the records and the plan.
+struct IdaJob {
+    records: Vec<Vec<f64>>,
+    h: f64,
+    masses: Vec<f64>,
+    law: String,
+    params: Vec<f64>,
+    width: usize,
+    c: Vec<f64>,
+    settings: NewtonSettings<f64>,
+    collapse: Collapse,
+    plan: Plan,
+    threads: usize,
+}
+
+impl IdaJob {
+    /// The progress total: runs of the stripes, or the hunt-and-fill budget.
+    fn total(&self) -> usize {
+        let per = match &self.plan {
+            Plan::Stripes(ims) => ims.len(),
+            Plan::HuntFill(s) => s.runs,
+        };
+        self.records.len().saturating_mul(per)
+    }
+}
+
+/// The peak absolute storey drift (m) over the storeys and every step of `ag` scaled by
+/// `scale`: the run of `shear_building` (same start, same steps), drifts `u_i − u_{i−1}`
+/// (`u_{−1} = 0`). Stops early with `InvalidParameter` once `cancel` is set (the batch is
+/// being abandoned; the value is discarded).
+fn peak_drift<const N: usize, L: Law<f64>>(
+    building: &ShearBuilding<f64, L, N>,
+    stepper: &Nonlinear<f64, N>,
+    ag: &[f64],
+    scale: f64,
+    cancel: &AtomicBool,
+) -> Result<f64, Error> {
+    let zero = SVector::<f64, N>::zeros();
+    let p0 = building.ground_load(ag[0] * scale);
+    let (mut s, mut history) =
+        stepper.start_with_history(building, &zero, &zero, &p0, &building.initial_history())?;
+    let mut peak = 0.0f64;
+    for (n, &a) in ag.iter().enumerate().skip(1) {
+        if n % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
+            return Err(Error::InvalidParameter);
+        }
+        let p = building.ground_load(a * scale);
+        stepper.try_step_with_history(building, &mut s, &mut history, &p)?;
+        let mut below = 0.0f64;
+        for &u in s.u().iter() {
+            peak = peak.max((u - below).abs());
+            below = u;
+        }
+    }
+    Ok(peak)
+}
+
+/// The batch on the `N` laws.
+struct Batch<'a> {
+    job: &'a IdaJob,
+    progress: &'a (dyn Fn(usize, usize) + Sync),
+    cancel: &'a AtomicBool,
+}
+
+impl<const N: usize> WithLaws<N> for Batch<'_> {
+    type Out = Vec<Curve>;
+    fn run<L: Law<f64> + Send + Sync>(self, laws: [L; N]) -> Res<Vec<Curve>> {
+        let job = self.job;
+        let masses: [f64; N] = core::array::from_fn(|i| job.masses[i]);
+        let building = ShearBuilding::<f64, L, N>::new(masses, laws, &rows::<N>(&job.c))?;
+        let stepper = Nonlinear::<f64, N>::new(job.h, job.settings)?;
+        let cancel = self.cancel;
+        let analysis = |ag: &Vec<f64>, im: f64| {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(Error::InvalidParameter);
+            }
+            peak_drift(&building, &stepper, ag, im, cancel)
+        };
+        run_plan(job, &analysis, self.progress)
+    }
+}
+
+/// A run of the analysis: `(record, scale factor) → peak drift`.
+type Analysis<'a> = &'a (dyn Fn(&Vec<f64>, f64) -> Result<f64, Error> + Sync);
+
+/// The plan on the library's pool. Not generic: one copy of the batch machinery for every
+/// size and law (only `peak_drift` is per size and law), which keeps the module's build
+/// time and size down; the dynamic call is one per run of thousands of steps.
+fn run_plan(
+    job: &IdaJob,
+    analysis: Analysis<'_>,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Res<Vec<Curve>> {
+    let curves = match &job.plan {
+        Plan::Stripes(ims) => ida::stripes(
+            &job.records,
+            ims,
+            &job.collapse,
+            job.threads,
+            analysis,
+            Some(progress),
+        ),
+        Plan::HuntFill(s) => ida::hunt_fill(&job.records, s, job.threads, analysis, Some(progress)),
+    };
+    Ok(curves?)
+}
+
+fn batch_n<const N: usize, const S: usize>(
+    job: &IdaJob,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &AtomicBool,
+) -> Res<Vec<Curve>> {
+    laws::with_laws::<N, _>(
+        &job.law,
+        &job.params,
+        job.width,
+        Batch {
+            job,
+            progress,
+            cancel,
+        },
+    )
+}
+
+/// Runs the batch on a background thread, the GIL released except at each [`POLL`], where
+/// `progress(done, total)` is called (when `done` moved) and signals are checked.
+fn run_polled(
+    py: Python<'_>,
+    job: &IdaJob,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<Curve>> {
+    let n = job.masses.len();
+    let total = job.total();
+    let done = AtomicUsize::new(0);
+    let cancel = AtomicBool::new(false);
+    let finished = (Mutex::new(false), Condvar::new());
+    let tick = |d: usize, _total: usize| {
+        done.fetch_max(d, Ordering::Relaxed);
+    };
+    std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            let out = by_size!(n, batch_n(job, &tick, &cancel));
+            let (lock, cv) = &finished;
+            *lock.lock().unwrap_or_else(|e| e.into_inner()) = true;
+            cv.notify_all();
+            out
+        });
+        let mut reported = 0usize;
+        let mut raised: Option<PyErr> = None;
+        loop {
+            let over = py.detach(|| {
+                let (lock, cv) = &finished;
+                let guard = lock.lock().unwrap_or_else(|e| e.into_inner());
+                let (guard, _) = cv
+                    .wait_timeout_while(guard, POLL, |f| !*f)
+                    .unwrap_or_else(|e| e.into_inner());
+                *guard
+            });
+            if raised.is_none() {
+                let d = done.load(Ordering::Relaxed);
+                let call = match progress {
+                    Some(f) if d != reported => f.call1((d, total)).map(|_| ()),
+                    _ => Ok(()),
+                };
+                reported = d;
+                if let Err(e) = call.and_then(|()| py.check_signals()) {
+                    cancel.store(true, Ordering::Relaxed);
+                    raised = Some(e);
+                }
+            }
+            if over {
+                break;
+            }
+        }
+        let out = py.detach(|| worker.join());
+        if let Some(e) = raised {
+            return Err(e);
+        }
+        match out {
+            Ok(r) => r.map_err(|f| f.raise(py)),
+            Err(_) => Err(PyRuntimeError::new_err(
+                "aemstep: the IDA worker thread panicked",
+            )),
+        }
+    })
+}
+
+/// A `ValueError` for a law name `shear_building` does not know.
+fn known_law(law: &str) -> PyResult<()> {
+    match laws::law_width(law) {
+        Some(_) => Ok(()),
+        None => Err(PyValueError::new_err(format!(
+            "unknown law {law:?}: one of bilinear, bouc_wen, bilinear_friction"
+        ))),
+    }
+}
+
+fn on_failure_of(s: &str) -> PyResult<OnFailure> {
+    match s {
+        "collapse" => Ok(OnFailure::Collapse),
+        "abort" => Ok(OnFailure::Abort),
+        other => Err(PyValueError::new_err(format!(
+            "unknown on_failure {other:?}: \"collapse\" or \"abort\""
+        ))),
+    }
+}
+
+/// The building and records checked and copied; `plan` and `collapse` as given.
+#[allow(clippy::too_many_arguments)]
+fn prepare(
+    records: &[PyReadonlyArray1<'_, f64>],
+    h: f64,
+    masses: &PyReadonlyArray1<'_, f64>,
+    law: &str,
+    params: &PyReadonlyArray2<'_, f64>,
+    c: &PyReadonlyArray2<'_, f64>,
+    max_iterations: u32,
+    tolerance: f64,
+    collapse: Collapse,
+    plan: Plan,
+    threads: usize,
+) -> Res<IdaJob> {
+    let width = laws::law_width(law).unwrap_or(0);
+    let masses = read1(masses);
+    let n = masses.len();
+    if !SIZES.contains(&n) {
+        return Err(Fail::Size(format!(
+            "{n} storeys: this build supports n in {SIZES:?}"
+        )));
+    }
+    let (p, r, cols) = read2(params);
+    if r != n || cols != width {
+        return shape(format!(
+            "params must be {n}x{width} for law {law:?} and {n} storeys, got {r}x{cols}"
+        ));
+    }
+    let records: Vec<Vec<f64>> = records.iter().map(read1).collect();
+    if let Some(i) = records.iter().position(|r| r.is_empty()) {
+        return shape(format!("record {i} has no samples"));
+    }
+    Ok(IdaJob {
+        records,
+        h,
+        masses,
+        law: law.to_owned(),
+        params: p,
+        width,
+        c: square(c, n, "c")?,
+        settings: NewtonSettings::up_to(max_iterations, tolerance),
+        collapse,
+        plan,
+        threads,
+    })
+}
+
+/// The curves as dicts: `intensity`, `drift`, `collapsed`, `collapse`, `error`.
+fn curves_out<'py>(py: Python<'py>, curves: Vec<Curve>) -> PyResult<Bound<'py, PyList>> {
+    let list = PyList::empty(py);
+    for c in curves {
+        let d = PyDict::new(py);
+        let pts = &c.points;
+        d.set_item(
+            "intensity",
+            out1(py, pts.iter().map(|p| p.intensity).collect()),
+        )?;
+        d.set_item("drift", out1(py, pts.iter().map(|p| p.edp).collect()))?;
+        let collapsed: Vec<bool> = pts.iter().map(|p| p.collapsed).collect();
+        d.set_item("collapsed", collapsed.into_pyarray(py))?;
+        d.set_item("collapse", c.collapse.map(|[lo, hi]| (lo, hi)))?;
+        // The variant's name (its Debug form up to a field list, e.g. `NotConverged`).
+        let errors: Vec<Option<String>> = pts
+            .iter()
+            .map(|p| {
+                p.error.map(|e| {
+                    format!("{e:?}")
+                        .split([' ', '{', '('])
+                        .next()
+                        .unwrap_or("")
+                        .to_owned()
+                })
+            })
+            .collect();
+        d.set_item("error", errors)?;
+        list.append(d)?;
+    }
+    Ok(list)
+}
+
+/// The IDA curves of a suite of records on fixed stripes of intensity: every record scaled
+/// by every intensity, each run the yielding shear building of `shear_building`.
+///
+/// Arguments: `records` — ground accelerations (m/s²), 1-D, sampled every `h` s;
+/// `intensities` — the record scale factors (finite, `> 0`, any order); `masses`, `law`,
+/// `params`, `c`, `max_iterations`, `tolerance` — the building and its Newton settings, as
+/// `shear_building`; `collapse_drift` — the peak storey drift (m, `> 0`; `None` or `inf`:
+/// never) at or above which a run has collapsed; `on_failure` — `"collapse"` (a run whose analysis
+/// fails, e.g. `NotConverged`, is a collapse with drift `inf`) or `"abort"` (the first
+/// failure in (record, intensity) order is raised); `threads` (0: all cores); `progress` —
+/// `None` or a callable `progress(done, total)` called from this thread about every 0.1 s
+/// while the runs go (`total = records × intensities`).
+///
+/// Returns one dict per record: `intensity` (sorted), `drift` (peak absolute storey drift,
+/// m), `collapsed` (bool), `error` (the error name of a failed run counted as collapse, or
+/// `None`), `collapse` (`(lo, hi)`: the highest non-collapsing intensity below the lowest
+/// collapsing one, that lowest; `None` if none collapsed). Bit for bit the same on any
+/// thread count. The GIL is released while the runs go.
+#[pyfunction]
+#[pyo3(signature = (records, h, intensities, masses, law, params, c, max_iterations=20, tolerance=1e-10, collapse_drift=None, on_failure="collapse", threads=0, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn ida_stripes<'py>(
+    py: Python<'py>,
+    records: Vec<PyReadonlyArray1<'py, f64>>,
+    h: f64,
+    intensities: PyReadonlyArray1<'py, f64>,
+    masses: PyReadonlyArray1<'py, f64>,
+    law: &str,
+    params: PyReadonlyArray2<'py, f64>,
+    c: PyReadonlyArray2<'py, f64>,
+    max_iterations: u32,
+    tolerance: f64,
+    collapse_drift: Option<f64>,
+    on_failure: &str,
+    threads: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyList>> {
+    let collapse = Collapse {
+        edp: collapse_drift.unwrap_or(f64::INFINITY),
+        on_failure: on_failure_of(on_failure)?,
+    };
+    known_law(law)?;
+    let plan = Plan::Stripes(read1(&intensities));
+    let job = prepare(
+        &records,
+        h,
+        &masses,
+        law,
+        &params,
+        &c,
+        max_iterations,
+        tolerance,
+        collapse,
+        plan,
+        threads,
+    )
+    .map_err(|f| f.raise(py))?;
+    let curves = run_polled(py, &job, progress.as_ref())?;
+    curves_out(py, curves)
+}
+
+/// The hunt-and-fill IDA curves of a suite of records (Vamvatsikos & Cornell 2002): per
+/// record, intensities (record scale factors) `first`, `first + step`, … with the step
+/// growing by `step_increment` a run until a run collapses, then bisection of the collapse
+/// bracket down to `resolution`, then the largest gaps below it filled, `runs` analyses at
+/// most a record.
+///
+/// Arguments: as `ida_stripes`, with `first`, `step` (`> 0`), `step_increment` (`≥ 0`),
+/// `resolution` (`> 0`; all scale factors) and `runs` (1 to 10 000) instead of
+/// `intensities`; `progress(done, total)` with `total = records × runs` (a record that ends
+/// early counts its unused runs at once).
+///
+/// Returns the dicts of `ida_stripes`, at most `runs` points each. Raises
+/// `InvalidParameter` for settings out of range (before any run), the library's errors
+/// with `on_failure="abort"`.
+#[pyfunction]
+#[pyo3(signature = (records, h, masses, law, params, c, max_iterations=20, tolerance=1e-10, first=0.1, step=0.2, step_increment=0.1, resolution=0.05, runs=12, collapse_drift=None, on_failure="collapse", threads=0, progress=None))]
+#[allow(clippy::too_many_arguments)]
+fn ida_hunt_fill<'py>(
+    py: Python<'py>,
+    records: Vec<PyReadonlyArray1<'py, f64>>,
+    h: f64,
+    masses: PyReadonlyArray1<'py, f64>,
+    law: &str,
+    params: PyReadonlyArray2<'py, f64>,
+    c: PyReadonlyArray2<'py, f64>,
+    max_iterations: u32,
+    tolerance: f64,
+    first: f64,
+    step: f64,
+    step_increment: f64,
+    resolution: f64,
+    runs: i64,
+    collapse_drift: Option<f64>,
+    on_failure: &str,
+    threads: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyList>> {
+    let collapse = Collapse {
+        edp: collapse_drift.unwrap_or(f64::INFINITY),
+        on_failure: on_failure_of(on_failure)?,
+    };
+    known_law(law)?;
+    // A budget outside 1..=10 000 (negative too) is the library's InvalidParameter.
+    let runs = usize::try_from(runs).unwrap_or(0);
+    let plan = Plan::HuntFill(HuntFill {
+        first,
+        step,
+        step_increment,
+        resolution,
+        runs,
+        collapse,
+    });
+    let job = prepare(
+        &records,
+        h,
+        &masses,
+        law,
+        &params,
+        &c,
+        max_iterations,
+        tolerance,
+        collapse,
+        plan,
+        threads,
+    )
+    .map_err(|f| f.raise(py))?;
+    let curves = run_polled(py, &job, progress.as_ref())?;
+    curves_out(py, curves)
+}
+
+/// The fractile IDA curves: for each quantile `q[k]` and drift level `drifts[j]`, the
+/// `q[k]` quantile over the records of the intensity at which each curve first reaches
+/// `drifts[j]` (`aemstep::ida::fractiles`: the non-collapsing points below the collapse
+/// joined by straight lines from the origin; a collapsed curve flat past its last point;
+/// numpy's default linear quantile; `NaN` where records censored at that level decide it).
+///
+/// Arguments: `intensity`, `drift`, `collapsed` — one array per curve (as the dicts of
+/// `ida_stripes`), `drifts` — the levels (m, finite, `≥ 0`), `q` — in `[0, 1]`.
+/// Returns `len(q) × len(drifts)` intensities. Raises `InvalidParameter` for no curves,
+/// bad levels or quantiles, `ShapeError` for a curve whose arrays differ in length.
+#[pyfunction]
+fn ida_fractiles<'py>(
+    py: Python<'py>,
+    intensity: Vec<PyReadonlyArray1<'py, f64>>,
+    drift: Vec<PyReadonlyArray1<'py, f64>>,
+    collapsed: Vec<PyReadonlyArray1<'py, bool>>,
+    drifts: PyReadonlyArray1<'py, f64>,
+    q: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let build = || -> Res<Vec<Curve>> {
+        if intensity.len() != drift.len() || intensity.len() != collapsed.len() {
+            return shape("intensity, drift and collapsed must hold one array per curve".into());
+        }
+        let mut curves = Vec::with_capacity(intensity.len());
+        for (k, ((im, e), c)) in intensity.iter().zip(&drift).zip(&collapsed).enumerate() {
+            let (im, e) = (read1(im), read1(e));
+            let c: Vec<bool> = c.as_array().iter().copied().collect();
+            if im.len() != e.len() || im.len() != c.len() {
+                return shape(format!(
+                    "curve {k}: intensity ({}), drift ({}) and collapsed ({}) differ in length",
+                    im.len(),
+                    e.len(),
+                    c.len()
+                ));
+            }
+            let points = im
+                .iter()
+                .zip(&e)
+                .zip(&c)
+                .map(|((&intensity, &edp), &collapsed)| Point {
+                    intensity,
+                    edp,
+                    collapsed,
+                    error: None,
+                })
+                .collect();
+            curves.push(Curve::from_points(points));
+        }
+        Ok(curves)
+    };
+    let curves = build().map_err(|f| f.raise(py))?;
+    let (levels, q) = (read1(&drifts), read1(&q));
+    let out = ida::fractiles(&curves, &levels, &q).map_err(|e| Fail::from(e).raise(py))?;
+    Ok(out2(py, out.into_iter().flatten().collect(), levels.len()))
+}
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(ida_stripes, m)?)?;
+    m.add_function(wrap_pyfunction!(ida_hunt_fill, m)?)?;
+    m.add_function(wrap_pyfunction!(ida_fractiles, m)?)?;
+    Ok(())
+}

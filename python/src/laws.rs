@@ -1,0 +1,69 @@
+//! The storey laws of a shear building from their parameter rows, shared by
+//! `shear_building` and the IDA functions (`ida.rs`): one place that maps a law name and a
+//! `storeys × width` parameter table to `[L; N]`.
+
+use aemstep::Error;
+use aemstep::hysteresis::{Bilinear, BoucWen, Friction, Law, Parallel};
+
+use crate::{Fail, Res};
+
+/// The parameter columns of each law name: `(name, width)`.
+pub(crate) const LAW_WIDTHS: [(&str, usize); 3] =
+    [("bilinear", 3), ("bouc_wen", 6), ("bilinear_friction", 5)];
+
+/// The number of parameter columns of `law`, or `None` for an unknown name.
+pub(crate) fn law_width(law: &str) -> Option<usize> {
+    LAW_WIDTHS.iter().find(|(n, _)| *n == law).map(|&(_, w)| w)
+}
+
+/// What to do with the `N` storey laws once built (a generic callback over the law type).
+pub(crate) trait WithLaws<const N: usize> {
+    type Out;
+    fn run<L: Law<f64> + Send + Sync>(self, laws: [L; N]) -> Res<Self::Out>;
+}
+
+/// `N` laws, the `i`-th from `f(i)`.
+fn build<const N: usize, L>(f: impl Fn(usize) -> Result<L, Error>) -> Result<[L; N], Error> {
+    let mut v = Vec::with_capacity(N);
+    for i in 0..N {
+        v.push(f(i)?);
+    }
+    v.try_into().map_err(|_| unreachable!("N laws pushed"))
+}
+
+/// Builds the `N` laws named `law` from `params` (row-major, `N × width`, one row a storey,
+/// the columns of `shear_building`'s docstring) and hands them to `v`.
+///
+/// Errors: the laws' `InvalidMaterial`; an unknown name or a table of the wrong size is a
+/// `ShapeError` (callers check both first).
+pub(crate) fn with_laws<const N: usize, V: WithLaws<N>>(
+    law: &str,
+    params: &[f64],
+    width: usize,
+    v: V,
+) -> Res<V::Out> {
+    if law_width(law) != Some(width) || params.len() != N * width {
+        return Err(Fail::Shape(format!(
+            "law {law:?} with a {N}x{width} parameter table of {} values",
+            params.len()
+        )));
+    }
+    let row = |i: usize| &params[i * width..(i + 1) * width];
+    match law {
+        "bilinear" => v.run(build::<N, _>(|i| {
+            let r = row(i);
+            Bilinear::<f64>::new(r[0], r[1], r[2])
+        })?),
+        "bouc_wen" => v.run(build::<N, _>(|i| {
+            let r = row(i);
+            BoucWen::<f64>::new(r[0], r[1], r[2], r[3], r[4], r[5])
+        })?),
+        _ => v.run(build::<N, _>(|i| {
+            let r = row(i);
+            Ok(Parallel(
+                Bilinear::<f64>::new(r[0], r[1], r[2])?,
+                Friction::<f64>::new(r[3], r[4])?,
+            ))
+        })?),
+    }
+}
