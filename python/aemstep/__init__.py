@@ -52,6 +52,7 @@ from ._aemstep import (  # noqa: F401  (re-exported)
     InvalidParameter,
     InvalidPeriod,
     InvalidTimeStep,
+    MalformedRecord,
     MassNotSpd,
     NonClassicalDamping,
     NonFiniteForce,

@@ -63,6 +63,11 @@ class RiccatiNotConverged(AemstepError): ...
 class StateSizeMismatch(AemstepError): ...
 class InputNotIdentifiable(AemstepError): ...
 
+class MalformedRecord(AemstepError):
+    """A record's text is malformed (``aemstep::records``)."""
+
+    line: int  # the 1-based line where the problem was found
+
 def linear_response(
     m: F64,
     c: F64,

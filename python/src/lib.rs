@@ -131,6 +131,7 @@ variants!(
     RiccatiNotConverged,
     StateSizeMismatch,
     InputNotIdentifiable,
+    MalformedRecord,
 );
 
 /// Why a run stopped: a library error (at a step, if a step failed) or a bad argument.
