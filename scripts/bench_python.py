@@ -209,7 +209,7 @@ def aem_ida_stripes(recs_h, scales, masses, params, c, threads=2):
     peaks = np.zeros((len(recs_h), len(scales)))
     order = np.argsort(scales)
     for r, cur in enumerate(curves):
-        assert not any(cur["collapsed"]), "a run failed"
+        assert not np.any(cur["collapsed"]), "a run failed"
         peaks[r, order] = np.asarray(cur["drift"])  # curves come sorted by intensity
     return peaks
 
@@ -402,9 +402,8 @@ def main():
         "<!-- host timings: end -->", END,
     ]
     if QUICK:
-        lines.insert(-3, "Run with `--quick`: the IDA is the subset stated in its rows (records 1–4, scales "
-                         "0.1, 0.5, 1.0, 1.5, 2.0), not extrapolated.")
-        lines.insert(-3, "")
+        lines[-3:-3] = ["", "Run with `--quick`: the IDA is the subset stated in its rows (records 1–4, "
+                            "scales 0.1, 0.5, 1.0, 1.5, 2.0), not extrapolated."]
     section = "\n".join(lines)
     doc = open(DOC).read()
     if BEGIN in doc:
