@@ -364,6 +364,9 @@ def main():
         lines.append(f"| IDA, {ida_what}: `ida_stripes(threads=2)` against openseespy serial "
                      f"| {t_str:.2f} s | {t_os:.1f} s | {t_os / t_str:.0f}× | peak drifts {ida_rel:.1e} of "
                      f"the largest (asserted ≤ {bound:.1e}); `ida_stripes` against the pool {str_rel:.1e} |")
+    else:
+        lines.append(f"| IDA, {ida_what}: `ida_stripes(threads=2)` | not in this build (`aemstep.ida_stripes` "
+                     "absent: the IDA binding is on another branch) | — | — | — |")
     lines.append(f"| IDA, {ida_what}: `shear_building(histories=False)` on a 2-thread pool against "
                  f"openseespy serial | {t_pool:.2f} s | {t_os:.1f} s | {t_os / t_pool:.0f}× | peak drifts "
                  f"{ida_rel:.1e} of the largest |")
