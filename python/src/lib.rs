@@ -452,17 +452,27 @@ struct BuildingJob {
     settings: NewtonSettings<f64>,
     /// Keep the energy account (`N` law trials and `N²` more a step).
     energy: bool,
+    /// Keep the per-step histories (`u`, `v`, `a`, drifts, iterations, energy): `4N + 1`
+    /// values a step written to memory; without, only the peaks and the last energy row.
+    histories: bool,
 }
 
-/// The histories of a building run (row-major).
+/// The outcome of a building run (histories row-major, empty without `histories`).
 struct BuildingOut {
     u: Vec<f64>,
     v: Vec<f64>,
     a: Vec<f64>,
-    /// E_in, E_k, E_s, E_v, E_h, balance error (J) per step (empty without the account).
+    /// Storey drifts `u_i − u_{i−1}` (m), `steps×N`.
+    drifts: Vec<f64>,
+    /// E_in, E_k, E_s, E_v, E_h, balance error (J) per step (empty without the account;
+    /// the last step's row only without `histories`).
     energy: Vec<f64>,
     iterations: Vec<f64>,
     initial_energy: f64,
+    /// max |drift| per storey over the steps (m), always kept.
+    peak_drifts: Vec<f64>,
+    /// Newton iterations summed over the steps, always kept.
+    total_iterations: u64,
 }
 
 fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) -> Res<BuildingOut> {
@@ -478,34 +488,56 @@ fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) ->
     let mut account = job
         .energy
         .then(|| EnergyAccount::start(&building, &s, &history, &p0));
+    // Capacity only when the histories are kept: the run then writes each value once into
+    // memory handed to numpy as it is (no copy on the way out).
+    let kept = if job.histories { steps } else { 0 };
     let mut o = BuildingOut {
-        u: Vec::with_capacity(steps * N),
-        v: Vec::with_capacity(steps * N),
-        a: Vec::with_capacity(steps * N),
-        energy: Vec::with_capacity(if job.energy { steps * 6 } else { 0 }),
-        iterations: Vec::with_capacity(steps),
+        u: Vec::with_capacity(kept * N),
+        v: Vec::with_capacity(kept * N),
+        a: Vec::with_capacity(kept * N),
+        drifts: Vec::with_capacity(kept * N),
+        energy: Vec::with_capacity(if job.energy { kept.max(1) * 6 } else { 0 }),
+        iterations: Vec::with_capacity(kept),
         initial_energy: account.as_ref().map_or(f64::NAN, |e| e.initial),
+        peak_drifts: Vec::new(),
+        total_iterations: 0,
     };
-    let keep = |o: &mut BuildingOut,
-                s: &aemstep::State<f64, N>,
-                e: Option<&EnergyAccount<f64, N>>,
-                iterations: u32| {
-        o.u.extend_from_slice(s.u().as_slice());
-        o.v.extend_from_slice(s.v().as_slice());
-        o.a.extend_from_slice(s.a().as_slice());
-        if let Some(e) = e {
-            o.energy.extend_from_slice(&[
-                e.input,
-                e.kinetic,
-                e.recoverable,
-                e.viscous,
-                e.hysteretic,
-                e.balance_error(),
-            ]);
+    let mut peaks = [0.0f64; N];
+    let histories = job.histories;
+    // The drifts as numpy's `np.diff(u, axis=1, prepend=0.0)` forms them (`u_0 − 0` first),
+    // so the peaks are bitwise those of the histories.
+    let mut keep = |o: &mut BuildingOut, s: &aemstep::State<f64, N>, iterations: u32| {
+        let u = s.u();
+        let mut below = 0.0;
+        let mut drifts = [0.0f64; N];
+        for i in 0..N {
+            drifts[i] = u[i] - below;
+            below = u[i];
+            peaks[i] = peaks[i].max(drifts[i].abs());
         }
-        o.iterations.push(f64::from(iterations));
+        o.total_iterations += u64::from(iterations);
+        if histories {
+            o.u.extend_from_slice(u.as_slice());
+            o.v.extend_from_slice(s.v().as_slice());
+            o.a.extend_from_slice(s.a().as_slice());
+            o.drifts.extend_from_slice(&drifts);
+            o.iterations.push(f64::from(iterations));
+        }
     };
-    keep(&mut o, &s, account.as_ref(), 0);
+    let row = |e: &EnergyAccount<f64, N>| {
+        [
+            e.input,
+            e.kinetic,
+            e.recoverable,
+            e.viscous,
+            e.hysteretic,
+            e.balance_error(),
+        ]
+    };
+    keep(&mut o, &s, 0);
+    if let (Some(e), true) = (account.as_ref(), histories) {
+        o.energy.extend_from_slice(&row(e));
+    }
     for n in 1..steps {
         let p = building.ground_load(job.ag[n]);
         let previous = history;
@@ -514,9 +546,16 @@ fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) ->
             .map_err(at(n))?;
         if let Some(e) = account.as_mut() {
             e.step(&building, &previous, &s, &history, &p);
+            if histories {
+                o.energy.extend_from_slice(&row(e));
+            }
         }
-        keep(&mut o, &s, account.as_ref(), report.iterations);
+        keep(&mut o, &s, report.iterations);
     }
+    if let (Some(e), false) = (account.as_ref(), histories) {
+        o.energy.extend_from_slice(&row(e));
+    }
+    o.peak_drifts = peaks.to_vec();
     Ok(o)
 }
 
@@ -542,16 +581,21 @@ fn building_n<const N: usize, const S: usize>(law: &str, job: &BuildingJob) -> R
 /// `c` — damping matrix (N·s/m), `n×n`; `h` — time step (s); `ag` — ground acceleration
 /// (m/s²) at `t = i·h`; `max_iterations`, `tolerance` — Newton budget and relative
 /// tolerance; `energy` — keep the energy account (about `N` law trials and `N²`
-/// multiply-adds more a step; `False` for the bare stepping speed).
+/// multiply-adds more a step; `False` for the bare stepping speed); `histories` — keep
+/// the per-step histories (`4n + 1` values a step, `8·(4n + 1)` bytes, plus 48 with the
+/// account; `False`: the peaks only, no memory a step, the speed of the Rust loop).
 ///
-/// Returns a dict: `u`, `v`, `a` — floor displacements (m), velocities (m/s),
-/// accelerations (m/s²) relative to the ground, `steps×n`; `energy` — `steps×6`: input,
+/// Returns a dict. Always: `peak_drifts` — max |storey drift| per storey (m), length `n`;
+/// `peak_drift` — their max (m); `total_iterations` — Newton iterations over the run.
+/// With `histories`: `u`, `v`, `a` — floor displacements (m), velocities (m/s),
+/// accelerations (m/s²) relative to the ground, `steps×n`; `drifts` — storey drifts
+/// `u_i − u_{i−1}` (m), `steps×n`; `iterations` — Newton iterations per step. With
+/// `energy`: `energy` — `steps×6` (`1×6`, the last step, without `histories`): input,
 /// kinetic, recoverable strain, viscous, hysteretic energies and the balance error (J);
-/// `initial_energy` (J) — both absent without `energy`; `iterations` — Newton iterations
-/// per step. Raises the library's
-/// errors (`NotConverged` with `.step`, `InvalidMaterial`, `InvalidNewtonSettings`, …).
+/// `initial_energy` (J). Raises the library's errors (`NotConverged` with `.step`,
+/// `InvalidMaterial`, `InvalidNewtonSettings`, …).
 #[pyfunction]
-#[pyo3(signature = (masses, law, params, c, h, ag, max_iterations=20, tolerance=1e-10, energy=true))]
+#[pyo3(signature = (masses, law, params, c, h, ag, max_iterations=20, tolerance=1e-10, energy=true, histories=true))]
 #[allow(clippy::too_many_arguments)]
 fn shear_building<'py>(
     py: Python<'py>,
@@ -564,6 +608,7 @@ fn shear_building<'py>(
     max_iterations: u32,
     tolerance: f64,
     energy: bool,
+    histories: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let width = match law {
         "bilinear" => 3,
@@ -598,6 +643,7 @@ fn shear_building<'py>(
                 ag,
                 settings: NewtonSettings::up_to(max_iterations, tolerance),
                 energy,
+                histories,
             },
             n,
         ))
@@ -607,14 +653,21 @@ fn shear_building<'py>(
         .detach(|| by_size!(n, building_n(law, &job)))
         .map_err(|f| f.raise(py))?;
     let d = PyDict::new(py);
-    d.set_item("u", out2(py, o.u, n))?;
-    d.set_item("v", out2(py, o.v, n))?;
-    d.set_item("a", out2(py, o.a, n))?;
+    let peak = o.peak_drifts.iter().fold(0.0f64, |m, &x| m.max(x));
+    d.set_item("peak_drifts", out1(py, o.peak_drifts))?;
+    d.set_item("peak_drift", peak)?;
+    d.set_item("total_iterations", o.total_iterations)?;
+    if histories {
+        d.set_item("u", out2(py, o.u, n))?;
+        d.set_item("v", out2(py, o.v, n))?;
+        d.set_item("a", out2(py, o.a, n))?;
+        d.set_item("drifts", out2(py, o.drifts, n))?;
+        d.set_item("iterations", out1(py, o.iterations))?;
+    }
     if energy {
         d.set_item("energy", out2(py, o.energy, 6))?;
         d.set_item("initial_energy", o.initial_energy)?;
     }
-    d.set_item("iterations", out1(py, o.iterations))?;
     Ok(d)
 }
 

@@ -156,3 +156,30 @@ def test_without_the_energy_account_the_run_is_the_same(elcentro):
     b = aemstep.shear_building(masses, c, dt, ag, energy=False, **kw)
     assert b.energy is None and a.energy is not None
     assert np.array_equal(a.u, b.u) and np.array_equal(a.iterations, b.iterations)
+
+
+@pytest.mark.parametrize("energy", [False, True])
+def test_without_histories_the_peaks_are_those_of_the_histories(elcentro, energy):
+    """histories=False keeps no per-step arrays; its peaks and iteration count are
+    bitwise those computed from the full run's histories (drifts as np.diff forms them)."""
+    ag, dt = elcentro
+    masses, m, k, c = three_storey()
+    kw = dict(k=1e8, fy=[6e5, 5e5, 3.5e5], alpha=0.05, energy=energy)
+    full = aemstep.shear_building(masses, c, dt, ag, **kw)
+    bare = aemstep.shear_building(masses, c, dt, ag, histories=False, **kw)
+    assert bare.u is None and bare.v is None and bare.a is None
+    assert bare.drifts is None and bare.iterations is None
+    drifts = np.diff(full.u, axis=1, prepend=0.0)
+    assert np.array_equal(full.drifts, drifts)
+    peaks = np.abs(drifts).max(axis=0)
+    assert np.array_equal(bare.peak_drifts, peaks) and np.array_equal(full.peak_drifts, peaks)
+    assert bare.peak_drift == full.peak_drift == peaks.max()
+    assert bare.total_iterations == full.total_iterations == int(full.iterations.sum())
+    assert (peaks > np.array([6e5, 5e5, 3.5e5]) / 1e8).any()  # a storey yields
+    if energy:
+        for name in ("input", "kinetic", "recoverable", "viscous", "hysteretic", "balance_error"):
+            assert getattr(bare.energy, name).shape == (1,)
+            assert getattr(bare.energy, name)[0] == getattr(full.energy, name)[-1]
+        assert bare.energy.initial == full.energy.initial
+    else:
+        assert bare.energy is None
