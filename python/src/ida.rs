@@ -227,16 +227,6 @@ fn run_polled(
     })
 }
 
-/// A `ValueError` for a law name `shear_building` does not know.
-fn known_law(law: &str) -> PyResult<()> {
-    match laws::law_width(law) {
-        Some(_) => Ok(()),
-        None => Err(PyValueError::new_err(format!(
-            "unknown law {law:?}: one of bilinear, bouc_wen, bilinear_friction"
-        ))),
-    }
-}
-
 fn on_failure_of(s: &str) -> PyResult<OnFailure> {
     match s {
         "collapse" => Ok(OnFailure::Collapse),
@@ -369,7 +359,7 @@ fn ida_stripes<'py>(
         edp: collapse_drift.unwrap_or(f64::INFINITY),
         on_failure: on_failure_of(on_failure)?,
     };
-    known_law(law)?;
+    laws::known_law(law)?;
     let plan = Plan::Stripes(read1(&intensities));
     let job = prepare(
         &records,
@@ -430,7 +420,7 @@ fn ida_hunt_fill<'py>(
         edp: collapse_drift.unwrap_or(f64::INFINITY),
         on_failure: on_failure_of(on_failure)?,
     };
-    known_law(law)?;
+    laws::known_law(law)?;
     // A budget outside 1..=10 000 (negative too) is the library's InvalidParameter.
     let runs = usize::try_from(runs).unwrap_or(0);
     let plan = Plan::HuntFill(HuntFill {

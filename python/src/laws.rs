@@ -11,6 +11,16 @@ use crate::{Fail, Res};
 pub(crate) const LAW_WIDTHS: [(&str, usize); 3] =
     [("bilinear", 3), ("bouc_wen", 6), ("bilinear_friction", 5)];
 
+/// The number of parameter columns of `law`; a `ValueError` naming the laws for a name
+/// `shear_building` does not know.
+pub(crate) fn known_law(law: &str) -> pyo3::PyResult<usize> {
+    law_width(law).ok_or_else(|| {
+        pyo3::exceptions::PyValueError::new_err(format!(
+            "unknown law {law:?}: one of bilinear, bouc_wen, bilinear_friction"
+        ))
+    })
+}
+
 /// The number of parameter columns of `law`, or `None` for an unknown name.
 pub(crate) fn law_width(law: &str) -> Option<usize> {
     LAW_WIDTHS.iter().find(|(n, _)| *n == law).map(|&(_, w)| w)

@@ -610,16 +610,7 @@ fn shear_building<'py>(
     energy: bool,
     histories: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let width = match law {
-        "bilinear" => 3,
-        "bouc_wen" => 6,
-        "bilinear_friction" => 5,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "unknown law {other:?}: one of bilinear, bouc_wen, bilinear_friction"
-            )));
-        }
-    };
+    let width = laws::known_law(law)?;
     let prepare = || -> Res<(BuildingJob, usize)> {
         let masses = read1(&masses);
         let n = masses.len();
