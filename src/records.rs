@@ -1,6 +1,6 @@
 //! Ground-motion record readers: PEER NGA **AT2** text and **one-column** text (one value a
 //! line), parsed from a `&str` by an iterator or into a caller's `&mut [T]` (`no_std`, no
-//! heap), and with the `std` feature into a [`Record`] (`Vec<f64>`) from text or a file.
+//! heap), and with the `std` feature into a `Record` (`Vec<f64>`) from text or a file.
 //!
 //! ```
 //! use aemstep::records;
@@ -58,7 +58,7 @@
 //! count [`column()`]'s values first). Nothing here panics, on any bytes (a property test
 //! feeds random text).
 //!
-//! **Cost**: one pass over the text, no allocation (except [`Record`]'s `Vec`); each value
+//! **Cost**: one pass over the text, no allocation (except `Record`'s `Vec`); each value
 //! is parsed by `core`'s correctly rounded `f64` parser (`str::parse`), so the values are
 //! exactly those of the text, rounded once (to `f32` from that `f64` for `f32` buffers).
 
