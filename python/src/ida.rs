@@ -244,6 +244,7 @@ fn prepare(
     h: f64,
     masses: &PyReadonlyArray1<'_, f64>,
     law: &str,
+    width: usize,
     params: &PyReadonlyArray2<'_, f64>,
     c: &PyReadonlyArray2<'_, f64>,
     max_iterations: u32,
@@ -252,7 +253,6 @@ fn prepare(
     plan: Plan,
     threads: usize,
 ) -> Res<IdaJob> {
-    let width = laws::law_width(law).unwrap_or(0);
     let masses = read1(masses);
     let n = masses.len();
     if !SIZES.contains(&n) {
@@ -283,6 +283,54 @@ fn prepare(
         plan,
         threads,
     })
+}
+
+/// The collapse rule of the Python arguments: `collapse_drift` (m, `None`: never by drift)
+/// and `on_failure` (`"collapse"` or `"abort"`).
+fn collapse_of(collapse_drift: Option<f64>, on_failure: &str) -> PyResult<Collapse> {
+    Ok(Collapse {
+        edp: collapse_drift.unwrap_or(f64::INFINITY),
+        on_failure: on_failure_of(on_failure)?,
+    })
+}
+
+/// What `ida_stripes` and `ida_hunt_fill` share after reading their plan: the law name
+/// checked, the job gathered (`prepare`), run with the GIL released and polled for
+/// progress (`run_polled`), the curves as dicts (`curves_out`).
+#[allow(clippy::too_many_arguments)]
+fn run<'py>(
+    py: Python<'py>,
+    records: &[PyReadonlyArray1<'py, f64>],
+    h: f64,
+    masses: &PyReadonlyArray1<'py, f64>,
+    law: &str,
+    params: &PyReadonlyArray2<'py, f64>,
+    c: &PyReadonlyArray2<'py, f64>,
+    max_iterations: u32,
+    tolerance: f64,
+    collapse: Collapse,
+    plan: Plan,
+    threads: usize,
+    progress: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyList>> {
+    let width = laws::known_law(law)?;
+    let job = prepare(
+        records,
+        h,
+        masses,
+        law,
+        width,
+        params,
+        c,
+        max_iterations,
+        tolerance,
+        collapse,
+        plan,
+        threads,
+    )
+    .map_err(|f| f.raise(py))?;
+    let curves = run_polled(py, &job, progress)?;
+    curves_out(py, curves)
 }
 
 /// The curves as dicts: `intensity`, `drift`, `collapsed`, `collapse`, `error`.
@@ -355,13 +403,10 @@ fn ida_stripes<'py>(
     threads: usize,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
-    let collapse = Collapse {
-        edp: collapse_drift.unwrap_or(f64::INFINITY),
-        on_failure: on_failure_of(on_failure)?,
-    };
-    laws::known_law(law)?;
+    let collapse = collapse_of(collapse_drift, on_failure)?;
     let plan = Plan::Stripes(read1(&intensities));
-    let job = prepare(
+    run(
+        py,
         &records,
         h,
         &masses,
@@ -373,10 +418,8 @@ fn ida_stripes<'py>(
         collapse,
         plan,
         threads,
+        progress.as_ref(),
     )
-    .map_err(|f| f.raise(py))?;
-    let curves = run_polled(py, &job, progress.as_ref())?;
-    curves_out(py, curves)
 }
 
 /// The hunt-and-fill IDA curves of a suite of records (Vamvatsikos & Cornell 2002): per
@@ -416,11 +459,7 @@ fn ida_hunt_fill<'py>(
     threads: usize,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyList>> {
-    let collapse = Collapse {
-        edp: collapse_drift.unwrap_or(f64::INFINITY),
-        on_failure: on_failure_of(on_failure)?,
-    };
-    laws::known_law(law)?;
+    let collapse = collapse_of(collapse_drift, on_failure)?;
     // A budget outside 1..=10 000 (negative too) is the library's InvalidParameter.
     let runs = usize::try_from(runs).unwrap_or(0);
     let plan = Plan::HuntFill(HuntFill {
@@ -431,7 +470,8 @@ fn ida_hunt_fill<'py>(
         runs,
         collapse,
     });
-    let job = prepare(
+    run(
+        py,
         &records,
         h,
         &masses,
@@ -443,10 +483,8 @@ fn ida_hunt_fill<'py>(
         collapse,
         plan,
         threads,
+        progress.as_ref(),
     )
-    .map_err(|f| f.raise(py))?;
-    let curves = run_polled(py, &job, progress.as_ref())?;
-    curves_out(py, curves)
 }
 
 /// The fractile IDA curves: for each quantile `q[k]` and drift level `drifts[j]`, the
