@@ -65,10 +65,11 @@ pub enum Error {
     /// lost its precision (e.g. `M⁻¹K ≈ 1e-324` from data whose scales are 1e300 apart).
     /// Rescale the units.
     OperatorUnderflow,
-    /// A scheme parameter (Newmark β, γ; generalized-α ρ∞; HHT α) or a change detector's
-    /// (window length, false-alarm probability, bank size) is not finite or is outside its
-    /// documented range.
-    InvalidParameter,
+    /// A parameter is not finite or is outside its documented range: a scheme's (Newmark
+    /// β, γ; generalized-α ρ∞; HHT α), a change detector's (window length, false-alarm
+    /// probability, bank size), a delay compensator's, a spectrum's or an analysis'
+    /// setting. The payload names the parameter and, in its message, the rule it broke.
+    InvalidParameter(Param),
     /// A response-spectrum period is not finite and at least `1e-150` s (shorter ones have
     /// an `ω²` that overflows), or the periods of a bank are not in non-decreasing order
     /// (`spectrum::Bank`).
@@ -76,8 +77,9 @@ pub enum Error {
     /// A damping ratio is NaN or outside `[0, 1)` (`spectrum::Bank`).
     InvalidDamping,
     /// A hysteretic law's parameter is not finite or is outside its documented range
-    /// (e.g. a yield force `≤ 0`, a post-yield ratio outside `[0, 1)`).
-    InvalidMaterial,
+    /// (e.g. a yield force `≤ 0`, a post-yield ratio outside `[0, 1)`). The payload names
+    /// the parameter.
+    InvalidMaterial(Param),
     /// A covariance matrix (observer process or measurement noise, or an initial
     /// estimation covariance) is not finite, not symmetric, or not positive (semi)definite
     /// as required; or a Kalman filter's innovation covariance lost definiteness (state
@@ -109,9 +111,142 @@ pub enum Error {
     },
 }
 
+/// Which parameter an [`Error::InvalidParameter`] or [`Error::InvalidMaterial`] names; its
+/// [`as_str`](Param::as_str) states the rule it broke (the limits live in the message).
+/// One byte, `Copy`, usable in `const` contexts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum Param {
+    /// Newmark's `β` and `γ` (finite, `≥ 0`).
+    NewmarkBetaGamma,
+    /// The high-frequency spectral radius `ρ∞` of generalized-α or KR-α (in `[0, 1]`).
+    RhoInf,
+    /// HHT's `α` (in `[−1/3, 0]`).
+    HhtAlpha,
+    /// Generalized-α's `α_m`, `α_f` (finite, `< 1`), `β`, `γ` (finite, `≥ 0`).
+    AlphaParameters,
+    /// An actuator or compensation delay (s; finite, `≥ 0`; an adaptive compensator's initial delay at most its maximum).
+    Delay,
+    /// An actuator's first-order lag time constant (s; finite, `≥ 0`).
+    Lag,
+    /// A delay longer than the actuator's delay line holds (`delay/h ≤ L − 2` samples).
+    DelayLine,
+    /// A delay compensator's polynomial order (`1..=3`).
+    CompensationOrder,
+    /// A spectrum's sub-step rule (`Fixed(n)`, `1 ≤ n ≤` the documented maximum; `PointsPerPeriod(k)`, `k ≥ 1`).
+    Substeps,
+    /// An output buffer too short for the values (a record reader's `out`).
+    OutputBuffer,
+    /// A strength-reduction factor `R` (finite, `> 0`).
+    StrengthReduction,
+    /// A record's elastic strength demand at a period (finite, `> 0`: the record must move the oscillator).
+    ElasticStrength,
+    /// A target ductility `μ` (finite, `> 1`).
+    TargetDuctility,
+    /// A ductility search's settings (iterations `≥ 1`, a tolerance finite and at least 4 machine epsilons).
+    Search,
+    /// Hunt-and-fill settings (first intensity, growth, resolution finite and `> 0`, runs in `1..=10 000`, a finite top).
+    HuntFill,
+    /// A collapse EDP limit (`> 0`).
+    CollapseLimit,
+    /// An intensity measure level (finite, `> 0`).
+    Intensity,
+    /// Fractile inputs: at least one curve, EDP levels finite and `≥ 0`, quantiles in `[0, 1]`.
+    Fractiles,
+    /// A batch run cancelled by its caller (e.g. Ctrl-C) before it finished.
+    Cancelled,
+    /// A detector's number of outputs or degrees of freedom (`≥ 1`).
+    Outputs,
+    /// A detector's window length `W` (`≥ 1`).
+    Window,
+    /// A false-alarm probability `α` (in `(0, 1)`).
+    FalseAlarm,
+    /// A χ² threshold too large for the window's fixed-point sum.
+    Threshold,
+    /// A CUSUM's likelihood-ratio scale `λ` (finite, `> 1`).
+    CusumDrift,
+    /// A model bank's number of models `M` (`≥ 1`).
+    BankSize,
+    /// A law's initial stiffness `k` (finite, `> 0`).
+    Stiffness,
+    /// A law's yield force `f_y`, or a yield strength (finite, `> 0`, its yield displacement normal).
+    YieldForce,
+    /// A law's post-yield stiffness ratio `α` (finite, in `[0, 1)`).
+    PostYieldRatio,
+    /// Bouc–Wen's shape parameters: `β` finite `> 0`, `|γ| ≤ β`, exponent `n` finite `≥ 1`.
+    BoucWenShape,
+    /// A friction law's slip force `f_s` (finite, `> 0`).
+    FrictionForce,
+    /// A friction law's regularizing velocity `v_r` (finite, `> 0`).
+    ReferenceVelocity,
+}
+
+impl Param {
+    /// The parameter and the rule it broke, static (usable in a `const` `panic!`).
+    pub const fn as_str(&self) -> &'static str {
+        match self {
+            Param::NewmarkBetaGamma => "Newmark beta and gamma must be finite and >= 0",
+            Param::RhoInf => "rho_inf must be in [0, 1]",
+            Param::HhtAlpha => "HHT alpha must be in [-1/3, 0]",
+            Param::AlphaParameters => {
+                "generalized-alpha needs finite alpha_m < 1, alpha_f < 1, beta >= 0, gamma >= 0"
+            }
+            Param::Delay => {
+                "a delay must be finite, >= 0 (and the initial delay <= the maximum delay)"
+            }
+            Param::Lag => "the actuator lag must be finite and >= 0",
+            Param::DelayLine => {
+                "the delay is longer than the delay line: need delay/h <= L - 2 samples"
+            }
+            Param::CompensationOrder => "the compensation order must be 1, 2 or 3",
+            Param::Substeps => {
+                "substeps: Fixed(n) needs 1 <= n <= the maximum, PointsPerPeriod(k) needs k >= 1"
+            }
+            Param::OutputBuffer => "the output buffer is shorter than the values to write",
+            Param::StrengthReduction => "a strength reduction factor must be finite and > 0",
+            Param::ElasticStrength => {
+                "the record's elastic strength at a period is zero or not finite"
+            }
+            Param::TargetDuctility => "the target ductility must be finite and > 1",
+            Param::Search => "ductility search: iterations >= 1 and tolerance >= 4 eps, finite",
+            Param::HuntFill => {
+                "hunt-and-fill settings: positive finite intensities and steps, 1..=10000 runs"
+            }
+            Param::CollapseLimit => "the collapse EDP limit must be > 0",
+            Param::Intensity => "an intensity must be finite and > 0",
+            Param::Fractiles => {
+                "fractiles need >= 1 curve, EDP levels finite >= 0, quantiles in [0, 1]"
+            }
+            Param::Cancelled => "the run was cancelled",
+            Param::Outputs => "the number of outputs (degrees of freedom) must be >= 1",
+            Param::Window => "the window length W must be >= 1",
+            Param::FalseAlarm => "the false-alarm probability alpha must be in (0, 1)",
+            Param::Threshold => {
+                "the chi-square threshold overflows the window's fixed-point sum: use a larger alpha or a shorter window"
+            }
+            Param::CusumDrift => "the CUSUM lambda must be finite and > 1",
+            Param::BankSize => "a model bank needs M >= 1 models",
+            Param::Stiffness => "the stiffness k must be finite and > 0",
+            Param::YieldForce => "the yield force must be finite and > 0",
+            Param::PostYieldRatio => "the post-yield ratio alpha must be in [0, 1)",
+            Param::BoucWenShape => "Bouc-Wen needs beta > 0, |gamma| <= beta, n >= 1, all finite",
+            Param::FrictionForce => "the friction slip force must be finite and > 0",
+            Param::ReferenceVelocity => "the friction reference velocity must be finite and > 0",
+        }
+    }
+}
+
+impl fmt::Display for Param {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 impl Error {
     /// A short, static description (usable in `const` contexts, e.g. `panic!` while
-    /// building a `static` operator at compile time).
+    /// building a `static` operator at compile time). For [`Error::InvalidParameter`] and
+    /// [`Error::InvalidMaterial`] it is the parameter's rule ([`Param::as_str`]).
     pub const fn as_str(&self) -> &'static str {
         match self {
             Error::NonFiniteInput => "an input has a NaN or infinite entry",
@@ -147,14 +282,13 @@ impl Error {
                 "the damping is not classical (it couples the modes): use the full stepper"
             }
             Error::EigenNotConverged => "the symmetric eigen-solver did not converge",
-            Error::InvalidParameter => "a scheme parameter is not finite or out of range",
+            Error::InvalidParameter(p) | Error::InvalidMaterial(p) => p.as_str(),
             Error::OperatorOverflow => "an operator overflows the scalar type",
             Error::OperatorUnderflow => "an operator underflows the scalar type: rescale the units",
             Error::InvalidPeriod => {
                 "a period is not finite and > 0, or the periods are not in non-decreasing order"
             }
             Error::InvalidDamping => "a damping ratio is NaN or outside [0, 1)",
-            Error::InvalidMaterial => "a hysteretic law parameter is not finite or out of range",
             Error::InvalidCovariance => {
                 "a covariance is not finite, symmetric and positive (semi)definite"
             }
@@ -174,6 +308,11 @@ impl Error {
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::InvalidParameter(_) => f.write_str("invalid parameter: ")?,
+            Error::InvalidMaterial(_) => f.write_str("invalid material: ")?,
+            _ => {}
+        }
         f.write_str(self.as_str())?;
         match self {
             Error::SingularEffectiveMatrixAtStep { step } => write!(f, " (step {step})"),

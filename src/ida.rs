@@ -97,7 +97,7 @@
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::vec::Vec;
 
-use crate::Error;
+use crate::{Error, Param};
 
 /// What a failed analysis (an `Err` from the closure, or an EDP that is NaN) means.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -170,7 +170,7 @@ impl HuntFill {
         {
             self.collapse.check()
         } else {
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::HuntFill))
         }
     }
 }
@@ -186,7 +186,7 @@ impl Collapse {
         if self.edp > 0.0 {
             Ok(())
         } else {
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::CollapseLimit))
         }
     }
 }
@@ -463,7 +463,7 @@ where
 {
     collapse.check()?;
     if intensities.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
-        return Err(Error::InvalidParameter);
+        return Err(Error::InvalidParameter(Param::Intensity));
     }
     let jobs: Vec<(usize, f64)> = (0..records.len())
         .flat_map(|r| intensities.iter().map(move |&im| (r, im)))
@@ -517,7 +517,7 @@ pub fn fractiles(curves: &[Curve], edp: &[f64], q: &[f64]) -> Result<Vec<Vec<f64
         || edp.iter().any(|&e| !(e.is_finite() && e >= 0.0))
         || q.iter().any(|&x| !(0.0..=1.0).contains(&x))
     {
-        return Err(Error::InvalidParameter);
+        return Err(Error::InvalidParameter(Param::Fractiles));
     }
     let mut out: Vec<Vec<f64>> = (0..q.len())
         .map(|_| Vec::with_capacity(edp.len()))

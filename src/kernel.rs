@@ -12,7 +12,7 @@ use crate::linalg::lu::{Lu, condition, row_scales};
 use crate::linalg::op_rows::OpRows;
 use crate::linalg::{Mat, add_scaled, all_finite, first_error, fits, round_rows, rows_f64};
 use crate::scalar::initial_inputs_finite;
-use crate::{Error, Real, State};
+use crate::{Error, Param, Real, State};
 
 /// The operators of a constant-coefficient Newmark-family stepper, rounded to `T`: the
 /// storage of [`Linear`](crate::Linear) (β = 1/4, γ = 1/2) and
@@ -438,7 +438,7 @@ pub(crate) const fn newmark_operators<const N: usize>(
         return Err(Error::NonFiniteInput);
     }
     if !(beta.is_finite() && gamma.is_finite() && beta >= 0.0 && gamma >= 0.0) {
-        return Err(Error::InvalidParameter);
+        return Err(Error::InvalidParameter(Param::NewmarkBetaGamma));
     }
     let kin = match NewmarkKinematics::new(h, beta, gamma) {
         Ok(kin) => kin,

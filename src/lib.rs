@@ -187,7 +187,7 @@ pub mod records;
 #[cfg(feature = "defmt")]
 mod defmt_impls;
 
-pub use error::Error;
+pub use error::{Error, Param};
 pub use modal::{Damping, Modal, ModalState};
 pub use nonlinear::varying::{Coefficients, TimeVarying, Varying};
 pub use nonlinear::{

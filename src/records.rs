@@ -62,7 +62,7 @@
 //! is parsed by `core`'s correctly rounded `f64` parser (`str::parse`), so the values are
 //! exactly those of the text, rounded once (to `f32` from that `f64` for `f32` buffers).
 
-use crate::{Error, Real};
+use crate::{Error, Param, Real};
 
 /// Standard gravity (m/s²): multiply a PEER acceleration record (in g) by it for m/s².
 pub const G: f64 = 9.80665;
@@ -135,7 +135,7 @@ impl<'a> At2<'a> {
     /// [`At2::values`]. Cost: one pass over the values.
     pub fn read_into<T: Real>(&self, out: &mut [T]) -> Result<usize, Error> {
         if out.len() < self.npts {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::OutputBuffer));
         }
         fill(self.values(), out)
     }
@@ -257,7 +257,9 @@ fn fill<T: Real>(values: Values<'_>, out: &mut [T]) -> Result<usize, Error> {
     let mut values = values;
     while let Some(v) = values.next() {
         let v = v?;
-        let slot = out.get_mut(n).ok_or(Error::InvalidParameter)?;
+        let slot = out
+            .get_mut(n)
+            .ok_or(Error::InvalidParameter(Param::OutputBuffer))?;
         let t = T::from_f64_rounded(v);
         if !t.as_f64().is_finite() {
             return Err(Error::MalformedRecord {

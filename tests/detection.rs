@@ -9,13 +9,13 @@
 
 #![allow(clippy::needless_range_loop)] // matrix and record indices read best explicitly
 
-use aemstep::Error;
 use aemstep::detection::{
     ChiSquareTest, Cusum, CusumState, Detector, ModelBank, NIS_FRACTION_BITS, Whitener, Window,
     chi_square_quantile, innovation_covariance, normal_quantile,
 };
 use aemstep::models::{self, base_excitation};
 use aemstep::observer::{Measurement, Observer, Outputs, StateSpace, SteadyState};
+use aemstep::{Error, Param};
 use nalgebra::{SMatrix, SVector};
 
 #[path = "../scenes/modal/elcentro.rs"]
@@ -204,38 +204,38 @@ fn const_threshold_is_the_run_time_one_and_bad_parameters_are_typed() {
     );
     assert_eq!(
         ChiSquareTest::<0>::new(3, 0.01),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::Window))
     );
     assert_eq!(
         ChiSquareTest::<10>::new(0, 0.01),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::Outputs))
     );
     for a in [0.0, 1.0, -1e-3, 1.5, f64::NAN, f64::INFINITY] {
         assert_eq!(
             ChiSquareTest::<10>::new(2, a),
-            Err(Error::InvalidParameter),
+            Err(Error::InvalidParameter(Param::FalseAlarm)),
             "α = {a}"
         );
     }
     // A window so long that its threshold reaches the term cap (2⁴⁰/W).
     assert_eq!(
         ChiSquareTest::<2_000_000>::new(1, 0.01),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::Threshold))
     );
     // CUSUM: λ ≤ 1 or not finite, α outside (0, 1), no outputs.
-    for (o, l, a) in [
-        (3, 1.0, 0.01),
-        (3, 0.5, 0.01),
-        (3, f64::INFINITY, 0.01),
-        (3, f64::NAN, 0.01),
-        (3, 2.0, 0.0),
-        (3, 2.0, 1.0),
-        (3, 2.0, f64::NAN),
-        (0, 2.0, 0.01),
+    for (o, l, a, which) in [
+        (3, 1.0, 0.01, Param::CusumDrift),
+        (3, 0.5, 0.01, Param::CusumDrift),
+        (3, f64::INFINITY, 0.01, Param::CusumDrift),
+        (3, f64::NAN, 0.01, Param::CusumDrift),
+        (3, 2.0, 0.0, Param::FalseAlarm),
+        (3, 2.0, 1.0, Param::FalseAlarm),
+        (3, 2.0, f64::NAN, Param::FalseAlarm),
+        (0, 2.0, 0.01, Param::Outputs),
     ] {
         assert_eq!(
             Cusum::new(o, l, a),
-            Err(Error::InvalidParameter),
+            Err(Error::InvalidParameter(which)),
             "{o} {l} {a}"
         );
     }
@@ -266,7 +266,10 @@ fn const_threshold_is_the_run_time_one_and_bad_parameters_are_typed() {
         Whitener::<f32, 1>::new(&[[1e-80]]),
         Err(Error::OperatorOverflow)
     );
-    assert_eq!(Whitener::<f64, 0>::new(&[]), Err(Error::InvalidParameter));
+    assert_eq!(
+        Whitener::<f64, 0>::new(&[]),
+        Err(Error::InvalidParameter(Param::Outputs))
+    );
     // The const twin is bit-identical.
     let s = [[2.0, 0.3], [0.3, 0.5]];
     assert_eq!(
@@ -698,7 +701,7 @@ fn missing_samples_are_skipped_and_a_failed_bank_step_changes_nothing() {
     assert_eq!(big, big_before);
     assert_eq!(
         ModelBank::<f64, 10, 1, 3, 0>::new([], []),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::BankSize))
     );
     // The detector skips a NaN innovation too.
     let det = Detector::<f64, 3, 4>::new(w0, ChiSquareTest::new(3, 0.01).unwrap());

@@ -13,7 +13,7 @@ use aemstep::hybrid::{Actuator, Split, SplitState};
 use aemstep::hysteresis::{Bilinear, BilinearHistory, Law};
 use aemstep::models::{self, Rows, base_excitation};
 use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::{Error, KrAlpha, Real, Stepper};
+use aemstep::{Error, KrAlpha, Param, Real, Stepper};
 use nalgebra::{DMatrix, DVector};
 
 #[path = "support/kr.rs"]
@@ -393,7 +393,7 @@ fn bad_input_is_a_typed_error() {
     );
     assert_eq!(
         Split::<f64, 1>::new(&one, &zero, &one, &one, 0.01, 1.5),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::RhoInf))
     );
     assert_eq!(
         Split::<f64, 1>::chen_ricles(&one, &zero, &one, &one, -0.01),

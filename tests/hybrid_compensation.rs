@@ -5,8 +5,8 @@
 //! adaptive compensator's delay estimate converging to the true delay (with and without a
 //! lag) and standing still at rest; typed errors that change nothing; the `const` twins.
 
-use aemstep::Error;
 use aemstep::hybrid::{Actuator, Adaptive, Compensator, CompensatorState, Polynomial};
+use aemstep::{Error, Param};
 
 const EPS: f64 = f64::EPSILON;
 
@@ -204,11 +204,11 @@ fn bad_input_is_a_typed_error_and_changes_nothing() {
     for order in [0, 4] {
         assert_eq!(
             Polynomial::<f64>::new(order, h, 0.0),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::CompensationOrder))
         );
         assert_eq!(
             Adaptive::<f32>::new(order, h, 0.0, 0.01),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::CompensationOrder))
         );
     }
     for bad_h in [0.0, -1e-3, f64::NAN, f64::INFINITY] {
@@ -228,24 +228,24 @@ fn bad_input_is_a_typed_error_and_changes_nothing() {
     for bad in [-1e-3, f64::NAN, f64::INFINITY] {
         assert_eq!(
             Polynomial::<f64>::new(2, h, bad),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::Delay))
         );
         assert_eq!(
             Adaptive::<f64>::new(2, h, bad, 0.01),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::Delay))
         );
         assert_eq!(
             Actuator::<f64, 8>::new(h, bad, 0.0),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::Delay))
         );
         assert_eq!(
             Actuator::<f64, 8>::new(h, 0.0, bad),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::Lag))
         );
     }
     assert_eq!(
         Adaptive::<f64>::new(2, h, 0.02, 0.01),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::Delay))
     );
     assert_eq!(
         Adaptive::<f64>::new(2, 0.5, 0.0, 0.01),
@@ -255,11 +255,11 @@ fn bad_input_is_a_typed_error_and_changes_nothing() {
     assert!(Actuator::<f64, 8>::new(h, 6.0 * h, 0.0).is_ok());
     assert_eq!(
         Actuator::<f64, 8>::new(h, 6.01 * h, 0.0),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::DelayLine))
     );
     assert_eq!(
         Actuator::<f64, 1>::new(h, 0.0, 0.0),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::DelayLine))
     );
     // A weight that does not fit f32: s = 1e15 samples, order 3 (s³/6 ≈ 1.7e44).
     assert_eq!(
@@ -322,7 +322,7 @@ fn const_twins_are_the_run_time_builds() {
     );
     assert_eq!(
         Polynomial::new_f64(5, 1e-3, 0.0021),
-        Err::<Polynomial<f64>, _>(Error::InvalidParameter)
+        Err::<Polynomial<f64>, _>(Error::InvalidParameter(Param::CompensationOrder))
     );
     assert_eq!(P32.order(), 3);
     // Zero delay: the target itself.

@@ -27,7 +27,7 @@ use aemstep::hysteresis::{
 };
 use aemstep::nalgebra::{SMatrix, SVector, Vector3};
 use aemstep::{
-    Error, Linear, NewtonReport, NewtonSettings, Nonlinear, State, Stepper, Tangent, models,
+    Error, Linear, NewtonReport, NewtonSettings, Nonlinear, Param, State, Stepper, Tangent, models,
 };
 use checks::bits;
 use support::Rng;
@@ -38,25 +38,25 @@ const EPS: f64 = f64::EPSILON;
 
 #[test]
 fn bad_parameters_are_typed_errors() {
-    let bad = Some(Error::InvalidMaterial);
-    for (k, fy, a) in [
-        (1e8, -1.0, 0.05),
-        (1e8, 0.0, 0.05),
-        (1e8, 1e5, 1.0),
-        (1e8, 1e5, -0.01),
-        (-1e8, 1e5, 0.05),
-        (f64::NAN, 1e5, 0.05),
-        (1e8, f64::INFINITY, 0.05),
-        (1e8, 1e5, f64::NAN),
+    let bad = |p| Some(Error::InvalidMaterial(p));
+    for (k, fy, a, which) in [
+        (1e8, -1.0, 0.05, Param::YieldForce),
+        (1e8, 0.0, 0.05, Param::YieldForce),
+        (1e8, 1e5, 1.0, Param::PostYieldRatio),
+        (1e8, 1e5, -0.01, Param::PostYieldRatio),
+        (-1e8, 1e5, 0.05, Param::Stiffness),
+        (f64::NAN, 1e5, 0.05, Param::Stiffness),
+        (1e8, f64::INFINITY, 0.05, Param::YieldForce),
+        (1e8, 1e5, f64::NAN, Param::PostYieldRatio),
     ] {
         assert_eq!(
             Bilinear::<f64>::new(k, fy, a).err(),
-            bad,
+            bad(which),
             "bilinear {k} {fy} {a}"
         );
         assert_eq!(
             BoucWen::<f32>::new(k, fy, a, 0.5, 0.5, 1.0).err(),
-            bad,
+            bad(which),
             "Bouc–Wen {k} {fy} {a}"
         );
     }
@@ -70,25 +70,25 @@ fn bad_parameters_are_typed_errors() {
     ] {
         assert_eq!(
             BoucWen::<f64>::new(1e8, 1e5, 0.05, b, g, n).err(),
-            bad,
+            bad(Param::BoucWenShape),
             "{b} {g} {n}"
         );
     }
-    for (fs, vr) in [
-        (-1.0, 0.01),
-        (1e4, 0.0),
-        (f64::NAN, 0.01),
-        (1e4, f64::INFINITY),
+    for (fs, vr, which) in [
+        (-1.0, 0.01, Param::FrictionForce),
+        (1e4, 0.0, Param::ReferenceVelocity),
+        (f64::NAN, 0.01, Param::FrictionForce),
+        (1e4, f64::INFINITY, Param::ReferenceVelocity),
     ] {
-        assert_eq!(Friction::<f64>::new(fs, vr).err(), bad);
+        assert_eq!(Friction::<f64>::new(fs, vr).err(), bad(which));
     }
     // Valid edges are accepted: α = 0, |γ| = β, n = 1.
     assert!(Bilinear::<f64>::new(1e8, 1e5, 0.0).is_ok());
     assert!(BoucWen::<f64>::new(1e8, 1e5, 0.0, 0.5, -0.5, 1.0).is_ok());
-    assert_eq!(
-        Error::InvalidMaterial.to_string(),
-        Error::InvalidMaterial.as_str()
-    );
+    // The message names the parameter and its rule.
+    let e = Error::InvalidMaterial(Param::YieldForce);
+    assert_eq!(e.to_string(), format!("invalid material: {}", e.as_str()));
+    assert!(e.as_str().contains("yield force"), "{e}");
     // The building: masses and damping.
     let law = Bilinear::<f64>::new(1e8, 1e5, 0.05).unwrap();
     let c = [[0.0; 2]; 2];

@@ -17,7 +17,7 @@ use std::sync::Mutex;
 
 use aemstep::ida::{self, Collapse, Curve, HuntFill, OnFailure, Point};
 use aemstep::nalgebra::SVector;
-use aemstep::{Error, Linear, Stepper, models};
+use aemstep::{Error, Linear, Param, Stepper, models};
 
 /// A record of the toy analysis: its collapse intensity `c`.
 #[derive(Clone, Copy, Debug)]
@@ -231,14 +231,20 @@ fn failures_collapse_or_abort() {
 #[test]
 fn bad_settings_are_typed_errors() {
     let bad = |s: HuntFill| {
+        // The collapse limit is named as such; every other setting as hunt-and-fill's.
+        let which = if s.collapse.edp > 0.0 {
+            Param::HuntFill
+        } else {
+            Param::CollapseLimit
+        };
         assert_eq!(
             ida::trace(&Toy { c: 1.0 }, &s, toy),
-            Err(Error::InvalidParameter),
+            Err(Error::InvalidParameter(which)),
             "{s:?}"
         );
         assert_eq!(
             ida::hunt_fill(&[Toy { c: 1.0 }], &s, 2, toy, None),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(which))
         );
     };
     for x in [0.0, -1.0, f64::NAN, f64::INFINITY] {
@@ -276,29 +282,29 @@ fn bad_settings_are_typed_errors() {
     for ims in [&[1.0, 0.0][..], &[f64::NAN], &[-1.0], &[f64::INFINITY]] {
         assert_eq!(
             ida::stripes(&[Toy { c: 1.0 }], ims, &rule, 2, never, None),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::Intensity))
         );
     }
     let zero_edp = Collapse { edp: 0.0, ..rule };
     assert_eq!(
         ida::stripes(&[Toy { c: 1.0 }], &[1.0], &zero_edp, 2, never, None),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::CollapseLimit))
     );
     let c = ida::trace(&Toy { c: 1.0 }, &DYADIC, toy).unwrap();
     assert_eq!(
         ida::fractiles(&[], &[0.01], &[0.5]),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::Fractiles))
     );
     for e in [-0.01, f64::NAN, f64::INFINITY] {
         assert_eq!(
             ida::fractiles(std::slice::from_ref(&c), &[e], &[0.5]),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::Fractiles))
         );
     }
     for q in [-0.1, 1.1, f64::NAN] {
         assert_eq!(
             ida::fractiles(std::slice::from_ref(&c), &[0.01], &[q]),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::Fractiles))
         );
     }
     assert!(HuntFill::default() == HuntFill::DEFAULT);

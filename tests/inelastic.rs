@@ -10,9 +10,9 @@
 #[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 
-use aemstep::Error;
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
 use aemstep::spectrum::{Bank, Scheme, Substeps};
+use aemstep::{Error, Param};
 
 const DT: f64 = elcentro::DT;
 const P: usize = 10;
@@ -401,13 +401,13 @@ fn bad_input_gives_typed_errors() {
     for alpha in [1.0, -0.1, f64::NAN, f64::INFINITY] {
         assert_eq!(
             Yielding::<f64, P>::new(t, z, alpha, DT),
-            Err(Error::InvalidMaterial)
+            Err(Error::InvalidMaterial(Param::PostYieldRatio))
         );
     }
     for s in [Substeps::Fixed(0), Substeps::PointsPerPeriod(0)] {
         assert_eq!(
             Yielding::<f64, P>::with(t, z, 0.0, DT, s),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::Substeps))
         );
     }
     // f32: ω² of a 1e-30 s period overflows
@@ -421,22 +421,29 @@ fn bad_input_gives_typed_errors() {
     for a in [0.0, -1.0, f64::NAN, f64::NEG_INFINITY] {
         let mut ay = [1.0; P];
         ay[4] = a;
-        assert_eq!(y.at_rest(&ay), Err(Error::InvalidMaterial), "{a}");
-        assert_eq!(y.response(record(), &ay), Err(Error::InvalidMaterial));
+        assert_eq!(
+            y.at_rest(&ay),
+            Err(Error::InvalidMaterial(Param::YieldForce)),
+            "{a}"
+        );
+        assert_eq!(
+            y.response(record(), &ay),
+            Err(Error::InvalidMaterial(Param::YieldForce))
+        );
     }
     for r in [0.0, -2.0, f64::NAN, f64::INFINITY] {
         let mut rr = [2.0; P];
         rr[0] = r;
         assert_eq!(
             y.constant_strength(record(), &rr).map(|_| ()),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::StrengthReduction))
         );
     }
     for mu in [1.0, 0.5, f64::NAN, f64::INFINITY] {
         assert_eq!(
             y.constant_ductility(record(), mu, &Search::DEFAULT)
                 .map(|_| ()),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::TargetDuctility))
         );
     }
     for s in [
@@ -463,7 +470,7 @@ fn bad_input_gives_typed_errors() {
     ] {
         assert_eq!(
             y.constant_ductility(record(), 2.0, &s).map(|_| ()),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::Search))
         );
     }
     // a tolerance below 4 ε of f32
@@ -475,12 +482,12 @@ fn bad_input_gives_typed_errors() {
     assert_eq!(
         y32.constant_ductility(&elcentro::AG_F32, 2.0, &s)
             .map(|_| ()),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::Search))
     );
     // a record that leaves the oscillators at rest
     assert_eq!(
         y.constant_strength(&[0.0; 100], &[2.0; P]).map(|_| ()),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::ElasticStrength))
     );
 }
 

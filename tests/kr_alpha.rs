@@ -10,7 +10,7 @@
 use aemstep::analysis::{Scheme, amplification_matrix, sdof, spectral_radius};
 use aemstep::models::{self, Rows, base_excitation};
 use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::{Error, GeneralizedAlpha, KrAlpha, State, Stepper};
+use aemstep::{Error, GeneralizedAlpha, KrAlpha, Param, State, Stepper};
 use nalgebra::{DMatrix, DVector};
 
 #[path = "support/kr.rs"]
@@ -500,11 +500,11 @@ fn bad_input_is_a_typed_error() {
     for rho in [-0.1, 1.5, f64::NAN] {
         assert_eq!(
             KrAlpha::<f64, 1>::new(&one, &zero, &one, 0.01, rho),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::RhoInf))
         );
         assert_eq!(
             KrAlpha::from_rows_f32([[1.0]], [[0.0]], [[1.0]], 0.01, rho),
-            Err::<KrAlpha<f32, 1>, _>(Error::InvalidParameter)
+            Err::<KrAlpha<f32, 1>, _>(Error::InvalidParameter(Param::RhoInf))
         );
     }
     // A massless degree of freedom: an explicit scheme needs M regular.

@@ -11,7 +11,8 @@ use aemstep::nalgebra::{SVector, vector};
 use aemstep::observer::{Measurement, Observer, Outputs, Readout, StateSpace};
 use aemstep::spectrum::{Bank, RotD, Scheme, Substeps};
 use aemstep::{
-    CompensatedLinear, Damping, Error, KrAlpha, Linear, LinearInput, Modal, Real, State, Stepper,
+    CompensatedLinear, Damping, Error, KrAlpha, Linear, LinearInput, Modal, Param, Real, State,
+    Stepper,
 };
 
 const fn ok<T: Copy>(r: Result<T, Error>) -> T {
@@ -218,7 +219,7 @@ fn generic_bank_fails_as_the_const_banks() {
             [0.05; 2],
             0.01,
             Substeps::Fixed(0),
-            Error::InvalidParameter,
+            Error::InvalidParameter(Param::Substeps),
         ),
     ];
     for (t, z, h, rule, e) in cases {

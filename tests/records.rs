@@ -3,8 +3,8 @@
 //! spellings in use, malformed input as typed errors with the line, `f32` buffers, the
 //! `std` conveniences (text and files), and random text never panics (proptest).
 
-use aemstep::Error;
 use aemstep::records::{self, At2};
+use aemstep::{Error, Param};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
@@ -127,7 +127,7 @@ fn malformed_values_are_typed_errors_with_the_line() {
     let mut short = [7.0f64; 2];
     assert_eq!(
         records::at2(&text).unwrap().read_into(&mut short),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::OutputBuffer))
     );
     assert_eq!(short, [7.0; 2]);
     // Finite in f64, infinite in f32.
@@ -155,7 +155,7 @@ fn one_column() {
     let mut out = [0.0f64; 2];
     assert_eq!(
         records::column_into("1\n2\n3\n", &mut out),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::OutputBuffer))
     );
     assert_eq!(records::column_into("1\n2\n", &mut out), Ok(2));
 }

@@ -2,7 +2,7 @@
 
 mod support;
 
-use aemstep::{Error, Exact, GeneralizedAlpha, Linear, Newmark, State, Stepper};
+use aemstep::{Error, Exact, GeneralizedAlpha, Linear, Newmark, Param, State, Stepper};
 use nalgebra::{SMatrix, SVector, matrix, vector};
 
 type M3 = SMatrix<f64, 3, 3>;
@@ -348,11 +348,11 @@ fn constructors_reject_bad_input() {
     let (m, c, k) = (matrix![1.0], matrix![0.1], matrix![4.0]);
     assert_eq!(
         Newmark::<f64, _>::new(&m, &c, &k, 0.1, -0.1, 0.5),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::NewmarkBetaGamma))
     );
     assert_eq!(
         Newmark::<f64, _>::new(&m, &c, &k, 0.1, 0.25, f64::NAN),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::NewmarkBetaGamma))
     );
     assert_eq!(
         Newmark::<f64, _>::new(&m, &c, &k, 0.0, 0.25, 0.5),
@@ -364,11 +364,11 @@ fn constructors_reject_bad_input() {
     );
     assert_eq!(
         GeneralizedAlpha::<f64, _>::new(&m, &c, &k, 0.1, 1.5),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::RhoInf))
     );
     assert_eq!(
         GeneralizedAlpha::<f64, _>::hht(&m, &c, &k, 0.1, -0.5),
-        Err(Error::InvalidParameter)
+        Err(Error::InvalidParameter(Param::HhtAlpha))
     );
     assert_eq!(
         GeneralizedAlpha::<f64, _>::new(&m, &c, &k, -1.0, 0.5),

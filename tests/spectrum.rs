@@ -12,8 +12,8 @@
 #[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 
-use aemstep::Error;
 use aemstep::spectrum::{Bank, MAX_SUBSTEPS, RotD, Scheme, Substeps};
+use aemstep::{Error, Param};
 
 const DT: f64 = 0.02;
 const P: usize = 100;
@@ -576,7 +576,7 @@ fn bad_periods_damping_and_time_step_are_typed_errors() {
         Substeps::PointsPerPeriod(0),
     ] {
         let e = Bank::<f32, 1>::with([1.0], [0.05], 0.01, Scheme::Exact, s).map(|_| ());
-        assert_eq!(e, Err(Error::InvalidParameter));
+        assert_eq!(e, Err(Error::InvalidParameter(Param::Substeps)));
     }
     // Display and as_str agree
     assert_eq!(

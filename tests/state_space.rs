@@ -16,7 +16,7 @@ mod elcentro;
 
 use aemstep::models::{self, base_excitation};
 use aemstep::observer::{Kalman, Observer, Outputs, StateSpace, SteadyState};
-use aemstep::{AlphaParameters, Error, GeneralizedAlpha, Newmark, State, Stepper};
+use aemstep::{AlphaParameters, Error, GeneralizedAlpha, Newmark, Param, State, Stepper};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 use support::{riccati_residual, sm, spectral_radius};
 
@@ -463,7 +463,16 @@ fn errors_are_the_steppers_for_the_same_bad_input() {
             Error::InvalidTimeStep,
         ),
         ("h < 0", m, c, k, -h, 1.0 / 6.0, 0.5, Error::InvalidTimeStep),
-        ("β < 0", m, c, k, h, -0.1, 0.5, Error::InvalidParameter),
+        (
+            "β < 0",
+            m,
+            c,
+            k,
+            h,
+            -0.1,
+            0.5,
+            Error::InvalidParameter(Param::NewmarkBetaGamma),
+        ),
         (
             "γ = NaN",
             m,
@@ -472,7 +481,7 @@ fn errors_are_the_steppers_for_the_same_bad_input() {
             h,
             0.25,
             f64::NAN,
-            Error::InvalidParameter,
+            Error::InvalidParameter(Param::NewmarkBetaGamma),
         ),
         // Newmark checks β, γ before h.
         (
@@ -483,7 +492,7 @@ fn errors_are_the_steppers_for_the_same_bad_input() {
             0.0,
             -0.1,
             0.5,
-            Error::InvalidParameter,
+            Error::InvalidParameter(Param::NewmarkBetaGamma),
         ),
         (
             "central difference, M = C = 0",
@@ -539,7 +548,7 @@ fn errors_are_the_steppers_for_the_same_bad_input() {
             k,
             h,
             bad(|q| q.alpha_m = 1.0),
-            Error::InvalidParameter,
+            Error::InvalidParameter(Param::AlphaParameters),
         ),
         (
             "α_f = NaN",
@@ -548,7 +557,7 @@ fn errors_are_the_steppers_for_the_same_bad_input() {
             k,
             h,
             bad(|q| q.alpha_f = f64::NAN),
-            Error::InvalidParameter,
+            Error::InvalidParameter(Param::AlphaParameters),
         ),
         (
             "β < 0",
@@ -557,7 +566,7 @@ fn errors_are_the_steppers_for_the_same_bad_input() {
             k,
             h,
             bad(|q| q.beta = -1.0),
-            Error::InvalidParameter,
+            Error::InvalidParameter(Param::AlphaParameters),
         ),
         // Generalized-α checks h before its parameters.
         (
@@ -598,11 +607,14 @@ fn errors_are_the_steppers_for_the_same_bad_input() {
     for r in [-0.1, 1.1, f64::NAN] {
         assert_eq!(
             AlphaParameters::chung_hulbert(r),
-            Err(Error::InvalidParameter)
+            Err(Error::InvalidParameter(Param::RhoInf))
         );
     }
     for a in [0.1, -0.34, f64::NAN] {
-        assert_eq!(AlphaParameters::hht(a), Err(Error::InvalidParameter));
+        assert_eq!(
+            AlphaParameters::hht(a),
+            Err(Error::InvalidParameter(Param::HhtAlpha))
+        );
     }
     // The state-space builders' own checks: S, B, and M⁻¹ (the steppers build with a
     // singular M and start from a known acceleration; the model needs M⁻¹ for a).

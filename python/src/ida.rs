@@ -19,7 +19,7 @@ use std::time::Duration;
 use aemstep::hysteresis::{HistoryModel, Law, ShearBuilding};
 use aemstep::ida::{self, Collapse, Curve, HuntFill, OnFailure, Point};
 use aemstep::nalgebra::SVector;
-use aemstep::{Error, NewtonSettings, Nonlinear};
+use aemstep::{Error, NewtonSettings, Nonlinear, Param};
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -84,7 +84,7 @@ fn peak_drift<const N: usize, L: Law<f64>>(
     let mut peak = 0.0f64;
     for (n, &a) in ag.iter().enumerate().skip(1) {
         if n % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::Cancelled));
         }
         let p = building.ground_load(a * scale);
         stepper.try_step_with_history(building, &mut s, &mut history, &p)?;
@@ -114,7 +114,7 @@ impl<const N: usize> WithLaws<N> for Batch<'_> {
         let cancel = self.cancel;
         let analysis = |ag: &Vec<f64>, im: f64| {
             if cancel.load(Ordering::Relaxed) {
-                return Err(Error::InvalidParameter);
+                return Err(Error::InvalidParameter(Param::Cancelled));
             }
             peak_drift(&building, &stepper, ag, im, cancel)
         };

@@ -162,6 +162,10 @@ impl Fail {
                 if let Error::MalformedRecord { line } = e {
                     let _ = err.value(py).setattr("line", line);
                 }
+                if let Error::InvalidParameter(p) | Error::InvalidMaterial(p) = e {
+                    // The parameter's name (`Param`'s variant), e.g. "RhoInf".
+                    let _ = err.value(py).setattr("parameter", format!("{p:?}"));
+                }
                 err
             }
             Fail::Shape(m) => ShapeError::new_err(m),

@@ -51,7 +51,7 @@ ONE = np.array([[1.0]])
          "the damping is not classical (it couples the modes): use the full stepper",
          lambda: aemstep.linear_response(np.eye(2), [[1.0, 0.0], [0.0, 0.0]], [[2.0, -1.0], [-1.0, 1.0]],
                                          0.01, p=np.zeros((3, 2)), scheme="modal")),
-        (aemstep.InvalidParameter, "a scheme parameter is not finite or out of range",
+        (aemstep.InvalidParameter, "invalid parameter: HHT alpha must be in [-1/3, 0]",
          lambda: aemstep.linear_response(ONE, ONE, ONE, 0.01, p=np.zeros((3, 1)), scheme="hht", alpha=0.5)),
         (aemstep.NonFiniteState, "the step would make the state NaN or infinite; state unchanged",
          lambda: aemstep.linear_response(1e-3 * ONE, ONE, ONE, 0.01, p=np.array([[0.0], [1e308], [1e308]]))),
@@ -65,6 +65,15 @@ def test_variants_raised_with_their_display(exc, message, call):
         call()
     assert str(info.value) == message
     assert type(info.value).__name__ == exc.__name__
+
+
+def test_an_invalid_parameter_names_it():
+    with pytest.raises(aemstep.InvalidParameter) as info:
+        aemstep.linear_response(ONE, ONE, ONE, 0.01, p=np.zeros((3, 1)), scheme="hht", alpha=0.5)
+    assert info.value.parameter == "HhtAlpha"
+    with pytest.raises(aemstep.InvalidMaterial) as info:
+        aemstep.shear_building([1e5], [[0.0]], 0.01, np.zeros(10), k=1e8, fy=-1.0)
+    assert info.value.parameter == "YieldForce"
 
 
 def test_a_failed_step_says_which():

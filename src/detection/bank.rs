@@ -4,7 +4,7 @@ use nalgebra::SVector;
 
 use super::{Whitener, Window};
 use crate::observer::{Estimate, Observer};
-use crate::{Error, Real, StepState};
+use crate::{Error, Param, Real, StepState};
 
 /// `ln 2π`.
 const LN_2PI: f64 = 1.837_877_066_409_345_5;
@@ -71,7 +71,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const M: usize>
         whiteners: [Whitener<T, O>; M],
     ) -> Result<Self, Error> {
         if M == 0 {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::BankSize));
         }
         Ok(Self {
             observers,

@@ -1,7 +1,7 @@
 //! Page's CUSUM on the normalized innovations squared, for an increase of their covariance.
 
 use super::quantile::ln;
-use crate::Error;
+use crate::{Error, Param};
 
 /// Page's CUSUM test for a change of the innovations' covariance from `S` to `λS`
 /// (`λ > 1`), on the normalized innovations squared `q_n = νᵀ S⁻¹ ν` of `O` measurements
@@ -62,8 +62,14 @@ impl Cusum {
     /// Errors: [`Error::InvalidParameter`] (`outputs = 0`, `lambda` not finite or `≤ 1`,
     /// `alpha` NaN or outside `(0, 1)`). Cost: two logarithms.
     pub const fn new(outputs: usize, lambda: f64, alpha: f64) -> Result<Self, Error> {
-        if outputs == 0 || !(lambda > 1.0 && lambda.is_finite()) || !(alpha > 0.0 && alpha < 1.0) {
-            return Err(Error::InvalidParameter);
+        if outputs == 0 {
+            return Err(Error::InvalidParameter(Param::Outputs));
+        }
+        if !(lambda > 1.0 && lambda.is_finite()) {
+            return Err(Error::InvalidParameter(Param::CusumDrift));
+        }
+        if !(alpha > 0.0 && alpha < 1.0) {
+            return Err(Error::InvalidParameter(Param::FalseAlarm));
         }
         Ok(Self {
             slope: 0.5 * (1.0 - 1.0 / lambda),

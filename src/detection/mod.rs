@@ -80,7 +80,7 @@ use crate::linalg::cholesky::{cholesky, lower_solve};
 use crate::linalg::{Mat, add_scaled, all_finite, finite_as, identity, mul, round_rows, transpose};
 use crate::observer::{Measurement, SteadyState};
 use crate::scalar::sealed::Sealed;
-use crate::{Error, Real};
+use crate::{Error, Param, Real};
 
 /// Fractional bits of the fixed-point terms of a [`Window`]: a term `q` is held as the
 /// integer nearest `q·2²⁴` (a quantum of `6·10⁻⁸`, the rounding of `f32` at 1).
@@ -130,7 +130,7 @@ const fn whitener_parts<const O: usize>(
     max: f64,
 ) -> Result<(Mat<O, O>, f64), Error> {
     if O == 0 {
-        return Err(Error::InvalidParameter);
+        return Err(Error::InvalidParameter(Param::Outputs));
     }
     if !all_finite(s) || !crate::linalg::is_symmetric(s, 64.0 * f64::EPSILON) {
         return Err(Error::InvalidCovariance);
@@ -369,14 +369,20 @@ impl<const W: usize> ChiSquareTest<W> {
     /// `(0, 1)`, or a threshold of `2⁴⁰/W` or more, where [`Window`] caps its terms:
     /// `W·O` beyond about `10⁶`). Cost: a few hundred flops.
     pub const fn new(outputs: usize, alpha: f64) -> Result<Self, Error> {
-        if W == 0 || outputs == 0 || !(alpha > 0.0 && alpha < 1.0) {
-            return Err(Error::InvalidParameter);
+        if W == 0 {
+            return Err(Error::InvalidParameter(Param::Window));
+        }
+        if outputs == 0 {
+            return Err(Error::InvalidParameter(Param::Outputs));
+        }
+        if !(alpha > 0.0 && alpha < 1.0) {
+            return Err(Error::InvalidParameter(Param::FalseAlarm));
         }
         let dof = (W as u64).saturating_mul(outputs as u64);
         let threshold = chi_square_quantile(dof, alpha);
         let cap = (u64::MAX / W as u64) as f64 / NIS_SCALE;
         if !(threshold.is_finite() && threshold < cap) {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::Threshold));
         }
         Ok(Self {
             dof,

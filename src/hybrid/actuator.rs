@@ -2,7 +2,7 @@
 //! hybrid loop on the host and on the device.
 
 use crate::kinematics::check_time_step_as;
-use crate::{Error, Real};
+use crate::{Error, Param, Real};
 
 /// An emulated servo-hydraulic actuator for one degree of freedom: the displacement it
 /// reaches at sample `n` is its command delayed by `τ` and passed through a first-order
@@ -70,13 +70,16 @@ impl<T: Real, const L: usize> Actuator<T, L> {
     /// longer than the line holds). Cost: one `exp`.
     pub fn new(h: f64, delay: f64, lag: f64) -> Result<Self, Error> {
         let h = check_time_step_as(h, T::MAX)?;
-        if !(delay.is_finite() && delay >= 0.0 && lag.is_finite() && lag >= 0.0) {
-            return Err(Error::InvalidParameter);
+        if !(delay.is_finite() && delay >= 0.0) {
+            return Err(Error::InvalidParameter(Param::Delay));
+        }
+        if !(lag.is_finite() && lag >= 0.0) {
+            return Err(Error::InvalidParameter(Param::Lag));
         }
         let samples = delay / h;
         // `samples` is finite (delay finite, h > 0): no NaN to let through.
         if samples > L as f64 - 2.0 {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::DelayLine));
         }
         // `samples` ≤ L − 2: the cast is exact and in range.
         let whole = samples as usize;

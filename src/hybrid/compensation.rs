@@ -2,7 +2,7 @@
 //! adaptive compensator that estimates the delay from the measured response.
 
 use crate::kinematics::check_time_step_as;
-use crate::{Error, Real};
+use crate::{Error, Param, Real};
 
 /// What sits between the model's target displacement and the actuator: one call a sample.
 ///
@@ -135,14 +135,14 @@ pub struct Polynomial<T> {
 /// Check `order`, `h`, `delay` and compute the weights in `f64` (`const fn`).
 const fn polynomial_weights(order: usize, h: f64, delay: f64, max: f64) -> Result<[f64; 4], Error> {
     if order < 1 || order > 3 {
-        return Err(Error::InvalidParameter);
+        return Err(Error::InvalidParameter(Param::CompensationOrder));
     }
     let h = match check_time_step_as(h, max) {
         Ok(h) => h,
         Err(e) => return Err(e),
     };
     if !(delay.is_finite() && delay >= 0.0) {
-        return Err(Error::InvalidParameter);
+        return Err(Error::InvalidParameter(Param::Delay));
     }
     let w = weights_f64(order, delay / h);
     if !crate::linalg::all_fit(&w, max) {
@@ -281,7 +281,7 @@ impl<T: Real> Adaptive<T> {
     /// `h ≥ T_c = 0.5 s`). Cost: O(1).
     pub fn new(order: usize, h: f64, initial_delay: f64, max_delay: f64) -> Result<Self, Error> {
         if !(1..=3).contains(&order) {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::CompensationOrder));
         }
         let h = check_time_step_as(h, T::MAX)?;
         if h >= TIME_CONSTANT {
@@ -292,7 +292,7 @@ impl<T: Real> Adaptive<T> {
             && initial_delay >= 0.0
             && initial_delay <= max_delay)
         {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::Delay));
         }
         let mu = h / TIME_CONSTANT;
         if !crate::linalg::all_fit(&[1.0 / h, max_delay / h], T::MAX) {

@@ -1,6 +1,6 @@
 //! Bilinear elastic–plastic law with linear kinematic hardening, by return mapping.
 
-use super::{Law, LawTrial, fits, positive, unit_ratio};
+use super::{Law, LawTrial, check_elastic_plastic, fits};
 use crate::{Error, Real};
 
 /// Bilinear hysteresis with linear kinematic hardening: elastic stiffness `k`, yield force
@@ -52,9 +52,7 @@ impl<T: Real> Bilinear<T> {
     /// finite; [`Error::OperatorOverflow`] if a coefficient does not fit `T` (e.g.
     /// `k > f32::MAX` in `f32`). Cost: O(1).
     pub fn new(k: f64, fy: f64, alpha: f64) -> Result<Self, Error> {
-        if !(positive(k) && positive(fy) && unit_ratio(alpha)) {
-            return Err(Error::InvalidMaterial);
-        }
+        check_elastic_plastic(k, fy, alpha)?;
         let c = [
             k,
             fy,

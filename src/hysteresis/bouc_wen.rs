@@ -3,8 +3,8 @@
 
 use nalgebra::ComplexField;
 
-use super::{Law, LawTrial, fits, positive, unit_ratio};
-use crate::{Error, Real};
+use super::{Law, LawTrial, check_elastic_plastic, fits, positive};
+use crate::{Error, Param, Real};
 
 /// Iterations allowed for the internal variable of one trial: Newton, with bisection steps
 /// where it leaves its bracket or crawls, and every other iteration from [`FREE_NEWTON`]
@@ -113,16 +113,14 @@ impl<T: Real> BoucWen<T> {
     /// hysteretic force the law can produce, `(1 − α) f_y 2^{1/n} z_max` (for `β + γ > 0`),
     /// does not (e.g. `f_y = f64::MAX`, `β = 1`, `γ = 1/2`, `n = 1`: `1.33 f_y`). Cost: O(1).
     pub fn new(k: f64, fy: f64, alpha: f64, beta: f64, gamma: f64, n: f64) -> Result<Self, Error> {
-        if !(positive(k)
-            && positive(fy)
-            && unit_ratio(alpha)
-            && positive(beta)
+        check_elastic_plastic(k, fy, alpha)?;
+        if !(positive(beta)
             && gamma.is_finite()
             && gamma.abs() <= beta
             && n.is_finite()
             && n >= 1.0)
         {
-            return Err(Error::InvalidMaterial);
+            return Err(Error::InvalidMaterial(Param::BoucWenShape));
         }
         // β + |γ| ≤ 2β may overflow f64: then halved (the ratios are the same, κ gains
         // the factor 2^{1/n}).

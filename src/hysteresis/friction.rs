@@ -1,7 +1,7 @@
 //! Coulomb friction regularized in the velocity.
 
 use super::{Law, LawTrial, fits, positive};
-use crate::{Error, Real};
+use crate::{Error, Param, Real};
 
 /// A friction device: Coulomb friction of slip force `f_s`, regularized in the velocity,
 ///
@@ -34,8 +34,11 @@ impl<T: Real> Friction<T> {
     /// Errors: [`Error::InvalidMaterial`]; [`Error::OperatorOverflow`] if a coefficient
     /// does not fit `T`. Cost: O(1).
     pub fn new(fs: f64, vr: f64) -> Result<Self, Error> {
-        if !(positive(fs) && positive(vr)) {
-            return Err(Error::InvalidMaterial);
+        if !positive(fs) {
+            return Err(Error::InvalidMaterial(Param::FrictionForce));
+        }
+        if !positive(vr) {
+            return Err(Error::InvalidMaterial(Param::ReferenceVelocity));
         }
         // `f_s / v_r` too: the trial's damping `(f_s / v_r)(1 − tanh²)` was `∞ · 0 = NaN`
         // with `v_r = 1.25e-308` (found by fuzzing).

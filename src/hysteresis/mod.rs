@@ -182,6 +182,25 @@ pub(crate) fn unit_ratio(x: f64) -> bool {
     x.is_finite() && (0.0..1.0).contains(&x)
 }
 
+/// The elastic–plastic parameters every law with a yield point shares: stiffness `k` and
+/// yield force `fy` finite and `> 0`, post-yield ratio `alpha` in `[0, 1)`.
+///
+/// Errors: [`Error::InvalidMaterial`](crate::Error::InvalidMaterial) naming the first
+/// parameter out of range.
+pub(crate) fn check_elastic_plastic(k: f64, fy: f64, alpha: f64) -> Result<(), crate::Error> {
+    use crate::{Error, Param};
+    if !positive(k) {
+        return Err(Error::InvalidMaterial(Param::Stiffness));
+    }
+    if !positive(fy) {
+        return Err(Error::InvalidMaterial(Param::YieldForce));
+    }
+    if !unit_ratio(alpha) {
+        return Err(Error::InvalidMaterial(Param::PostYieldRatio));
+    }
+    Ok(())
+}
+
 /// Every coefficient of a law or model, computed in `f64`, fits `T` (finite and at most
 /// `T::MAX` in size): else it would round to `∞` (found by fuzzing: `Bilinear::<f32>` with
 /// `k = 1.6e293` had an infinite stiffness).

@@ -30,7 +30,7 @@ use crate::linalg::lu::{Lu, condition};
 use crate::linalg::{
     Mat, add_scaled, all_finite, finite_as, first_error, fits, round_rows, rows_f64, scaled,
 };
-use crate::{Error, Real, State, Stepper};
+use crate::{Error, Param, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -54,7 +54,7 @@ impl AlphaParameters {
     pub const fn chung_hulbert(rho_inf: f64) -> Result<Self, Error> {
         // Written as comparisons (`contains` is not `const`); NaN fails both.
         if !(rho_inf >= 0.0 && rho_inf <= 1.0) {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::RhoInf));
         }
         let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
         let alpha_f = rho_inf / (rho_inf + 1.0);
@@ -74,7 +74,7 @@ impl AlphaParameters {
     /// (usable in a `static`); cost O(1).
     pub const fn hht(alpha: f64) -> Result<Self, Error> {
         if !(alpha >= -1.0 / 3.0 && alpha <= 0.0) {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::HhtAlpha));
         }
         Ok(Self {
             alpha_m: 0.0,
@@ -141,7 +141,7 @@ pub(crate) const fn alpha_operators<const N: usize>(
         Err(e) => return Err(e),
     };
     if !(finite && alpha_m < 1.0 && alpha_f < 1.0 && beta >= 0.0 && gamma >= 0.0) {
-        return Err(Error::InvalidParameter);
+        return Err(Error::InvalidParameter(Param::AlphaParameters));
     }
     let hf = kin.h;
     let f1 = 1.0 - alpha_f;

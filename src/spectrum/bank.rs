@@ -3,7 +3,7 @@
 use super::operators::{self, SdofOps};
 use super::{MAX_SUBSTEPS, Scheme, Substeps};
 use crate::linalg::{all_fit, fits_value};
-use crate::{Error, Real};
+use crate::{Error, Param, Real};
 use core::f64::consts::TAU;
 
 /// A bank of `P` damped single-degree-of-freedom oscillators (the response-spectrum
@@ -157,10 +157,10 @@ pub(super) const fn build_f64<const P: usize>(
     if let Substeps::Fixed(n) = rule
         && (n == 0 || n > MAX_SUBSTEPS)
     {
-        return Err(Error::InvalidParameter);
+        return Err(Error::InvalidParameter(Param::Substeps));
     }
     if let Substeps::PointsPerPeriod(0) = rule {
-        return Err(Error::InvalidParameter);
+        return Err(Error::InvalidParameter(Param::Substeps));
     }
     let zero = SdofOps {
         uu: 0.0,

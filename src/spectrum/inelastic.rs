@@ -87,7 +87,7 @@
 use super::bank::substeps_for;
 use super::{MAX_SUBSTEPS, Substeps};
 use crate::linalg::all_fit;
-use crate::{Error, Real};
+use crate::{Error, Param, Real};
 use core::f64::consts::TAU;
 
 /// A bank of `P` yielding single-degree-of-freedom oscillators (bilinear, kinematic
@@ -153,8 +153,10 @@ const fn coeffs<const P: usize>(
         return Err(Error::InvalidTimeStep);
     }
     match rule {
-        Substeps::Fixed(n) if n == 0 || n > MAX_SUBSTEPS => return Err(Error::InvalidParameter),
-        Substeps::PointsPerPeriod(0) => return Err(Error::InvalidParameter),
+        Substeps::Fixed(n) if n == 0 || n > MAX_SUBSTEPS => {
+            return Err(Error::InvalidParameter(Param::Substeps));
+        }
+        Substeps::PointsPerPeriod(0) => return Err(Error::InvalidParameter(Param::Substeps)),
         _ => {}
     }
     let mut out = Coeffs {
@@ -200,7 +202,7 @@ const fn coeffs<const P: usize>(
         p += 1;
     }
     if !(alpha.is_finite() && alpha >= 0.0 && alpha < 1.0) {
-        return Err(Error::InvalidMaterial);
+        return Err(Error::InvalidMaterial(Param::PostYieldRatio));
     }
     if !fits {
         return Err(Error::OperatorOverflow);
@@ -439,7 +441,7 @@ impl<T: Real, const P: usize> Yielding<T, P> {
             uy[p] = a * self.inv_w2[p];
             // `!(x > 0)` is true for NaN too
             if !(a > zero && lim[p] > zero && uy[p] > zero) {
-                return Err(Error::InvalidMaterial);
+                return Err(Error::InvalidMaterial(Param::YieldForce));
             }
         }
         Ok(YieldResponse {
@@ -611,14 +613,14 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     ) -> Result<ConstantStrength<T, P>, Error> {
         let zero = T::from_f64_rounded(0.0);
         if reduction.iter().any(|&x| !(super::finite(x) && x > zero)) {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::StrengthReduction));
         }
         let elastic = self.elastic_strength(record);
         let mut ay = elastic;
         for p in 0..P {
             ay[p] /= reduction[p];
             if !(elastic[p] > zero && super::finite(elastic[p])) {
-                return Err(Error::InvalidParameter);
+                return Err(Error::InvalidParameter(Param::ElasticStrength));
             }
         }
         let r = self.response(record, &ay)?;
@@ -674,13 +676,16 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     ) -> Result<ConstantDuctility<T, P>, Error> {
         let eps = T::default_epsilon().as_f64();
         let mu_t = target.as_f64();
-        if !(mu_t.is_finite() && mu_t > 1.0 && search.valid() && search.tol >= 4.0 * eps) {
-            return Err(Error::InvalidParameter);
+        if !(mu_t.is_finite() && mu_t > 1.0) {
+            return Err(Error::InvalidParameter(Param::TargetDuctility));
+        }
+        if !(search.valid() && search.tol >= 4.0 * eps) {
+            return Err(Error::InvalidParameter(Param::Search));
         }
         let elastic = self.elastic_strength(record);
         let zero = T::from_f64_rounded(0.0);
         if elastic.iter().any(|&x| !(x > zero && super::finite(x))) {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::ElasticStrength));
         }
         let a0 = elastic.map(|x| x.as_f64());
         let ratio = libm_pow(search.lowest, 1.0 / (search.points - 1) as f64);

@@ -524,7 +524,7 @@ pub(super) fn twins(t: &str, h: f64, name: &str, e64: Option<Error>, e32: Option
         Some(
             Error::NonFiniteInput
                 | Error::InvalidTimeStep
-                | Error::InvalidParameter
+                | Error::InvalidParameter(_)
                 | Error::InvalidModeSelection
         )
     );

@@ -12,7 +12,7 @@ use aemstep::detection::{
 };
 use aemstep::nalgebra::{SMatrix, SVector};
 use aemstep::observer::{Kalman, Measurement, Observer, StateSpace, SteadyState};
-use aemstep::{Error, Real, StepState};
+use aemstep::{Error, Param, Real, StepState};
 
 use super::common::*;
 use super::estimation::debug_finite;
@@ -126,9 +126,10 @@ fn sized<const O: usize, const W: usize>(b: &mut Bytes) {
     cusum(outputs, lambda, a1, &qs);
     let window = window::<W>(&qs);
     check!(
-        err(&ChiSquareTest::<0>::new(1, 0.5)) == Some(Error::InvalidParameter)
-            && err(&Whitener::<f64, 0>::new(&[])) == Some(Error::InvalidParameter)
-            && err(&ModelBank::<f64, 2, 1, O, 0>::new([], [])) == Some(Error::InvalidParameter),
+        err(&ChiSquareTest::<0>::new(1, 0.5)) == Some(Error::InvalidParameter(Param::Window))
+            && err(&Whitener::<f64, 0>::new(&[])) == Some(Error::InvalidParameter(Param::Outputs))
+            && err(&ModelBank::<f64, 2, 1, O, 0>::new([], []))
+                == Some(Error::InvalidParameter(Param::BankSize)),
         "{DE}: W = 0, O = 0 or M = 0 accepted"
     );
 
@@ -240,13 +241,18 @@ fn chi_square_test<const W: usize>(outputs: u64, alpha: f64) -> Option<ChiSquare
     outcome(DE, &t);
     if o == 0 || !(alpha > 0.0 && alpha < 1.0) {
         check!(
-            err(&t) == Some(Error::InvalidParameter),
+            err(&t)
+                == Some(Error::InvalidParameter(if o == 0 {
+                    Param::Outputs
+                } else {
+                    Param::FalseAlarm
+                })),
             "{DE}: ChiSquareTest::new({o}, {alpha:e}) gave {:?}",
             err(&t)
         );
     } else {
         check!(
-            err(&t).is_none() || err(&t) == Some(Error::InvalidParameter),
+            err(&t).is_none() || err(&t) == Some(Error::InvalidParameter(Param::Threshold)),
             "{DE}: ChiSquareTest::new gave {:?}",
             err(&t)
         );
@@ -270,9 +276,18 @@ fn cusum(outputs: u64, lambda: f64, alpha: f64, qs: &[f64]) {
     let o = usize::try_from(outputs).unwrap_or(usize::MAX);
     let c = Cusum::new(o, lambda, alpha);
     outcome(DE, &c);
-    let bad = o == 0 || !(lambda > 1.0 && lambda.is_finite()) || !(alpha > 0.0 && alpha < 1.0);
+    let which = if o == 0 {
+        Some(Param::Outputs)
+    } else if !(lambda > 1.0 && lambda.is_finite()) {
+        Some(Param::CusumDrift)
+    } else if !(alpha > 0.0 && alpha < 1.0) {
+        Some(Param::FalseAlarm)
+    } else {
+        None
+    };
+    let bad = which.is_some();
     check!(
-        bad == (err(&c) == Some(Error::InvalidParameter)) && (bad || c.is_ok()),
+        err(&c) == which.map(Error::InvalidParameter) && (bad || c.is_ok()),
         "{DE}: Cusum::new({o}, {lambda:e}, {alpha:e}) gave {:?}",
         err(&c)
     );

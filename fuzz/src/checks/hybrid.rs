@@ -19,7 +19,7 @@
 
 use aemstep::hybrid::{Actuator, Adaptive, Compensator, Polynomial, Split, SplitState};
 use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::{Error, KrAlpha, Real, Stepper};
+use aemstep::{Error, KrAlpha, Param, Real, Stepper};
 
 use super::common::*;
 
@@ -160,7 +160,11 @@ fn delay_typed<T: Real>(d: &DelayInputs) {
         );
     } else if !(delay_ok && lag_ok) {
         check!(
-            act == Err(Error::InvalidParameter),
+            act == Err(Error::InvalidParameter(if delay_ok {
+                Param::Lag
+            } else {
+                Param::Delay
+            })),
             "Actuator: bad delay or lag gave {act:?}"
         );
     }
@@ -205,7 +209,7 @@ fn delay_typed<T: Real>(d: &DelayInputs) {
     outcome(HYB, &poly);
     if !(1..=3).contains(&d.order) {
         check!(
-            poly == Err(Error::InvalidParameter),
+            poly == Err(Error::InvalidParameter(Param::CompensationOrder)),
             "Polynomial: order {} gave {poly:?}",
             d.order
         );
@@ -216,7 +220,7 @@ fn delay_typed<T: Real>(d: &DelayInputs) {
         );
     } else if !delay_ok {
         check!(
-            poly == Err(Error::InvalidParameter),
+            poly == Err(Error::InvalidParameter(Param::Delay)),
             "Polynomial: bad delay gave {poly:?}"
         );
     }
@@ -233,7 +237,7 @@ fn delay_typed<T: Real>(d: &DelayInputs) {
     outcome(HYB, &adaptive);
     if !(1..=3).contains(&d.order) {
         check!(
-            adaptive == Err(Error::InvalidParameter),
+            adaptive == Err(Error::InvalidParameter(Param::CompensationOrder)),
             "Adaptive: order {} gave {adaptive:?}",
             d.order
         );
@@ -350,7 +354,7 @@ fn hybrid_typed<T: Real, const N: usize>(d: &HybridInputs<N>) {
             let early = matches!(
                 e_kr,
                 Some(
-                    Error::InvalidParameter
+                    Error::InvalidParameter(_)
                         | Error::NonFiniteInput
                         | Error::InvalidTimeStep
                         | Error::SingularMass
@@ -387,7 +391,7 @@ fn expect_rule<X>(name: &str, r: &Result<X, Error>, bad_rho: bool, want: Option<
     if bad_rho {
         let got = r.as_ref().err().copied();
         check!(
-            got == Some(Error::InvalidParameter),
+            got == Some(Error::InvalidParameter(Param::RhoInf)),
             "{HYB}: {name} with ρ∞ out of [0, 1] gave {got:?}"
         );
     } else {

@@ -188,7 +188,7 @@ fn law_rule<X>(name: &str, r: &Result<X, Error>, in_range: bool) {
     let ok = if in_range {
         e.is_none() || e == Some(Error::OperatorOverflow)
     } else {
-        e == Some(Error::InvalidMaterial)
+        matches!(e, Some(Error::InvalidMaterial(_)))
     };
     check!(
         ok,

@@ -9,7 +9,7 @@ use std::fmt::Debug;
 use aemstep::nalgebra::{SMatrix, SVector};
 use aemstep::{
     AlphaParameters, CompensatedLinear, Error, Exact, GeneralizedAlpha, Linear, LinearInput,
-    Newmark, Real,
+    Newmark, Param, Real,
 };
 
 use super::common::*;
@@ -209,7 +209,7 @@ fn linear_rest<T: Real, const N: usize>(
         expect_data(LIN, "Newmark::new", &nm, want);
     } else if want != Some(Error::NonFiniteInput) {
         check!(
-            nm.as_ref().err() == Some(&Error::InvalidParameter),
+            nm.as_ref().err() == Some(&Error::InvalidParameter(Param::NewmarkBetaGamma)),
             "{LIN}: Newmark β = {}, γ = {}: {:?}",
             d.beta,
             d.gamma,
@@ -248,16 +248,16 @@ fn linear_rest<T: Real, const N: usize>(
     let alpha_ok = (-1.0 / 3.0..=0.0).contains(&d.alpha);
     let ga = GeneralizedAlpha::<T, N>::new(m, c, k, h, d.rho);
     let hht = GeneralizedAlpha::<T, N>::hht(m, c, k, h, d.alpha);
-    for (name, r, ok) in [
-        ("GeneralizedAlpha::new", ga, rho_ok),
-        ("GeneralizedAlpha::hht", hht, alpha_ok),
+    for (name, r, ok, which) in [
+        ("GeneralizedAlpha::new", ga, rho_ok, Param::RhoInf),
+        ("GeneralizedAlpha::hht", hht, alpha_ok, Param::HhtAlpha),
     ] {
         outcome(LIN, &r);
         if ok {
             expect_data(LIN, name, &r, want);
         } else {
             check!(
-                r.as_ref().err() == Some(&Error::InvalidParameter),
+                r.as_ref().err() == Some(&Error::InvalidParameter(which)),
                 "{LIN}: {name} with a parameter out of range: {:?}",
                 r.as_ref().err()
             );

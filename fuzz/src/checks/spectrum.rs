@@ -11,7 +11,7 @@ use std::fmt::Debug;
 
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
 use aemstep::spectrum::{Bank, Response, RotD, RotDResponse, Scheme, Substeps};
-use aemstep::{Error, Real};
+use aemstep::{Error, Param, Real};
 
 use super::common::*;
 
@@ -124,7 +124,7 @@ where
     } else if matches!(sub, Substeps::Fixed(0) | Substeps::PointsPerPeriod(0))
         || matches!(sub, Substeps::Fixed(n) if n > aemstep::spectrum::MAX_SUBSTEPS)
     {
-        Some(Error::InvalidParameter)
+        Some(Error::InvalidParameter(Param::Substeps))
     } else {
         (0..3).find_map(|p| {
             let t = period[p];
@@ -328,7 +328,7 @@ fn inelastic_typed<T: Real>(
             "{SP}: Yielding::with gave {got:?} where Bank::with gave {e:?}"
         ),
         _ if !alpha_ok => check!(
-            got == Some(Error::InvalidMaterial) || got == bank_err,
+            got == Some(Error::InvalidMaterial(Param::PostYieldRatio)) || got == bank_err,
             "{SP}: Yielding::with with α = {} gave {got:?}",
             y.alpha
         ),
@@ -344,7 +344,7 @@ fn inelastic_typed<T: Real>(
     let bad_strength = ay.iter().any(|&a| !(a > T::zero()));
     if bad_strength {
         check!(
-            rest == Err(Error::InvalidMaterial),
+            rest == Err(Error::InvalidMaterial(Param::YieldForce)),
             "{SP}: Yielding::at_rest with strengths {ay:?} gave {:?}",
             rest.as_ref().err()
         );
@@ -384,13 +384,13 @@ fn inelastic_typed<T: Real>(
     outcome(SP, &cs);
     if let Err(e) = cs {
         check!(
-            matches!(e, Error::InvalidParameter | Error::InvalidMaterial),
+            matches!(e, Error::InvalidParameter(_) | Error::InvalidMaterial(_)),
             "{SP}: constant_strength gave {e:?}"
         );
     }
     if reduction.iter().any(|&x| !(x > T::zero() && x.is_finite())) {
         check!(
-            cs.as_ref().err() == Some(&Error::InvalidParameter),
+            cs.as_ref().err() == Some(&Error::InvalidParameter(Param::StrengthReduction)),
             "{SP}: constant_strength with R = {reduction:?} gave {:?}",
             cs.as_ref().err()
         );
@@ -399,7 +399,7 @@ fn inelastic_typed<T: Real>(
     outcome(SP, &cd);
     match cd {
         Err(e) => check!(
-            matches!(e, Error::InvalidParameter | Error::InvalidMaterial),
+            matches!(e, Error::InvalidParameter(_) | Error::InvalidMaterial(_)),
             "{SP}: constant_ductility gave {e:?}"
         ),
         Ok(c) => {
@@ -425,7 +425,12 @@ fn inelastic_typed<T: Real>(
 /// overflows `f32`); the iterator ends after its first error.
 fn records_checks(text: &str) {
     use aemstep::records;
-    let typed = |e: &Error| matches!(e, Error::MalformedRecord { .. } | Error::InvalidParameter);
+    let typed = |e: &Error| {
+        matches!(
+            e,
+            Error::MalformedRecord { .. } | Error::InvalidParameter(_)
+        )
+    };
     let values = |it: records::Values<'_>| {
         let mut out = Vec::new();
         let mut it = it;
@@ -496,7 +501,8 @@ fn records_checks(text: &str) {
         );
         if !v.is_empty() {
             check!(
-                records::column_into(text, &mut buf[..v.len() - 1]) == Err(Error::InvalidParameter),
+                records::column_into(text, &mut buf[..v.len() - 1])
+                    == Err(Error::InvalidParameter(Param::OutputBuffer)),
                 "records: a short buffer is not InvalidParameter"
             );
         }
@@ -588,7 +594,7 @@ fn ida_checks(b: &mut Bytes) {
         && (1..=10_000).contains(&settings.runs)
         && settings.collapse.edp > 0.0;
     match curve {
-        Err(Error::InvalidParameter) => {
+        Err(Error::InvalidParameter(_)) => {
             check!(
                 calls.get() == 0,
                 "ida: {} runs before InvalidParameter",
@@ -633,7 +639,10 @@ fn ida_checks(b: &mut Bytes) {
                     f.len() == 2 && f.iter().all(|r| r.len() == 2),
                     "ida: fractile shape"
                 ),
-                Err(e) => check!(e == Error::InvalidParameter, "ida: fractiles {e:?}"),
+                Err(e) => check!(
+                    e == Error::InvalidParameter(Param::Fractiles),
+                    "ida: fractiles {e:?}"
+                ),
             }
             count(SP, "ida: curves traced");
         }
