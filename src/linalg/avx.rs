@@ -17,22 +17,20 @@
 //! and the OS to have enabled the SSE and AVX register state in `XCR0` — the conditions
 //! under which the Intel and AMD manuals define AVX instructions to execute. `XGETBV`
 //! itself is read only once CPUID reports OSXSAVE (its own precondition), and CPUID (an
-//! `unsafe` intrinsic on the MSRV) exists on every x86-64 CPU. These blocks (the query, the
-//! two guarded calls: [`column_blocks`] and [`run`], the spectrum bank's step) are the
-//! crate's only `unsafe`. A build that already targets AVX
+//! `unsafe` intrinsic on the MSRV) exists on every x86-64 CPU. These blocks (the query and
+//! the one guarded call in [`run`], through which the column-blocked product and the
+//! spectrum bank's step go) are the crate's only `unsafe`. A build that already targets AVX
 //! (`-C target-cpu=native`, `-C target-feature=+avx`) compiles the plain loop with AVX
 //! and never takes this path.
 //!
 //! Cost: one relaxed atomic load and a branch a step (the CPUID query runs once per
-//! process); [`column_blocks`] takes it only for operators of at least [`MIN_BYTES`] bytes,
-//! below which the call does not pay for itself. [`run`] (the spectrum bank, about 100 ns a
+//! process); the column-blocked product (`op_rows`) takes it only for operators of at
+//! least [`MIN_BYTES`] bytes, below which the call does not pay for itself. [`run`] (the spectrum bank, about 100 ns a
 //! sample at `P = 100`) halves `Bank<f64, 100>`'s step (`docs/spectrum.md`).
 
 #![allow(unsafe_code)]
 
 use core::sync::atomic::{AtomicU8, Ordering};
-
-use crate::Real;
 
 /// Operators of fewer bytes (`K·N²` values) stay on the inlined SSE2 loop: there a step is
 /// a few tens of nanoseconds and the call's overhead is a fair share of it. Measured with
@@ -91,36 +89,6 @@ fn __cpuid(leaf: u32) -> core::arch::x86_64::CpuidResult {
     }
 }
 
-/// `out = ops · x` by the column-blocked loop (`op_rows::column_blocks`), on AVX
-/// registers when [`available`], else on SSE2. Same bits either way.
-#[inline(always)]
-pub(crate) fn column_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
-    ops: &[[[T; N]; K]; N],
-    from: usize,
-    x: &[[T; N]; K],
-    out: &mut [T],
-) {
-    if PLAIN_ONLY || K * N * N * core::mem::size_of::<T>() < MIN_BYTES || !available() {
-        super::op_rows::column_blocks::<T, N, K, W>(ops, from, x, out);
-    } else {
-        // SAFETY: `available()` is true: the CPU reports AVX and the OS saves its
-        // registers (module docs), the precondition of `column_blocks_avx`.
-        unsafe { column_blocks_avx::<T, N, K, W>(ops, from, x, out) }
-    }
-}
-
-/// The column-blocked loop compiled with AVX enabled (its body is the same inlined loop).
-#[target_feature(enable = "avx")]
-#[inline(never)]
-fn column_blocks_avx<T: Real, const N: usize, const K: usize, const W: usize>(
-    ops: &[[[T; N]; K]; N],
-    from: usize,
-    x: &[[T; N]; K],
-    out: &mut [T],
-) {
-    super::op_rows::column_blocks::<T, N, K, W>(ops, from, x, out);
-}
-
 /// Run `f` (a closure whose body is inlined loops over independent lanes, e.g. the
 /// spectrum bank's per-sample step over its oscillators) compiled with AVX enabled when
 /// [`available`], else as is. Same bits either way, for the reasons in the module docs:
@@ -149,56 +117,9 @@ fn run_avx<R>(f: impl FnOnce() -> R) -> R {
 mod tests {
     use super::*;
 
-    /// The AVX and SSE2 paths give the same bits, for operator sizes above the dispatch
-    /// threshold, both block widths, first blocks of every kind, and the product of
-    /// every block or all but the first.
-    fn same_bits<T: Real, const N: usize, const K: usize, const W: usize>() {
-        let mut ops = [[[T::zero(); N]; K]; N];
-        let mut x = [[T::zero(); N]; K];
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64 ^ (N * 131 + K) as u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            // Values of mixed sign and magnitude, so every rounding matters.
-            let m = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
-            T::from_f64_rounded(m * 2f64.powi((seed % 40) as i32 - 20))
-        };
-        for v in ops.iter_mut().flatten().flatten() {
-            *v = next();
-        }
-        for v in x.iter_mut().flatten() {
-            *v = next();
-        }
-        for from in [0, 1] {
-            let (mut plain, mut wide) = ([T::zero(); N], [T::zero(); N]);
-            super::super::op_rows::column_blocks::<T, N, K, W>(&ops, from, &x, &mut plain);
-            column_blocks::<T, N, K, W>(&ops, from, &x, &mut wide);
-            for (p, w) in plain.iter().zip(&wide) {
-                assert_eq!(
-                    p.as_f64().to_bits(),
-                    w.as_f64().to_bits(),
-                    "N = {N}, K = {K}, from block {from}"
-                );
-            }
-        }
-    }
-
     /// The CPUID/XCR0 query agrees with the standard library's detection.
     #[test]
     fn detection_agrees_with_std() {
         assert_eq!(available(), std::is_x86_feature_detected!("avx"));
-    }
-
-    #[test]
-    fn avx_path_is_bit_identical() {
-        // Where the CPU has no AVX both calls run the SSE2 loop (and still must agree).
-        same_bits::<f64, 16, 3, 16>();
-        same_bits::<f64, 37, 3, 16>();
-        same_bits::<f64, 100, 3, 16>();
-        same_bits::<f64, 100, 4, 16>();
-        same_bits::<f32, 50, 3, 32>();
-        same_bits::<f32, 100, 3, 32>();
-        same_bits::<f32, 100, 2, 32>();
     }
 }

@@ -159,8 +159,10 @@ impl<T: Real, const N: usize, const K: usize> OpRows<T, N, K> {
     }
 }
 
-/// The column-blocked product: on x86-64 through the run-time AVX choice
-/// ([`super::avx`]), elsewhere (never reached: no other target is column-blocked) plain.
+/// The column-blocked product: on x86-64, operators of at least
+/// [`MIN_BYTES`](super::avx::MIN_BYTES) through the run-time AVX choice ([`super::wide`]:
+/// same bits), smaller ones on the inlined SSE2 loop, where the call would cost a fair
+/// share of the step; elsewhere (never reached: no other target is column-blocked) plain.
 #[inline(always)]
 fn wide_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
     ops: &[[[T; N]; K]; N],
@@ -169,8 +171,9 @@ fn wide_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
     out: &mut [T],
 ) {
     #[cfg(target_arch = "x86_64")]
-    super::avx::column_blocks::<T, N, K, W>(ops, from, x, out);
-    #[cfg(not(target_arch = "x86_64"))]
+    if K * N * N * core::mem::size_of::<T>() >= super::avx::MIN_BYTES {
+        return super::wide(|| column_blocks::<T, N, K, W>(ops, from, x, out));
+    }
     column_blocks::<T, N, K, W>(ops, from, x, out);
 }
 
@@ -293,7 +296,7 @@ fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::{column_blocks, flat_index, layout, row_pairs};
+    use super::{column_blocks, flat_index, layout, row_pairs, wide_blocks};
     use crate::Real;
 
     /// Row `i` of `rows[.., from..] · x[from..]` as one serial chain, first product first:
@@ -381,5 +384,52 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The AVX and SSE2 paths (`wide_blocks` against the plain loop) give the same bits, for operator sizes above the dispatch
+    /// threshold, both block widths, first blocks of every kind, and the product of
+    /// every block or all but the first.
+    fn same_bits<T: Real, const N: usize, const K: usize, const W: usize>() {
+        let mut ops = [[[T::zero(); N]; K]; N];
+        let mut x = [[T::zero(); N]; K];
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64 ^ (N * 131 + K) as u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            // Values of mixed sign and magnitude, so every rounding matters.
+            let m = (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            T::from_f64_rounded(m * 2f64.powi((seed % 40) as i32 - 20))
+        };
+        for v in ops.iter_mut().flatten().flatten() {
+            *v = next();
+        }
+        for v in x.iter_mut().flatten() {
+            *v = next();
+        }
+        for from in [0, 1] {
+            let (mut plain, mut wide) = ([T::zero(); N], [T::zero(); N]);
+            column_blocks::<T, N, K, W>(&ops, from, &x, &mut plain);
+            wide_blocks::<T, N, K, W>(&ops, from, &x, &mut wide);
+            for (p, w) in plain.iter().zip(&wide) {
+                assert_eq!(
+                    p.as_f64().to_bits(),
+                    w.as_f64().to_bits(),
+                    "N = {N}, K = {K}, from block {from}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn avx_path_is_bit_identical() {
+        // Where the CPU has no AVX both calls run the SSE2 loop (and still must agree).
+        same_bits::<f64, 16, 3, 16>();
+        same_bits::<f64, 37, 3, 16>();
+        same_bits::<f64, 100, 3, 16>();
+        same_bits::<f64, 100, 4, 16>();
+        same_bits::<f32, 50, 3, 32>();
+        same_bits::<f32, 100, 3, 32>();
+        same_bits::<f32, 100, 2, 32>();
     }
 }

@@ -33,6 +33,7 @@ use crate::hysteresis::{HistoryModel, Trial};
 use crate::kinematics::{AemKinematics, Kinematics, check_time_step_as};
 use crate::linalg::lu::{solve_in_place, solve_in_place_scaled};
 use crate::linalg::tridiagonal;
+pub use crate::linalg::tridiagonal::SymTridiagonal;
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State};
 
@@ -43,62 +44,6 @@ pub struct Tangent<T, const N: usize> {
     pub stiffness: SMatrix<T, N, N>,
     /// Tangent damping `∂F/∂v` (force per velocity), `N×N`.
     pub damping: SMatrix<T, N, N>,
-}
-
-/// A symmetric tridiagonal `N×N` matrix: the stiffness, damping or mass of a chain of
-/// degrees of freedom (a shear building, masses and springs in series).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SymTridiagonal<T, const N: usize> {
-    /// The diagonal, `A_ii`.
-    pub diagonal: SVector<T, N>,
-    /// The off-diagonal: `off[i] = A_{i,i−1} = A_{i−1,i}` for `i ≥ 1`; `off[0]` is not
-    /// read (keep it zero).
-    pub off: SVector<T, N>,
-}
-
-impl<T: Real, const N: usize> SymTridiagonal<T, N> {
-    /// `A x`, each row summed in column order (`A_{i,i−1} x_{i−1} + A_ii x_i +
-    /// A_{i,i+1} x_{i+1}`): the same value as the dense product, whose other terms are
-    /// exact zeros. Cost: `3N` multiplies, `2N` adds.
-    pub fn mul(&self, x: &SVector<T, N>) -> SVector<T, N> {
-        let (d, e, x) = (&self.diagonal.data.0[0], &self.off.data.0[0], &x.data.0[0]);
-        let mut y = [T::zero(); N];
-        for i in 0..N {
-            let mut s = T::zero();
-            if i > 0 {
-                s = e[i] * x[i - 1];
-            }
-            s += d[i] * x[i];
-            if i + 1 < N {
-                s += e[i + 1] * x[i + 1];
-            }
-            y[i] = s;
-        }
-        SVector::from(y)
-    }
-
-    /// The same matrix laid out densely (`N×N`, zero off the three diagonals). Cost: `N²`.
-    pub fn to_matrix(&self) -> SMatrix<T, N, N> {
-        SMatrix::from_fn(|row, col| match row.abs_diff(col) {
-            0 => self.diagonal[row],
-            1 => self.off[row.max(col)],
-            _ => T::zero(),
-        })
-    }
-
-    /// The zero matrix.
-    pub(crate) fn zero() -> Self {
-        Self {
-            diagonal: SVector::zeros(),
-            off: SVector::zeros(),
-        }
-    }
-
-    /// Every entry read (the diagonal and `off[1..]`) is finite. Cost: `2N`.
-    fn is_finite(&self) -> bool {
-        self.diagonal.iter().all(|x| x.is_finite())
-            && self.off.iter().skip(1).all(|x| x.is_finite())
-    }
 }
 
 /// The mass and the tangent of a model whose `M`, `∂F/∂u` and `∂F/∂v` are all symmetric
