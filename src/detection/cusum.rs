@@ -34,11 +34,21 @@ pub struct Cusum<T> {
 
 /// The state of a [`Cusum`]: the statistic `g ≥ 0` and the skipped samples. Plain data;
 /// `const` at rest (`CusumState::at_rest_f32`/`at_rest_f64`, equal to `Default`).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct CusumState<T> {
     g: T,
     skipped: u64,
+}
+
+/// At rest: as `CusumState::at_rest_f32`/`at_rest_f64`, for any `T`.
+impl<T: Real> Default for CusumState<T> {
+    fn default() -> Self {
+        Self {
+            g: T::zero(),
+            skipped: 0,
+        }
+    }
 }
 
 macro_rules! cusum_state_const {

@@ -323,9 +323,11 @@ fn cusum<T: Real>(outputs: u64, lambda: f64, alpha: f64, qs: &[f64]) {
         let (g, skipped) = (s.statistic(), s.skipped());
         let alarm = c.update(&mut s, q);
         count(DE, "cusum updates");
-        if q.is_nan() {
+        if q.as_f64().is_nan() {
             check!(
-                !alarm && s.skipped() == skipped + 1 && s.statistic().to_bits() == g.to_bits(),
+                !alarm
+                    && s.skipped() == skipped + 1
+                    && s.statistic().as_f64().to_bits() == g.as_f64().to_bits(),
                 "{DE}: Cusum: a NaN sample not skipped"
             );
         } else {
