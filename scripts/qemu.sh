@@ -263,6 +263,22 @@ $ind"
     echo "ok: $ex: ${#roots[@]} step function(s), $(wc -l <<<"$fns") functions reachable, none panics, no indirect branch"
 done
 
+step "qemu: the f32 detector's step links no soft-double routine (qemu_estimator)"
+# `qemu_estimator_step` steps the f32 joint estimator and its χ² detector and reads the
+# window's sum as a handler logs it (`Window::sum`, f32): nothing reachable from it may be a
+# double-precision routine (`__aeabi_d*`, a conversion to double `__aeabi_*2d`,
+# compiler-builtins' `__*df3`/`__extendsfdf2`). Control: the same walk from `main`, which
+# steps the f64 reference estimator in soft float, must find them.
+SOFT_DOUBLE='__aeabi_d|__aeabi_[a-z0-9]+2d$|df[0-9]$|sfdf'
+control=$(reachable "$OUT/qemu_estimator-qemu" main)
+grep -E "$SOFT_DOUBLE" <<<"$control" >/dev/null ||
+    fail "control: the call-graph walk from qemu_estimator's main found no soft-double routine"
+fns=$(reachable "$OUT/qemu_estimator-qemu" qemu_estimator_step cost_step_detector)
+if grep -E "$SOFT_DOUBLE" <<<"$fns"; then
+    fail "qemu_estimator: the f32 detector's step reaches a soft-double routine (above)"
+fi
+echo "ok: qemu_estimator: $(wc -l <<<"$fns") functions reachable from the f32 detector's step, no soft-double routine (main reaches $(grep -cE "$SOFT_DOUBLE" <<<"$control"))"
+
 step "qemu: host and Cortex-M4F f32 runs are bit-identical (Example 2, u at 25 s)"
 host_bits=$(cargo test -q --release --test firmware_example2 -- --nocapture --exact \
     f32_error_within_the_firmware_bound 2>&1 | sed -n 's/^host u(25 s) f32 bits = //p')

@@ -73,6 +73,29 @@
 //!   On a type with one scalar (`f64`), a variant ends in its kind:
 //!   [`observer::StateSpace::from_rows_aem`], `from_rows_newmark`,
 //!   `from_rows_generalized_alpha`, `from_rows_modal`; [`observer::SteadyState::from_parts`].
+//!   The `const` twin of a run-time `new` that takes neither rows nor parts is
+//!   `new_<scalar>`: [`spectrum::Bank::new_f32`], [`detection::ChiSquareTest::new_f32`],
+//!   [`detection::Cusum::new_f64`]. A `const fn` that is generic over `T` (one impl,
+//!   nothing of `T` to compute) carries no suffix: [`detection::Detector::from_parts`],
+//!   [`detection::ModelBank::from_parts`] (both take `const`-built parts),
+//!   [`detection::Whitener::from_rows_f32`] takes rows.
+//! - **A state at rest** (`const fn`, so a state can live in a `static`, e.g. a
+//!   `static Mutex<RefCell<State<f32, 4>>>`): `at_rest_f32` / `at_rest_f64` where it holds
+//!   values of `T` ([`State::at_rest_f32`], `JointEstimate`, `Estimate`, `SplitState`, the
+//!   actuator's, compensator's, CUSUM's and model bank's states, the hysteretic laws'
+//!   histories), `at_rest` where it holds none ([`detection::Window::at_rest`]). Each
+//!   equals the type's `Default` (the spelling generic code uses) and the start from rest
+//!   of what steps it. A stepper's own start (`Observer::start_at_rest`,
+//!   [`spectrum::Bank::at_rest`]) is a method of the stepper. Time-varying filters that
+//!   carry a covariance (`Kalman`, the input–state and dual Kalman filters) start at run
+//!   time only.
+//! - **Statistics take their degrees of freedom from a type**:
+//!   [`detection::ChiSquareTest::new`] and [`detection::Cusum::new`] take the estimator
+//!   ([`detection::Innovations`]: `O` for an observer, `O − I` for the joint input–state
+//!   estimator), or [`detection::Dof`] for a stated count — never a bare number.
+//! - Stated exceptions: [`estimation::InputStateGains::solve`] and
+//!   [`estimation::DualGains::solve`] (`const fn`) are named for what they do — solve the
+//!   gains' Riccati equations, in `f64` — and build data, not a stepper.
 //! - [`State::restore`] rebuilds a saved state (checked finite); it is not a `const`
 //!   constructor.
 //! - **The time step** is `time_step` everywhere: [`Stepper::time_step`], an inherent

@@ -2,6 +2,7 @@
 
 use nalgebra::SVector;
 
+use crate::observer::Estimate;
 use crate::{Error, Real, StepState};
 
 /// The state at step `n`: displacement `u`, velocity `v`, acceleration `a` (the paper's
@@ -121,6 +122,86 @@ impl<T: Real, const N: usize> State<T, N> {
         true
     }
 }
+
+/// The zero vector of `f32`, in `const` (`SVector::zeros` is not a `const fn`).
+pub(crate) const fn zeros_f32<const N: usize>() -> SVector<f32, N> {
+    SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; N]; 1]))
+}
+
+/// The zero vector of `f64`, in `const`.
+pub(crate) const fn zeros_f64<const N: usize>() -> SVector<f64, N> {
+    SVector::from_array_storage(nalgebra::ArrayStorage([[0.0; N]; 1]))
+}
+
+/// At rest: as `State::at_rest_f32`/`at_rest_f64`, for any `T`.
+impl<T: Real, const N: usize> Default for State<T, N> {
+    fn default() -> Self {
+        Self::unchecked(SVector::zeros(), SVector::zeros(), SVector::zeros(), 0)
+    }
+}
+
+macro_rules! state_at_rest {
+    ($t:ident, $at_rest:ident, $zeros:ident) => {
+        impl<const N: usize> State<$t, N> {
+            /// At rest at step 0: `u = v = a = 0`. `const fn`, so a state can live in a
+            /// `static` (e.g. `static S: Mutex<RefCell<State<f32, 4>>>`) with no run-time
+            /// start; equal to `State::default()` and to a stepper's start at rest
+            /// with no load. Cost: none in a `static`, `3N` stores otherwise.
+            ///
+            /// ```
+            /// use aemstep::State;
+            #[doc = concat!("static S: State<", stringify!($t), ", 4> = State::", stringify!($at_rest), "();")]
+            /// assert_eq!(S, State::default());
+            /// assert_eq!(S.steps(), 0);
+            /// ```
+            pub const fn $at_rest() -> Self {
+                Self {
+                    u: $zeros(),
+                    v: $zeros(),
+                    a: $zeros(),
+                    n: 0,
+                }
+            }
+        }
+    };
+}
+state_at_rest!(f32, at_rest_f32, zeros_f32);
+state_at_rest!(f64, at_rest_f64, zeros_f64);
+
+// The observer's estimate at rest (its fields are the crate's; kept beside `State`'s).
+
+/// At rest: as `Estimate::at_rest_f32`/`at_rest_f64`, for any `T`.
+impl<T: Real, const S: usize, const I: usize> Default for Estimate<T, S, I> {
+    fn default() -> Self {
+        Estimate {
+            x: SVector::zeros(),
+            w: SVector::zeros(),
+            n: 0,
+            missing: 0,
+        }
+    }
+}
+
+macro_rules! estimate_at_rest {
+    ($t:ident, $at_rest:ident, $zeros:ident) => {
+        impl<const S: usize, const I: usize> Estimate<$t, S, I> {
+            /// At rest with no input (`x̂_0 = 0`, `w_0 = 0`, step 0): `const fn`, for a
+            /// `static`; equal to `Estimate::default()` and to
+            /// [`Observer::start_at_rest`](crate::observer::Observer::start_at_rest) with
+            /// `w0 = 0`. Cost: none in a `static`.
+            pub const fn $at_rest() -> Self {
+                Estimate {
+                    x: $zeros(),
+                    w: $zeros(),
+                    n: 0,
+                    missing: 0,
+                }
+            }
+        }
+    };
+}
+estimate_at_rest!(f32, at_rest_f32, zeros_f32);
+estimate_at_rest!(f64, at_rest_f64, zeros_f64);
 
 #[cfg(feature = "defmt")]
 impl<T: Real + defmt::Format, const N: usize> defmt::Format for State<T, N> {

@@ -1165,7 +1165,7 @@ fn zero_dynamics_not_finite_is_operator_overflow() {
 /// an alarm; a NaN innovation stays NaN (missing).
 #[test]
 fn nis_of_finite_innovation_overflowing_is_infinite() {
-    use aemstep::detection::{ChiSquareTest, Detector, Whitener, Window};
+    use aemstep::detection::{ChiSquareTest, Detector, Dof, Whitener, Window};
     let s = [[1.0, 0.99], [0.99, 1.0]];
     let w64 = Whitener::<f64, 2>::new(&s).unwrap();
     let nu = vector![f64::MAX / 2.0, f64::MAX / 2.0];
@@ -1176,8 +1176,8 @@ fn nis_of_finite_innovation_overflowing_is_infinite() {
         w32.nis(&vector![f32::MAX / 2.0, f32::MAX / 2.0]),
         f32::INFINITY
     );
-    let det = Detector::new(w64, ChiSquareTest::<1>::new(2, 1e-3).unwrap());
-    let mut win = Window::<1>::new();
+    let det = Detector::from_parts(w64, ChiSquareTest::<f64, 1>::new(&Dof::<2>, 1e-3).unwrap());
+    let mut win = Window::<f64, 1>::at_rest();
     assert!(
         det.update(&mut win, &nu),
         "an overflowing innovation is an alarm"

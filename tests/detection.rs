@@ -10,8 +10,8 @@
 #![allow(clippy::needless_range_loop)] // matrix and record indices read best explicitly
 
 use aemstep::detection::{
-    ChiSquareTest, Cusum, CusumState, Detector, ModelBank, NIS_FRACTION_BITS, Whitener, Window,
-    chi_square_quantile, innovation_covariance, normal_quantile,
+    ChiSquareTest, Cusum, CusumState, Detector, Dof, ModelBank, NIS_FRACTION_BITS, Whitener,
+    Window, chi_square_quantile, innovation_covariance, normal_quantile,
 };
 use aemstep::models::{self, base_excitation};
 use aemstep::observer::{Measurement, Observer, Outputs, StateSpace, SteadyState};
@@ -188,14 +188,14 @@ fn chi_square_quantile_against_tables_and_exact() {
 }
 
 /// The threshold of a `static` detector, computed by the compiler.
-static CONST_TEST: ChiSquareTest<50> = match ChiSquareTest::<50>::new(3, 1e-4) {
+static CONST_TEST: ChiSquareTest<f64, 50> = match ChiSquareTest::new_f64(&Dof::<3>, 1e-4) {
     Ok(t) => t,
     Err(e) => panic!("{}", e.as_str()),
 };
 
 #[test]
 fn const_threshold_is_the_run_time_one_and_bad_parameters_are_typed() {
-    let run = ChiSquareTest::<50>::new(3, 1e-4).unwrap();
+    let run = ChiSquareTest::<f64, 50>::new(&Dof::<3>, 1e-4).unwrap();
     assert_eq!(CONST_TEST, run);
     assert_eq!(run.dof(), 150);
     assert_eq!(
@@ -203,46 +203,50 @@ fn const_threshold_is_the_run_time_one_and_bad_parameters_are_typed() {
         chi_square_quantile(150, 1e-4).to_bits()
     );
     assert_eq!(
-        ChiSquareTest::<0>::new(3, 0.01),
+        ChiSquareTest::<f64, 0>::new(&Dof::<3>, 0.01),
         Err(Error::InvalidParameter(Param::Window))
     );
     assert_eq!(
-        ChiSquareTest::<10>::new(0, 0.01),
+        ChiSquareTest::<f64, 10>::new(&Dof::<0>, 0.01),
         Err(Error::InvalidParameter(Param::Outputs))
     );
     for a in [0.0, 1.0, -1e-3, 1.5, f64::NAN, f64::INFINITY] {
         assert_eq!(
-            ChiSquareTest::<10>::new(2, a),
+            ChiSquareTest::<f64, 10>::new(&Dof::<2>, a),
             Err(Error::InvalidParameter(Param::FalseAlarm)),
             "α = {a}"
         );
     }
     // A window so long that its threshold reaches the term cap (2⁴⁰/W).
     assert_eq!(
-        ChiSquareTest::<2_000_000>::new(1, 0.01),
+        ChiSquareTest::<f64, 2_000_000>::new(&Dof::<1>, 0.01),
         Err(Error::InvalidParameter(Param::Threshold))
     );
-    // CUSUM: λ ≤ 1 or not finite, α outside (0, 1), no outputs.
-    for (o, l, a, which) in [
-        (3, 1.0, 0.01, Param::CusumDrift),
-        (3, 0.5, 0.01, Param::CusumDrift),
-        (3, f64::INFINITY, 0.01, Param::CusumDrift),
-        (3, f64::NAN, 0.01, Param::CusumDrift),
-        (3, 2.0, 0.0, Param::FalseAlarm),
-        (3, 2.0, 1.0, Param::FalseAlarm),
-        (3, 2.0, f64::NAN, Param::FalseAlarm),
-        (0, 2.0, 0.01, Param::Outputs),
+    // CUSUM: λ ≤ 1 or not finite, α outside (0, 1), no degree of freedom.
+    for (l, a, which) in [
+        (1.0, 0.01, Param::CusumDrift),
+        (0.5, 0.01, Param::CusumDrift),
+        (f64::INFINITY, 0.01, Param::CusumDrift),
+        (f64::NAN, 0.01, Param::CusumDrift),
+        (2.0, 0.0, Param::FalseAlarm),
+        (2.0, 1.0, Param::FalseAlarm),
+        (2.0, f64::NAN, Param::FalseAlarm),
     ] {
         assert_eq!(
-            Cusum::new(o, l, a),
+            Cusum::<f64>::new(&Dof::<3>, l, a),
             Err(Error::InvalidParameter(which)),
-            "{o} {l} {a}"
+            "{l} {a}"
         );
     }
+    assert_eq!(
+        Cusum::<f64>::new(&Dof::<0>, 2.0, 0.01),
+        Err(Error::InvalidParameter(Param::Outputs))
+    );
     // Its increments are the log-likelihood ratio of N(0, λS) against N(0, S) (written
     // from the densities): q = 4, O = 2, λ = 2 → ½ (1 − ½) 4 − ln 2.
-    let c = Cusum::new(2, 2.0, 1e-3).unwrap();
-    let mut cs = CusumState::new();
+    let c = Cusum::new(&Dof::<2>, 2.0, 1e-3).unwrap();
+    assert_eq!(c, Cusum::new_f64(&Dof::<2>, 2.0, 1e-3).unwrap());
+    let mut cs = CusumState::default();
     assert!(!c.update(&mut cs, 4.0));
     assert!((cs.statistic() - (1.0 - 2f64.ln())).abs() <= 4.0 * f64::EPSILON);
     assert!((c.threshold() - 1e3f64.ln()).abs() <= 4.0 * f64::EPSILON * c.threshold());
@@ -294,7 +298,7 @@ fn window_sum_is_exact_after_a_long_run_and_skips_nan() {
     // A million pushes: the running sum is exactly the sum of the stored terms (integer
     // arithmetic), i.e. Σ round(q·2²⁴) of the last W values, recomputed here.
     const W: usize = 37;
-    let mut win = Window::<W>::new();
+    let mut win = Window::<f64, W>::at_rest();
     let mut g = Gauss::new(7);
     let mut last: Vec<f64> = Vec::new();
     let scale = (1u64 << NIS_FRACTION_BITS) as f64;
@@ -327,12 +331,12 @@ fn window_sum_is_exact_after_a_long_run_and_skips_nan() {
         (win.sum() - float).abs()
     );
     // +∞ is capped (an alarm, not a wrap-around).
-    let mut w2 = Window::<4>::new();
+    let mut w2 = Window::<f64, 4>::at_rest();
     for _ in 0..4 {
         w2.push(f64::INFINITY);
     }
     assert!(w2.sum() > 1e12 && w2.sum().is_finite());
-    let t = ChiSquareTest::<4>::new(1, 0.01).unwrap();
+    let t = ChiSquareTest::<f64, 4>::new(&Dof::<1>, 0.01).unwrap();
     assert!(t.alarm(&w2));
 }
 
@@ -356,7 +360,7 @@ fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
     let r = r_rows(sigma);
     let md = model([1.0; 5]);
     let (obs, wh, kf) = observer_of(&md, &r);
-    let det = Detector::<f64, 3, W>::new(wh, ChiSquareTest::new(3, ALPHA).unwrap());
+    let det = Detector::<f64, 3, W>::from_parts(wh, ChiSquareTest::new(&obs, ALPHA).unwrap());
     let truth = IntactTruth::new(&md, &kf);
     let ag = &elcentro::AG_F64;
     let (mut trials, mut alarms) = (0u64, 0u64);
@@ -365,14 +369,14 @@ fn false_alarm_rate_on_the_intact_building_is_the_one_set() {
     // The CUSUM beside it, tuned to a 50 % covariance increase, its false-alarm rate
     // bounded by 10⁻³ per sample (restarted after each alarm).
     const ALPHA_CUSUM: f64 = 1e-3;
-    let cusum = Cusum::new(3, 1.5, ALPHA_CUSUM).unwrap();
+    let cusum = Cusum::new(&obs, 1.5, ALPHA_CUSUM).unwrap();
     let mut cusum_alarms = 0u64;
     for seed in 0..SEEDS {
         let mut g = Gauss::new(1000 + seed);
         let mut x = truth.start(&mut g);
         let mut e = obs.start_at_rest(&SVector::from([ag[0]])).unwrap();
-        let mut win = Window::<W>::new();
-        let mut cs = CusumState::new();
+        let mut win = Window::<f64, W>::at_rest();
+        let mut cs = CusumState::default();
         for n in 1..ag.len() {
             let w1 = SVector::from([ag[n]]);
             let y = truth.step(&mut x, ag, n, &sigma, &mut g);
@@ -479,16 +483,17 @@ fn damage_run(seed: u64, verbose: bool, restart: bool) -> DamageRun {
         whs.push(w);
     }
     const ALPHA: f64 = 1e-6; // per evaluation: 0.18 false alarm-samples an hour at 50 Hz
-    let det = Detector::<f64, 3, W>::new(whs[0], ChiSquareTest::new(3, ALPHA).unwrap());
-    let bank = ModelBank::<f64, 10, 1, 3, HYPOTHESES>::new(
+    let det =
+        Detector::<f64, 3, W>::from_parts(whs[0], ChiSquareTest::new(&obs[0], ALPHA).unwrap());
+    let bank = ModelBank::<f64, 10, 1, 3, HYPOTHESES>::from_parts(
         core::array::from_fn(|m| obs[m]),
         core::array::from_fn(|m| whs[m]),
     )
     .unwrap();
-    let cusum = Cusum::new(3, 2.0, ALPHA).unwrap();
-    let mut cs = CusumState::new();
+    let cusum = Cusum::new(&obs[0], 2.0, ALPHA).unwrap();
+    let mut cs = CusumState::default();
     let (mut cusum_first, mut cusum_before) = (None, 0);
-    let mut win = Window::<W>::new();
+    let mut win = Window::<f64, W>::at_rest();
     let mut e = obs[0].start_at_rest(&SVector::from([ag[0]])).unwrap();
     let mut st = bank
         .start::<WB>(&SVector::zeros(), &SVector::from([ag[0]]))
@@ -652,7 +657,7 @@ fn missing_samples_are_skipped_and_a_failed_bank_step_changes_nothing() {
     let r = r_rows([0.2; 3]);
     let (o0, w0, _) = observer_of(&model([1.0; 5]), &r);
     let (o1, w1, _) = observer_of(&model(hypothesis(1)), &r);
-    let bank = ModelBank::<f64, 10, 1, 3, 2>::new([o0, o1], [w0, w1]).unwrap();
+    let bank = ModelBank::<f64, 10, 1, 3, 2>::from_parts([o0, o1], [w0, w1]).unwrap();
     let mut st = bank
         .start::<8>(&SVector::zeros(), &SVector::from([ag[0]]))
         .unwrap();
@@ -700,12 +705,12 @@ fn missing_samples_are_skipped_and_a_failed_bank_step_changes_nothing() {
     );
     assert_eq!(big, big_before);
     assert_eq!(
-        ModelBank::<f64, 10, 1, 3, 0>::new([], []),
+        ModelBank::<f64, 10, 1, 3, 0>::from_parts([], []),
         Err(Error::InvalidParameter(Param::BankSize))
     );
     // The detector skips a NaN innovation too.
-    let det = Detector::<f64, 3, 4>::new(w0, ChiSquareTest::new(3, 0.01).unwrap());
-    let mut win = Window::<4>::new();
+    let det = Detector::<f64, 3, 4>::from_parts(w0, ChiSquareTest::new(&o0, 0.01).unwrap());
+    let mut win = Window::<f64, 4>::at_rest();
     assert!(!det.update(&mut win, &SVector::from([f64::NAN, 0.0, 0.0])));
     assert_eq!((win.len(), win.skipped()), (0, 1));
 }
@@ -765,11 +770,11 @@ const KF: SteadyState<10, 3> = ok(SteadyState::from_parts(&SS, &MEAS, &Q_FW, &R_
 static OBS32: Observer<f32, 10, 1, 3> = ok(Observer::<f32, 10, 1, 3>::from_parts_f32(
     &SS, &MEAS, &KF.gain,
 ));
-static DET32: Detector<f32, 3, W> = Detector::new(
+static DET32: Detector<f32, 3, W> = Detector::from_parts(
     ok(Whitener::<f32, 3>::from_rows_f32(&ok(
         innovation_covariance(&KF, &MEAS, &R_FW),
     ))),
-    ok(ChiSquareTest::<W>::new(3, 1e-3)),
+    ok(ChiSquareTest::new_f32(&OBS32, 1e-3)),
 );
 
 #[test]
@@ -792,9 +797,9 @@ fn f32_detector_from_the_compiler_is_the_run_time_one_and_follows_f64() {
     // noisier than the detector assumes (so that it alarms often): the window sums and
     // the decisions.
     let obs64 = Observer::<f64, 10, 1, 3>::new(&SS, &MEAS, &kf.gain_matrix()).unwrap();
-    let det64 = Detector::<f64, 3, W>::new(
+    let det64 = Detector::<f64, 3, W>::from_parts(
         Whitener::new(&s).unwrap(),
-        ChiSquareTest::new(3, 1e-3).unwrap(),
+        ChiSquareTest::new(&obs64, 1e-3).unwrap(),
     );
     let ag = &elcentro::AG_F64;
     let (phi, g0, g1) = (SS.phi_matrix(), SS.gamma0_matrix(), SS.gamma1_matrix());
@@ -803,7 +808,7 @@ fn f32_detector_from_the_compiler_is_the_run_time_one_and_follows_f64() {
     let mut x = SVector::<f64, 10>::zeros();
     let mut e64 = obs64.start_at_rest(&SVector::from([ag[0]])).unwrap();
     let mut e32 = OBS32.start_at_rest(&SVector::from([ag[0] as f32])).unwrap();
-    let (mut w64, mut w32) = (Window::<W>::new(), Window::<W>::new());
+    let (mut w64, mut w32) = (Window::<f64, W>::at_rest(), Window::<f32, W>::at_rest());
     let (mut worst, mut disagree, mut alarms) = (0.0f64, 0, 0);
     for n in 1..ag.len() {
         let (a0, a1) = (SVector::from([ag[n - 1]]), SVector::from([ag[n]]));
@@ -815,7 +820,7 @@ fn f32_detector_from_the_compiler_is_the_run_time_one_and_follows_f64() {
         alarms += al64 as u32;
         disagree += (al64 != al32) as u32;
         if w64.is_full() {
-            worst = worst.max((w32.sum() - w64.sum()).abs() / w64.sum());
+            worst = worst.max((w32.sum() as f64 - w64.sum()).abs() / w64.sum());
         }
     }
     println!(
@@ -917,7 +922,7 @@ mod properties {
         ModelBank<f64, 10, 1, 3, 2>,
         [Whitener<f64, 3>; 2],
         Detector<f64, 3, WP>,
-        Cusum,
+        Cusum<f64>,
     );
 
     /// The intact building and storey 1 softer, built once (a Riccati solution each).
@@ -928,10 +933,10 @@ mod properties {
             let (o0, w0, _) = observer_of(&model([1.0; 5]), &r);
             let (o1, w1, _) = observer_of(&model(hypothesis(1)), &r);
             (
-                ModelBank::new([o0, o1], [w0, w1]).unwrap(),
+                ModelBank::from_parts([o0, o1], [w0, w1]).unwrap(),
                 [w0, w1],
-                Detector::new(w0, ChiSquareTest::new(3, 0.01).unwrap()),
-                Cusum::new(3, 2.0, 1e-3).unwrap(),
+                Detector::from_parts(w0, ChiSquareTest::new(&o0, 0.01).unwrap()),
+                Cusum::new(&o0, 2.0, 1e-3).unwrap(),
             )
         })
     }
@@ -1024,8 +1029,8 @@ mod properties {
         #[test]
         fn detector_and_cusum_skip_nan(nus in prop::collection::vec([entry(), entry(), entry()], 1..24)) {
             let (_, _, det, cusum) = parts();
-            let mut win = Window::<WP>::new();
-            let mut cs = CusumState::new();
+            let mut win = Window::<f64, WP>::at_rest();
+            let mut cs = CusumState::default();
             for nu in nus {
                 let nu = SVector::from(nu);
                 let q = det.whitener.nis(&nu);

@@ -10,8 +10,9 @@
 //! the input's directions), its whitened mean with `O − I`, its autocorrelation with zero.
 //! The residual itself is recomputed from the standard form's equations.
 
-use aemstep::detection::{ChiSquareTest, Detector, Whitener, Window};
-use aemstep::estimation::InputStateObserver;
+use aemstep::detection::{ChiSquareTest, Detector, Dof, Innovations, Whitener, Window};
+use aemstep::estimation::{InputModel, InputStateGains, InputStateObserver};
+use aemstep::observer::Outputs;
 use nalgebra::{SMatrix, SVector};
 
 #[path = "../scenes/detection/gauss.rs"]
@@ -23,6 +24,9 @@ mod unknown_load;
 use scene as estimator;
 
 use unknown_load::{DOF, Truth, damaged};
+
+#[path = "../scenes/detection/chi2.rs"]
+mod chi2;
 
 type V4 = SVector<f64, 4>;
 
@@ -110,8 +114,9 @@ fn the_residual_is_white_chi_square_with_o_minus_i_dof_whatever_the_force() {
     println!("largest lag-1..3 covariance {worst:.4} (≤ {band_lag:.4})");
     assert!(worst <= band_lag, "not white: {worst}");
     // The χ² test of O − I outputs over disjoint 1 s windows: false alarms at α.
-    let det = Detector::<f64, 4, 50>::new(wh, ChiSquareTest::<50>::new(DOF, scene::ALPHA).unwrap());
-    let mut win = Window::<50>::new();
+    let det = Detector::<f64, 4, 50>::from_parts(wh, ChiSquareTest::new(&f, scene::ALPHA).unwrap());
+    assert_eq!(det.test.dof(), 50 * DOF as u64);
+    let mut win = Window::<f64, 50>::at_rest();
     let (mut alarms, mut windows) = (0u32, 0u32);
     for (k, q) in qs.iter().enumerate() {
         win.push(*q);
@@ -134,13 +139,13 @@ fn a_storey_losing_stiffness_is_detected_with_the_load_unknown() {
     const START_UP: usize = 250;
     let f = observer();
     let wh = Whitener::<f64, 4>::new(&scene::GAINS.innovation_covariance).unwrap();
-    let det = Detector::<f64, 4, 250>::new(wh, ChiSquareTest::<250>::new(DOF, 1e-6).unwrap());
+    let det = Detector::<f64, 4, 250>::from_parts(wh, ChiSquareTest::new(&f, 1e-6).unwrap());
     let hurt = damaged(0.7);
     let mut delays = Vec::new();
     for seed in 0..6u64 {
         let mut truth = Truth::new(100 + seed);
         let mut e = f.start_at_rest();
-        let mut win = Window::<250>::new();
+        let mut win = Window::<f64, 250>::at_rest();
         let mut first = None;
         for n in 1..=3000usize {
             if n == DAMAGE_AT + 1 {
@@ -171,9 +176,9 @@ fn a_storey_losing_stiffness_is_detected_with_the_load_unknown() {
 fn a_missing_sample_gives_a_non_finite_residual_and_is_skipped() {
     let f = observer();
     let wh = Whitener::<f64, 4>::new(&scene::GAINS.innovation_covariance).unwrap();
-    let det = Detector::<f64, 4, 50>::new(wh, ChiSquareTest::<50>::new(DOF, 1e-3).unwrap());
+    let det = Detector::<f64, 4, 50>::from_parts(wh, ChiSquareTest::new(&f, 1e-3).unwrap());
     let mut e = f.start_at_rest();
-    let mut win = Window::<50>::new();
+    let mut win = Window::<f64, 50>::at_rest();
     let y = V4::new(0.1, f64::NAN, 0.2, 1e-4);
     let before = *e.input();
     let nu = f.step_innovation(&mut e, &y);
@@ -198,11 +203,11 @@ fn a_missing_sample_gives_a_non_finite_residual_and_is_skipped() {
 /// `f32` values in `[½, 1)` scale to a tie (`x.5`), so random terms test the rounding.
 #[test]
 fn the_f32_detectors_terms_are_the_f64_windows_terms() {
-    let det = Detector::<f32, 1, 7>::new(
+    let det = Detector::<f32, 1, 7>::from_parts(
         Whitener::<f32, 1>::new(&[[1.0]]).unwrap(),
-        ChiSquareTest::<7>::new(1, 1e-3).unwrap(),
+        ChiSquareTest::new(&Dof::<1>, 1e-3).unwrap(),
     );
-    let (mut a, mut b) = (Window::<7>::new(), Window::<7>::new());
+    let (mut a, mut b) = (Window::<f32, 7>::at_rest(), Window::<f64, 7>::at_rest());
     let mut g = gauss::Gauss::new(5);
     let mut specials = vec![0.0f32, -0.0, 1e-30, 2.9e-8, 3.0e-8, 0.5, 0.70710677, 1.0];
     specials.extend([
@@ -239,4 +244,71 @@ fn the_f32_detectors_terms_are_the_f64_windows_terms() {
         n += 1;
     }
     assert_eq!(n, 400_000);
+}
+
+/// Issue 31, "statistics not tied to types": three accelerometers, one unknown force, a
+/// 100-sample window, α = 10⁻⁶. The joint estimator's residual carries `O − I = 2`
+/// degrees of freedom a sample, so the window's sum is `χ²₂₀₀` and the threshold its upper
+/// 10⁻⁶ quantile, about 310; `ChiSquareTest::new(outputs, α)` had to be told `O − I`, and
+/// given `O = 3` it took `χ²₃₀₀`'s quantile, about 431, and the detector never alarmed.
+/// Now the test takes the number from the estimator's type.
+#[test]
+fn chi_square_threshold_takes_o_minus_i_from_the_joint_estimator() {
+    // The estimator scene's building and roof force, three of its sensors: the floor-1 and
+    // roof accelerometers and the roof displacement (the accelerometers alone leave the
+    // force's static part unidentifiable).
+    let sensors = scene::SENSORS;
+    let pick = [0, 2, 3];
+    let three = Outputs::<5, 1, 3> {
+        u: pick.map(|i| sensors.u[i]),
+        v: pick.map(|i| sensors.v[i]),
+        a: pick.map(|i| sensors.a[i]),
+        w: pick.map(|i| sensors.w[i]),
+    };
+    let meas = scene::SS.outputs(&three).unwrap();
+    let model = InputModel::from_parts(&scene::SS, &meas).unwrap();
+    let r = [[9e-4, 0.0, 0.0], [0.0, 9e-4, 0.0], [0.0, 0.0, 1e-10]];
+    let gains = InputStateGains::solve(&model, &scene::Q, &r).unwrap();
+    let est = InputStateObserver::<f32, 10, 1, 3>::new(&model, &gains).unwrap();
+    assert_eq!(<InputStateObserver<f32, 10, 1, 3> as Innovations>::DOF, 2);
+
+    const ALPHA: f64 = 1e-6;
+    let run = ChiSquareTest::<f64, 100>::new(&est, ALPHA).unwrap();
+    let at_compile = ChiSquareTest::<f64, 100>::new_f64(&est, ALPHA).unwrap();
+    assert_eq!(run, at_compile);
+    assert_eq!(run.dof(), 200);
+    // The exact quantiles of χ²₂₀₀ and χ²₃₀₀, by bisection of the regularized incomplete
+    // gamma function (`scenes/detection/chi2.rs`, written from its series, not the crate's).
+    let exact = |k: u64| {
+        let (mut lo, mut hi) = (0.0f64, 2.0 * k as f64 + 200.0);
+        while hi - lo > 1e-12 * hi {
+            let mid = 0.5 * (lo + hi);
+            if chi2::chi2_upper_tail(k, mid) > ALPHA {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    };
+    let (x200, x300) = (exact(200), exact(300));
+    println!(
+        "α = 1e-6, W = 100: threshold {:.3} (exact χ²₂₀₀ quantile {x200:.3}; χ²₃₀₀'s, the \
+         wrong count, {x300:.3})",
+        run.threshold()
+    );
+    // Wilson–Hilferty's relative error is c(z)/k (Cornish–Fisher terms of order 1/k);
+    // `tests/detection.rs` bounds c(z) by 0.01 (1 + z²) on α ∈ [1e-5, 0.05]; here z = 4.75
+    // (α = 1e-6), the same form extrapolated: 0.01 · 23.6 / 200 = 1.2e-3.
+    let z = 4.753_424_308_822_899; // Φ⁻¹(1 − 10⁻⁶), from tables
+    let bound = 0.01 * (1.0 + z * z) / 200.0;
+    let rel = (run.threshold() - x200).abs() / x200;
+    assert!(rel <= bound, "relative error {rel:.2e} > {bound:.2e}");
+    assert!((x200 - 310.0).abs() < 1.0 && (x300 - 431.0).abs() < 1.0);
+    // The threshold the issue's wrong count gave is nowhere near.
+    assert!(run.threshold() < x300 - 100.0);
+    // The CUSUM takes the same count: offset ½ (O − I) ln λ.
+    let c = aemstep::detection::Cusum::<f64>::new(&est, 2.0, ALPHA).unwrap();
+    let c2 = aemstep::detection::Cusum::<f64>::new(&Dof::<2>, 2.0, ALPHA).unwrap();
+    assert_eq!(c, c2);
 }

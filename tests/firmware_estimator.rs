@@ -165,12 +165,12 @@ fn f32_run_within_the_firmware_bound() {
 /// with the floor-1 accelerometer's readings multiplied by `gain` (1: a sound sensor).
 fn detector_run<T: aemstep::Real>(gain: f64) -> (u32, u64) {
     let est = InputStateObserver::<T, 10, 1, 4>::new(&scene::MODEL, &scene::GAINS).unwrap();
-    let det = Detector::<T, 4, { scene::WINDOW }>::new(
+    let det = Detector::<T, 4, { scene::WINDOW }>::from_parts(
         Whitener::new(&scene::GAINS.innovation_covariance).unwrap(),
-        ChiSquareTest::new(scene::DOF, scene::ALPHA).unwrap(),
+        ChiSquareTest::new(&est, scene::ALPHA).unwrap(),
     );
     let mut e = est.start_at_rest();
-    let mut win = Window::<{ scene::WINDOW }>::new();
+    let mut win = Window::<T, { scene::WINDOW }>::at_rest();
     let mut truth = scene::Truth::new();
     let mut alarms = 0;
     for _ in 0..scene::STEPS {

@@ -3,8 +3,14 @@
 //! over `T: Real` (`Bank::new`/`with`, `RotD::new`) equal the `const` ones bit for bit and
 //! fail with the same errors; the inherent `const fn time_step` of a per-scalar stepper is
 //! the value generic code reads through `Stepper::time_step`; `State::restore` checks its
-//! parts and restores a state the stepper continues from bit for bit.
+//! parts and restores a state the stepper continues from bit for bit; the detection types
+//! follow the same rule (`new` generic, `new_f32`/`new_f64` its `const` twins,
+//! `from_parts`/`from_rows_*` for `const` builds from parts or rows, `at_rest*` for a
+//! state at rest).
 
+use aemstep::detection::{
+    BankState, ChiSquareTest, Cusum, CusumState, Detector, ModelBank, Whitener, Window,
+};
 use aemstep::hybrid::Split;
 use aemstep::models::{self, Rows, base_excitation};
 use aemstep::nalgebra::{SVector, vector};
@@ -79,6 +85,18 @@ static ROT32: RotD<f32, 180> = RotD::new_f32();
 static KR32: KrAlpha<f32, 5> = ok(KrAlpha::from_rows_f32(B.0, B.1, B.2, H, 0.8));
 static CR64: KrAlpha<f64, 5> = ok(KrAlpha::from_rows_chen_ricles_f64(B.0, B.1, B.2, H));
 static SPLIT32: Split<f32, 5> = ok(Split::from_rows_f32(B.0, B.1, B.2, B.2, H, 0.8));
+
+// Detection: typed statics, no turbofish, the degrees of freedom from the observer's type.
+const OBS32C: Observer<f32, 10, 1, 1> = ok(Observer::from_parts_f32(&SS, &MEAS, &[[0.0]; 10]));
+const WH32: Whitener<f32, 1> = ok(Whitener::from_rows_f32(&[[4.0e-6]]));
+static DET32: Detector<f32, 1, 50> =
+    Detector::from_parts(WH32, ok(ChiSquareTest::new_f32(&OBS32C, 1e-3)));
+static CUSUM64: Cusum<f64> = ok(Cusum::new_f64(&OBS32C, 2.0, 1e-3));
+static MODELS32: ModelBank<f32, 10, 1, 1, 2> = ok(ModelBank::from_parts([OBS32C; 2], [WH32; 2]));
+static WINDOW32: Window<f32, 50> = Window::at_rest();
+static CUSUM_STATE32: CusumState<f32> = CusumState::at_rest_f32();
+static BANK_STATE32: BankState<f32, 10, 1, 2, 50> = BankState::at_rest_f32();
+static STATE32: State<f32, 5> = State::at_rest_f32();
 
 // The inherent `const fn time_step` in a `const`.
 const H32: f32 = LIN32.time_step();
@@ -265,4 +283,39 @@ fn restore_checks_and_continues_bit_for_bit() {
     // f64::MAX is finite: restored as given.
     let m = vector![f64::MAX, -f64::MAX];
     assert_eq!(State::restore(m, m, m, 9).unwrap().u(), &m);
+}
+
+#[test]
+fn detection_constructors_follow_the_rule() {
+    // `new` (run time, generic over `T`) equals its `const` twin `new_<scalar>` bit for bit.
+    assert_eq!(
+        ChiSquareTest::<f32, 50>::new(&OBS32C, 1e-3).unwrap(),
+        DET32.test
+    );
+    assert_eq!(Cusum::<f64>::new(&OBS32C, 2.0, 1e-3).unwrap(), CUSUM64);
+    assert_eq!(Whitener::<f32, 1>::new(&[[4.0e-6]]).unwrap(), WH32);
+    // One measurement: 50 degrees of freedom in the window.
+    assert_eq!(DET32.test.dof(), 50);
+    // `from_parts` is `const` and generic (one impl): the same value at run time.
+    assert_eq!(
+        ModelBank::from_parts([OBS32C; 2], [WH32; 2]).unwrap(),
+        MODELS32
+    );
+    assert_eq!(Detector::from_parts(WH32, DET32.test), DET32);
+    // A state at rest: `at_rest` (holds no `T`) or `at_rest_<scalar>`, equal to `Default`
+    // and to the owner's start from rest.
+    assert_eq!(WINDOW32, Window::default());
+    assert_eq!(CUSUM_STATE32, CusumState::default());
+    assert_eq!(BANK_STATE32, BankState::default());
+    assert_eq!(
+        MODELS32
+            .start::<50>(&SVector::zeros(), &SVector::zeros())
+            .unwrap(),
+        BANK_STATE32
+    );
+    assert_eq!(STATE32, State::default());
+    assert_eq!(
+        OBS32.start_at_rest(&SVector::zeros()).unwrap(),
+        aemstep::observer::Estimate::at_rest_f32()
+    );
 }

@@ -91,26 +91,27 @@ static DRIFTS: Readout<f32, 10, 1, 5> =
 static DRIFTS_F64: Readout<f64, 10, 1, 5> =
     ok(Readout::<f64, 10, 1, 5>::from_parts_f64(&scene::DRIFT_OUT));
 
-/// The χ² detector on the estimator's residual: `R̃` factored by the compiler.
-static DETECTOR: Detector<f32, 4, { scene::WINDOW }> = Detector::new(
+/// The χ² detector on the estimator's residual: `R̃` factored by the compiler, the
+/// threshold's degrees of freedom (`O − I = 3` a sample) taken from the estimator's type.
+static DETECTOR: Detector<f32, 4, { scene::WINDOW }> = Detector::from_parts(
     ok(Whitener::<f32, 4>::from_rows_f32(
         &scene::GAINS.innovation_covariance,
     )),
-    ok(ChiSquareTest::<{ scene::WINDOW }>::new(
-        scene::DOF,
-        scene::ALPHA,
-    )),
+    ok(ChiSquareTest::new_f32(&ESTIMATOR, scene::ALPHA)),
 );
 
 /// One sample from the sensors: step index, the four readings.
 type Sample = (u32, [f32; 4]);
 /// One estimate: step index, the force (N), the five drifts (m), missing samples so far,
-/// detector alarms so far, the detector's window sum (fixed point).
-type Est = (u32, f32, [f32; 5], u32, u32, u64);
+/// detector alarms so far, the detector's window sum (fixed point), the window sum as the
+/// statistic is logged (`f32`: no double-precision routine in the handler).
+type Est = (u32, f32, [f32; 5], u32, u32, u64, f32);
 
 /// One real-time step: the estimator's step and its residual, the χ² test on the window,
-/// then the force and the drifts; the `bool` is an alarm. Out of line so its code size
-/// (symbol `qemu_estimator_step`) and stack can be measured alone.
+/// then the force and the drifts; the `bool` is an alarm, the last `f32` the window's sum
+/// (the statistic a handler logs, `Window::sum`, in `f32`). Out of line so its code size
+/// (symbol `qemu_estimator_step`) and stack can be measured alone, and its call graph
+/// checked for soft-double routines (`scripts/qemu.sh`).
 #[unsafe(no_mangle)]
 #[inline(never)]
 fn qemu_estimator_step(
@@ -118,13 +119,18 @@ fn qemu_estimator_step(
     det: &Detector<f32, 4, { scene::WINDOW }>,
     drifts: &Readout<f32, 10, 1, 5>,
     e: &mut JointEstimate<f32, 10, 1>,
-    win: &mut Window<{ scene::WINDOW }>,
+    win: &mut Window<f32, { scene::WINDOW }>,
     y: [f32; 4],
-) -> (f32, [f32; 5], bool) {
+) -> (f32, [f32; 5], bool, f32) {
     let nu = est.step_innovation(e, &SVector::from(y));
     let alarm = det.update(win, &nu);
     let w = *e.input();
-    (w[0], drifts.read(&est.state(e), &w).into(), alarm)
+    (
+        w[0],
+        drifts.read(&est.state(e), &w).into(),
+        alarm,
+        win.sum(),
+    )
 }
 
 /// The estimator's step with the detector (the second `COST` line).
@@ -134,7 +140,7 @@ fn cost_step_detector(
     est: &InputStateObserver<f32, 10, 1, 4>,
     det: &Detector<f32, 4, { scene::WINDOW }>,
     e: &mut JointEstimate<f32, 10, 1>,
-    win: &mut Window<{ scene::WINDOW }>,
+    win: &mut Window<f32, { scene::WINDOW }>,
     y: [f32; 4],
 ) -> bool {
     let nu = est.step_innovation(e, &SVector::from(y));
@@ -185,7 +191,7 @@ type Ctx = (
     Consumer<'static, Sample>,
     Producer<'static, Est>,
     JointEstimate<f32, 10, 1>,
-    (Window<{ scene::WINDOW }>, u32),
+    (Window<f32, { scene::WINDOW }>, u32),
 );
 static CTX: Mutex<RefCell<Option<Ctx>>> = Mutex::new(RefCell::new(None));
 
@@ -204,7 +210,7 @@ fn SysTick() {
     };
     // `black_box`: the statics' addresses as arguments, so the compiler keeps the one
     // step symbol the memory table measures instead of a copy specialized to them.
-    let (w, d, alarm) = qemu_estimator_step(
+    let (w, d, alarm, sum) = qemu_estimator_step(
         black_box(&ESTIMATOR),
         black_box(&DETECTOR),
         black_box(&DRIFTS),
@@ -216,7 +222,7 @@ fn SysTick() {
         *alarms += 1;
     }
     if tx
-        .enqueue((n, w, d, e.missing() as u32, *alarms, win.sum_fixed()))
+        .enqueue((n, w, d, e.missing() as u32, *alarms, win.sum_fixed(), sum))
         .is_err()
     {
         periodic::overrun();
@@ -254,7 +260,7 @@ fn main() -> ! {
     }
 
     let mut e = ESTIMATOR.start_at_rest();
-    let mut win = Window::new();
+    let mut win = Window::at_rest();
     let c = per_step(syst, 1000, |y| {
         black_box(cost_step_detector(
             black_box(&ESTIMATOR),
@@ -281,7 +287,7 @@ fn main() -> ! {
     let (mut sensor_tx, sensor_rx) = q_in.split();
     let (est_tx, mut est_rx) = q_out.split();
     let mut probe = ESTIMATOR.start_at_rest();
-    let mut probe_win = Window::new();
+    let mut probe_win = Window::at_rest();
     let step_stack = fw::stack_used_by(|| {
         black_box(qemu_estimator_step(
             black_box(&ESTIMATOR),
@@ -309,8 +315,8 @@ fn main() -> ! {
         CTX.borrow(cs).replace(Some((
             sensor_rx,
             est_tx,
-            ESTIMATOR.start_at_rest(),
-            (Window::new(), 0),
+            JointEstimate::at_rest_f32(),
+            (Window::at_rest(), 0),
         )))
     });
 
@@ -321,7 +327,7 @@ fn main() -> ! {
     let mut expected = 1;
     // Largest differences and f64 peaks: force (N), drifts (m).
     let (mut err_w, mut err_d, mut peak_w, mut peak_d) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    let mut last = (0u32, 0.0f32, [0.0f32; 5], 0u32, 0u32, 0u64);
+    let mut last = (0u32, 0.0f32, [0.0f32; 5], 0u32, 0u32, 0u64, 0.0f32);
     let mut last_w64 = 0.0f64;
 
     periodic::start(syst, scene::H);
@@ -337,7 +343,7 @@ fn main() -> ! {
         syst,
         &mut est_rx,
         feed,
-        |(n, w, d, missing, alarms, sum)| {
+        |(n, w, d, missing, alarms, sum, sum32)| {
             if n != expected {
                 fail!("estimate {} arrived, expected {}", n, expected);
             }
@@ -356,7 +362,7 @@ fn main() -> ! {
             err_d = err_d.max(ed);
             peak_w = peak_w.max(libm::fabs(w64));
             peak_d = peak_d.max(max_abs(&d64));
-            last = (n, w, d, missing, alarms, sum);
+            last = (n, w, d, missing, alarms, sum, sum32);
             last_w64 = w64;
             expected += 1;
             n == STEPS
@@ -404,6 +410,15 @@ fn main() -> ! {
     hprintln!("target roof force f32 bits = {:#010x}", last.1.to_bits());
     hprintln!("target roof force f64 bits = {:#018x}", last_w64.to_bits());
     hprintln!("target detector window sum fixed = {}", last.5);
+    // The logged statistic is the fixed-point sum rounded once to f32 (scaling by 2⁻²⁴ is
+    // exact).
+    if last.6 != last.5 as f32 * (1.0 / (1u32 << 24) as f32) {
+        fail!(
+            "the f32 window sum {} is not the fixed-point sum {} in f32",
+            last.6,
+            last.5
+        );
+    }
     hprintln!("MEM qemu_estimator step_stack_bytes {}", step_stack);
     fw::report_stack("qemu_estimator");
     fw::exit_success()

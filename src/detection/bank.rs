@@ -22,20 +22,65 @@ const LN_2PI: f64 = 1.837_877_066_409_345_5;
 /// ℓ_m = −½ Σ_window ν_mᵀ S_m⁻¹ ν_m − (n/2) ln det S_m − (n·O/2) ln 2π     (n samples held)
 /// ```
 ///
-/// and [`ModelBank::ranking`] orders the models by it, most likely first. Cost of a step:
-/// `M` observer steps and `M·O(O+1)/2` multiply-adds.
+/// and [`ModelBank::ranking`] orders the models by it, most likely first. Everything is in
+/// `T` (an `f32` bank computes no `f64`). Cost of a step: `M` observer steps and
+/// `M·O(O+1)/2` multiply-adds.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ModelBank<T, const S: usize, const I: usize, const O: usize, const M: usize> {
     observers: [Observer<T, S, I, O>; M],
     whiteners: [Whitener<T, O>; M],
 }
 
-/// The state of a [`ModelBank`]: each model's [`Estimate`] and [`Window`]. Plain data.
+/// The state of a [`ModelBank`]: each model's [`Estimate`] and [`Window`]. Plain data;
+/// `const` at rest (`BankState::at_rest_f32`/`at_rest_f64`: every estimate zero with zero
+/// input, every window empty; equal to `Default` and to [`ModelBank::start`] at rest).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BankState<T, const S: usize, const I: usize, const M: usize, const W: usize> {
     pub(super) estimates: [Estimate<T, S, I>; M],
-    windows: [Window<W>; M],
+    windows: [Window<T, W>; M],
 }
+
+/// At rest: as `BankState::at_rest_f32`/`at_rest_f64`.
+impl<T: Real, const S: usize, const I: usize, const M: usize, const W: usize> Default
+    for BankState<T, S, I, M, W>
+{
+    fn default() -> Self {
+        Self {
+            estimates: [Estimate {
+                x: SVector::zeros(),
+                w: SVector::zeros(),
+                n: 0,
+                missing: 0,
+            }; M],
+            windows: [Window::at_rest(); M],
+        }
+    }
+}
+
+macro_rules! bank_state_const {
+    ($t:ident, $at_rest:ident, $zeros:ident) => {
+        impl<const S: usize, const I: usize, const M: usize, const W: usize>
+            BankState<$t, S, I, M, W>
+        {
+            /// At rest: every model's estimate `x̂ = 0` with input `w = 0`, step 0, every
+            /// window empty. `const fn` (for a `static`); equal to `Default`. Cost: none
+            /// in a `static`.
+            pub const fn $at_rest() -> Self {
+                Self {
+                    estimates: [Estimate {
+                        x: crate::state::$zeros(),
+                        w: crate::state::$zeros(),
+                        n: 0,
+                        missing: 0,
+                    }; M],
+                    windows: [Window::at_rest(); M],
+                }
+            }
+        }
+    };
+}
+bank_state_const!(f32, at_rest_f32, zeros_f32);
+bank_state_const!(f64, at_rest_f64, zeros_f64);
 
 impl<T: Real, const S: usize, const I: usize, const M: usize, const W: usize>
     BankState<T, S, I, M, W>
@@ -46,7 +91,7 @@ impl<T: Real, const S: usize, const I: usize, const M: usize, const W: usize>
     }
 
     /// Model `m`'s window of normalized innovations squared (`m < M`).
-    pub fn window(&self, m: usize) -> &Window<W> {
+    pub fn window(&self, m: usize) -> &Window<T, W> {
         &self.windows[m]
     }
 
@@ -55,7 +100,7 @@ impl<T: Real, const S: usize, const I: usize, const M: usize, const W: usize>
     pub fn clear_windows(&mut self) {
         for w in self.windows.iter_mut() {
             let skipped = w.skipped();
-            *w = Window::new();
+            *w = Window::at_rest();
             w.add_skipped(skipped);
         }
     }
@@ -64,9 +109,10 @@ impl<T: Real, const S: usize, const I: usize, const M: usize, const W: usize>
 impl<T: Real, const S: usize, const I: usize, const O: usize, const M: usize>
     ModelBank<T, S, I, O, M>
 {
-    /// The bank of `observers`, each with the whitener of its innovations.
-    /// Errors: [`Error::InvalidParameter`] (`M = 0`).
-    pub const fn new(
+    /// The bank of `observers`, each with the whitener of its innovations. `const fn`
+    /// (a `static` of `const`-built observers and whiteners).
+    /// Errors: [`Error::InvalidParameter`] (`M = 0`). Cost: a copy.
+    pub const fn from_parts(
         observers: [Observer<T, S, I, O>; M],
         whiteners: [Whitener<T, O>; M],
     ) -> Result<Self, Error> {
@@ -89,7 +135,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const M: usize>
         let e = self.observers[0].start(x0, w0)?;
         Ok(BankState {
             estimates: [e; M],
-            windows: [Window::new(); M],
+            windows: [Window::at_rest(); M],
         })
     }
 
@@ -112,13 +158,13 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const M: usize>
             return Err(Error::NonFiniteInput);
         }
         let mut next = state.estimates;
-        let mut q = [0.0f64; M];
+        let mut q = [T::zero(); M];
         for m in 0..M {
             let nu = self.observers[m].step_innovation(&mut next[m], w, y);
             if !next[m].is_finite() {
                 return Err(Error::NonFiniteState);
             }
-            q[m] = self.whiteners[m].nis(&nu).as_f64();
+            q[m] = self.whiteners[m].nis(&nu);
         }
         state.estimates = next;
         for m in 0..M {
@@ -128,12 +174,16 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const M: usize>
     }
 
     /// The log-likelihood `ℓ_m` of each model over its window (natural log, densities in
-    /// output units; see the type docs). Cost: `O(M)`.
-    pub fn log_likelihoods<const W: usize>(&self, state: &BankState<T, S, I, M, W>) -> [f64; M] {
+    /// output units; see the type docs), in `T`. Cost: `O(M)`.
+    pub fn log_likelihoods<const W: usize>(&self, state: &BankState<T, S, I, M, W>) -> [T; M] {
+        // `O ln 2π` in `f64`, rounded once (a constant after inlining).
+        let norm = T::from_f64_rounded(O as f64 * LN_2PI);
+        let half = T::from_f64_rounded(0.5);
         core::array::from_fn(|m| {
             let win = &state.windows[m];
-            let n = win.len() as f64;
-            -0.5 * (win.sum() + n * (self.whiteners[m].log_det() + O as f64 * LN_2PI))
+            // `as` (never `None` for a float).
+            let n = T::from_usize(win.len()).unwrap_or_else(T::zero);
+            -(half * (win.sum() + n * (self.whiteners[m].log_det() + norm)))
         })
     }
 

@@ -6,22 +6,22 @@ use defmt::{Format, Formatter, write};
 use super::{BankState, ChiSquareTest, Detector, ModelBank, Whitener, Window};
 use crate::Real;
 
-impl<T: Real, const O: usize> Format for Whitener<T, O> {
+impl<T: Real + Format, const O: usize> Format for Whitener<T, O> {
     fn format(&self, f: Formatter) {
         write!(
             f,
-            "Whitener {{ O: {=usize}, log_det: {=f64} }}",
+            "Whitener {{ O: {=usize}, log_det: {} }}",
             O,
             self.log_det()
         )
     }
 }
 
-impl<const W: usize> Format for Window<W> {
+impl<T: Real + Format, const W: usize> Format for Window<T, W> {
     fn format(&self, f: Formatter) {
         write!(
             f,
-            "Window {{ W: {=usize}, len: {=usize}, sum: {=f64}, skipped: {=u64} }}",
+            "Window {{ W: {=usize}, len: {=usize}, sum: {}, skipped: {=u64} }}",
             W,
             self.len(),
             self.sum(),
@@ -30,11 +30,11 @@ impl<const W: usize> Format for Window<W> {
     }
 }
 
-impl<const W: usize> Format for ChiSquareTest<W> {
+impl<T: Real + Format, const W: usize> Format for ChiSquareTest<T, W> {
     fn format(&self, f: Formatter) {
         write!(
             f,
-            "ChiSquareTest {{ dof: {=u64}, alpha: {=f64}, threshold: {=f64} }}",
+            "ChiSquareTest {{ dof: {=u64}, alpha: {}, threshold: {} }}",
             self.dof(),
             self.false_alarm(),
             self.threshold()
@@ -42,7 +42,7 @@ impl<const W: usize> Format for ChiSquareTest<W> {
     }
 }
 
-impl<T: Real, const O: usize, const W: usize> Format for Detector<T, O, W> {
+impl<T: Real + Format, const O: usize, const W: usize> Format for Detector<T, O, W> {
     fn format(&self, f: Formatter) {
         write!(
             f,

@@ -292,6 +292,38 @@ impl<T: Real, const S: usize, const I: usize> StepState for JointEstimate<T, S, 
     }
 }
 
+/// At rest: as `JointEstimate::at_rest_f32`/`at_rest_f64`, for any `T`.
+impl<T: Real, const S: usize, const I: usize> Default for JointEstimate<T, S, I> {
+    fn default() -> Self {
+        Self {
+            xi: SVector::zeros(),
+            w: SVector::zeros(),
+            n: 0,
+            missing: 0,
+        }
+    }
+}
+
+macro_rules! joint_estimate_at_rest {
+    ($t:ident, $at_rest:ident, $zeros:ident) => {
+        impl<const S: usize, const I: usize> JointEstimate<$t, S, I> {
+            /// At rest with no input (`ξ̂_0 = 0`, `ŵ_0 = 0`, step 0): `const fn`, for a
+            /// `static`; equal to `JointEstimate::default()` and to
+            /// [`InputStateObserver::start_at_rest`]. Cost: none in a `static`.
+            pub const fn $at_rest() -> Self {
+                Self {
+                    xi: crate::state::$zeros(),
+                    w: crate::state::$zeros(),
+                    n: 0,
+                    missing: 0,
+                }
+            }
+        }
+    };
+}
+joint_estimate_at_rest!(f32, at_rest_f32, zeros_f32);
+joint_estimate_at_rest!(f64, at_rest_f64, zeros_f64);
+
 /// `x − Γ₁ w` (or `+` with `sign = 1`) in `T`.
 pub(super) fn shift<T: Real, const S: usize, const I: usize>(
     gamma1: &[[T; I]; S],

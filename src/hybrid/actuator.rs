@@ -54,6 +54,36 @@ pub struct ActuatorState<T, const L: usize> {
     reached: T,
 }
 
+/// At rest at 0: as `ActuatorState::at_rest_f32`/`at_rest_f64`, for any `T`.
+impl<T: Real, const L: usize> Default for ActuatorState<T, L> {
+    fn default() -> Self {
+        Self {
+            line: [T::zero(); L],
+            head: 0,
+            reached: T::zero(),
+        }
+    }
+}
+
+macro_rules! actuator_state_at_rest {
+    ($t:ident, $at_rest:ident) => {
+        impl<const L: usize> ActuatorState<$t, L> {
+            /// At rest at displacement 0 (every past command 0): `const fn`, for a
+            /// `static`; equal to `ActuatorState::default()` and to
+            /// [`Actuator::rest`]`(0)`. Cost: none in a `static`, `L` stores otherwise.
+            pub const fn $at_rest() -> Self {
+                Self {
+                    line: [0.0; L],
+                    head: 0,
+                    reached: 0.0,
+                }
+            }
+        }
+    };
+}
+actuator_state_at_rest!(f32, at_rest_f32);
+actuator_state_at_rest!(f64, at_rest_f64);
+
 impl<T: Real, const L: usize> ActuatorState<T, L> {
     /// The displacement reached at the last sample (m). Cost: none.
     pub fn reached(&self) -> T {

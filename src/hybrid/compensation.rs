@@ -43,6 +43,40 @@ pub struct CompensatorState<T> {
     power: T,
 }
 
+/// At rest at 0 with a zero delay estimate: as `CompensatorState::at_rest_f32`/
+/// `at_rest_f64`, for any `T`.
+impl<T: Real> Default for CompensatorState<T> {
+    fn default() -> Self {
+        Self {
+            x: [T::zero(); 4],
+            tau: T::zero(),
+            power: T::zero(),
+        }
+    }
+}
+
+macro_rules! compensator_state_at_rest {
+    ($t:ident, $at_rest:ident) => {
+        impl CompensatorState<$t> {
+            /// At rest at 0 (every past target 0, delay estimate 0, no rate power):
+            /// `const fn`, for a `static`; equal to `CompensatorState::default()` and to
+            /// [`Polynomial`]'s [`Compensator::rest`]`(0)`. (An [`Adaptive`] compensator's
+            /// rest starts its delay estimate at its initial delay instead: the same
+            /// state once `rest` has been called, or this one if that delay is 0.) Cost:
+            /// none.
+            pub const fn $at_rest() -> Self {
+                Self {
+                    x: [0.0; 4],
+                    tau: 0.0,
+                    power: 0.0,
+                }
+            }
+        }
+    };
+}
+compensator_state_at_rest!(f32, at_rest_f32);
+compensator_state_at_rest!(f64, at_rest_f64);
+
 /// The Lagrange extrapolation weights of order `p ≤ 3` on the nodes `0, −1, …, −p`
 /// (samples) at `s` samples ahead: `c_j = Π_{m ≠ j} (s + m) / (m − j)`; zero beyond `p`.
 /// The same expressions in `f64` (`const`) and in `T` (the adaptive compensator's

@@ -73,6 +73,36 @@ pub struct SplitState<T, const N: usize> {
     p: SVector<T, N>,
 }
 
+/// At rest: as `SplitState::at_rest_f32`/`at_rest_f64`, for any `T`.
+impl<T: Real, const N: usize> Default for SplitState<T, N> {
+    fn default() -> Self {
+        Self {
+            state: State::default(),
+            r: SVector::zeros(),
+            p: SVector::zeros(),
+        }
+    }
+}
+
+macro_rules! split_state_at_rest {
+    ($t:ident, $at_rest:ident, $zeros:ident) => {
+        impl<const N: usize> SplitState<$t, N> {
+            /// At rest at step 0: `u = v = a = 0`, no restoring force, no load.
+            /// `const fn`, for a `static`; equal to `SplitState::default()` and to
+            /// [`Split::start`] from rest with `r0 = p0 = 0`. Cost: none in a `static`.
+            pub const fn $at_rest() -> Self {
+                Self {
+                    state: State::$at_rest(),
+                    r: crate::state::$zeros(),
+                    p: crate::state::$zeros(),
+                }
+            }
+        }
+    };
+}
+split_state_at_rest!(f32, at_rest_f32, zeros_f32);
+split_state_at_rest!(f64, at_rest_f64, zeros_f64);
+
 impl<T: Real, const N: usize> SplitState<T, N> {
     /// The kinematic state at `t_n`. Cost: none.
     pub fn state(&self) -> &State<T, N> {

@@ -42,6 +42,29 @@ pub struct BilinearHistory<T> {
     pub plastic: T,
 }
 
+/// Virgin: as `BilinearHistory::at_rest_f32`/`at_rest_f64`, for any `T`.
+impl<T: Real> Default for BilinearHistory<T> {
+    fn default() -> Self {
+        Self { plastic: T::zero() }
+    }
+}
+
+macro_rules! bilinear_history_at_rest {
+    ($t:ident, $at_rest:ident) => {
+        impl BilinearHistory<$t> {
+            /// The virgin history, `d_p = 0`: `const fn`, for a `static` (e.g.
+            /// `[BilinearHistory::at_rest_f32(); N]` for a shear building); equal to
+            /// `BilinearHistory::default()` and to the law's
+            /// [`Law::initial_history`]. Cost: none.
+            pub const fn $at_rest() -> Self {
+                Self { plastic: 0.0 }
+            }
+        }
+    };
+}
+bilinear_history_at_rest!(f32, at_rest_f32);
+bilinear_history_at_rest!(f64, at_rest_f64);
+
 impl<T: Real> Bilinear<T> {
     /// A bilinear law with elastic stiffness `k` (force/deformation, finite, `> 0`), yield
     /// force `fy` (force, finite, `> 0`) and post-yield stiffness ratio `alpha` (finite, in

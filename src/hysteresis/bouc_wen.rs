@@ -101,6 +101,34 @@ pub struct BoucWenHistory<T> {
     pub z: T,
 }
 
+/// Virgin: as `BoucWenHistory::at_rest_f32`/`at_rest_f64`, for any `T`.
+impl<T: Real> Default for BoucWenHistory<T> {
+    fn default() -> Self {
+        Self {
+            deformation: T::zero(),
+            z: T::zero(),
+        }
+    }
+}
+
+macro_rules! bouc_wen_history_at_rest {
+    ($t:ident, $at_rest:ident) => {
+        impl BoucWenHistory<$t> {
+            /// The virgin history, `d = 0`, `z = 0`: `const fn`, for a `static`; equal to
+            /// `BoucWenHistory::default()` and to the law's [`Law::initial_history`].
+            /// Cost: none.
+            pub const fn $at_rest() -> Self {
+                Self {
+                    deformation: 0.0,
+                    z: 0.0,
+                }
+            }
+        }
+    };
+}
+bouc_wen_history_at_rest!(f32, at_rest_f32);
+bouc_wen_history_at_rest!(f64, at_rest_f64);
+
 impl<T: Real> BoucWen<T> {
     /// A Bouc–Wen law with initial stiffness `k` (force/deformation, finite, `> 0`), yield
     /// force `fy` (finite, `> 0`), post-yield ratio `alpha` (finite, in `[0, 1)`), shape

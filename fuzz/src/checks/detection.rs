@@ -1,14 +1,14 @@
 //! Fuzz target `detection` (`fuzz_targets/detection.rs`): checks chi_square_quantile,
 //! normal_quantile, innovation_covariance, Whitener (new, from_rows_f32/_f64), Window,
-//! ChiSquareTest, Detector, Cusum, ModelBank (new, start, try_step, ranking,
+//! ChiSquareTest, Detector, Cusum, ModelBank (from_parts, start, try_step, ranking,
 //! clear_windows), Observer::step_innovation and Kalman::try_step_innovation; S = 2,
 //! I = 1, O = 1 … 3, W = 1, 4, 8; f32, f64.
 //!
 //! The decoder and the checks every target shares are in `common.rs`.
 
 use aemstep::detection::{
-    ChiSquareTest, Cusum, CusumState, Detector, ModelBank, NIS_FRACTION_BITS, Whitener, Window,
-    chi_square_quantile, innovation_covariance, normal_quantile,
+    ChiSquareTest, Cusum, CusumState, Detector, Dof, ModelBank, NIS_FRACTION_BITS, Whitener,
+    Window, chi_square_quantile, innovation_covariance, normal_quantile,
 };
 use aemstep::nalgebra::{SMatrix, SVector};
 use aemstep::observer::{Kalman, Measurement, Observer, StateSpace, SteadyState};
@@ -122,13 +122,17 @@ fn sized<const O: usize, const W: usize>(b: &mut Bytes) {
     ));
 
     quantiles(a1, a2, k);
-    let test = chi_square_test::<W>(outputs, a1);
-    cusum(outputs, lambda, a1, &qs);
-    let window = window::<W>(&qs);
+    let test64 = chi_square_test::<f64, W>(outputs, a1);
+    let test32 = chi_square_test::<f32, W>(outputs, a1);
+    cusum::<f64>(outputs, lambda, a1, &qs);
+    cusum::<f32>(outputs, lambda, a1, &qs);
+    let window64 = window::<f64, W>(&qs);
+    let window32 = window::<f32, W>(&qs);
     check!(
-        err(&ChiSquareTest::<0>::new(1, 0.5)) == Some(Error::InvalidParameter(Param::Window))
+        err(&ChiSquareTest::<f64, 0>::new(&Dof::<1>, 0.5))
+            == Some(Error::InvalidParameter(Param::Window))
             && err(&Whitener::<f64, 0>::new(&[])) == Some(Error::InvalidParameter(Param::Outputs))
-            && err(&ModelBank::<f64, 2, 1, O, 0>::new([], []))
+            && err(&ModelBank::<f64, 2, 1, O, 0>::from_parts([], []))
                 == Some(Error::InvalidParameter(Param::BankSize)),
         "{DE}: W = 0, O = 0 or M = 0 accepted"
     );
@@ -185,11 +189,11 @@ fn sized<const O: usize, const W: usize>(b: &mut Bytes) {
                 && (e64.is_none() || e64 == Some(Error::OperatorOverflow))),
         "{DE}: Whitener: f64 gave {e64:?}, f32 gave {e32:?} (S = {s0:?})"
     );
-    if let (Ok(wh), Some(test)) = (&wh64, &test) {
-        detector(wh, test, &window, &ys);
+    if let (Ok(wh), Some(test)) = (&wh64, &test64) {
+        detector(wh, test, &window64, &ys);
     }
-    if let (Ok(wh), Some(test)) = (&wh32, &test) {
-        detector(wh, test, &window, &ys);
+    if let (Ok(wh), Some(test)) = (&wh32, &test32) {
+        detector(wh, test, &window32, &ys);
     }
     if let [Some(m0), Some(m1)] = models {
         bank::<f64, O, W>(&meas, &[m0, m1], &x0, &ws, &ys);
@@ -231,13 +235,44 @@ fn quantiles(a1: f64, a2: f64, k: u64) {
     }
 }
 
-/// `ChiSquareTest::new`: `InvalidParameter` for no outputs or a bad `alpha`; `Ok` with the
-/// quantile of `W·O` degrees of freedom as its threshold.
-fn chi_square_test<const W: usize>(outputs: u64, alpha: f64) -> Option<ChiSquareTest<W>> {
-    let Ok(o) = usize::try_from(outputs) else {
-        return None;
-    };
-    let t = ChiSquareTest::<W>::new(o, alpha);
+/// The degrees of freedom a sample the tests are built for, picked by `outputs` (the
+/// count is a type, `Dof::<k>`): 0 … 3, 1000 or 10⁶.
+fn dof_of(outputs: u64) -> u64 {
+    [0, 1, 2, 3, 1000, 1_000_000][(outputs % 6) as usize]
+}
+
+/// `ChiSquareTest::new(&Dof::<o>, alpha)` for `o` from [`dof_of`].
+fn chi_new<T: Real, const W: usize>(o: u64, alpha: f64) -> Result<ChiSquareTest<T, W>, Error> {
+    match o {
+        0 => ChiSquareTest::new(&Dof::<0>, alpha),
+        1 => ChiSquareTest::new(&Dof::<1>, alpha),
+        2 => ChiSquareTest::new(&Dof::<2>, alpha),
+        3 => ChiSquareTest::new(&Dof::<3>, alpha),
+        1000 => ChiSquareTest::new(&Dof::<1000>, alpha),
+        _ => ChiSquareTest::new(&Dof::<1_000_000>, alpha),
+    }
+}
+
+/// `Cusum::new(&Dof::<o>, lambda, alpha)` for `o` from [`dof_of`].
+fn cusum_new<T: Real>(o: u64, lambda: f64, alpha: f64) -> Result<Cusum<T>, Error> {
+    match o {
+        0 => Cusum::new(&Dof::<0>, lambda, alpha),
+        1 => Cusum::new(&Dof::<1>, lambda, alpha),
+        2 => Cusum::new(&Dof::<2>, lambda, alpha),
+        3 => Cusum::new(&Dof::<3>, lambda, alpha),
+        1000 => Cusum::new(&Dof::<1000>, lambda, alpha),
+        _ => Cusum::new(&Dof::<1_000_000>, lambda, alpha),
+    }
+}
+
+/// `ChiSquareTest::new`: `InvalidParameter` for no degree of freedom or a bad `alpha`;
+/// `Ok` with the quantile of `W·k` degrees of freedom as its threshold, rounded to `T`.
+fn chi_square_test<T: Real, const W: usize>(
+    outputs: u64,
+    alpha: f64,
+) -> Option<ChiSquareTest<T, W>> {
+    let o = dof_of(outputs);
+    let t = chi_new::<T, W>(o, alpha);
     outcome(DE, &t);
     if o == 0 || !(alpha > 0.0 && alpha < 1.0) {
         check!(
@@ -258,13 +293,13 @@ fn chi_square_test<const W: usize>(outputs: u64, alpha: f64) -> Option<ChiSquare
         );
     }
     let t = t.ok()?;
-    let dof = (W as u64).saturating_mul(o as u64);
+    let dof = (W as u64).saturating_mul(o);
     check!(
         t.dof() == dof
-            && t.false_alarm() == alpha
+            && t.false_alarm() == T::from_f64_rounded(alpha)
             && t.threshold().is_finite()
-            && t.threshold() >= 0.0
-            && t.threshold() == chi_square_quantile(dof, alpha),
+            && t.threshold() >= T::zero()
+            && t.threshold() == T::from_f64_rounded(chi_square_quantile(dof, alpha)),
         "{DE}: ChiSquareTest Ok: {t:?}"
     );
     Some(t)
@@ -272,9 +307,9 @@ fn chi_square_test<const W: usize>(outputs: u64, alpha: f64) -> Option<ChiSquare
 
 /// `Cusum::new` errors, and its statistic: `≥ 0` (never NaN), NaN samples skipped and
 /// counted with the statistic unchanged, alarm exactly above the threshold.
-fn cusum(outputs: u64, lambda: f64, alpha: f64, qs: &[f64]) {
-    let o = usize::try_from(outputs).unwrap_or(usize::MAX);
-    let c = Cusum::new(o, lambda, alpha);
+fn cusum<T: Real>(outputs: u64, lambda: f64, alpha: f64, qs: &[f64]) {
+    let o = dof_of(outputs);
+    let c = cusum_new::<T>(o, lambda, alpha);
     outcome(DE, &c);
     let which = if o == 0 {
         Some(Param::Outputs)
@@ -293,42 +328,47 @@ fn cusum(outputs: u64, lambda: f64, alpha: f64, qs: &[f64]) {
     );
     let Ok(c) = c else { return };
     check!(
-        c.threshold().is_finite() && c.threshold() > 0.0,
-        "{DE}: Cusum threshold {:e}",
+        c.threshold().is_finite() && c.threshold() > T::zero(),
+        "{DE}: Cusum threshold {:?}",
         c.threshold()
     );
-    let mut s = CusumState::new();
+    let mut s = CusumState::<T>::default();
     for &q in qs {
+        let q = T::from_f64_rounded(q);
         let (g, skipped) = (s.statistic(), s.skipped());
         let alarm = c.update(&mut s, q);
         count(DE, "cusum updates");
-        if q.is_nan() {
+        if q.as_f64().is_nan() {
             check!(
-                !alarm && s.skipped() == skipped + 1 && s.statistic().to_bits() == g.to_bits(),
+                !alarm
+                    && s.skipped() == skipped + 1
+                    && s.statistic().as_f64().to_bits() == g.as_f64().to_bits(),
                 "{DE}: Cusum: a NaN sample not skipped"
             );
         } else {
             check!(
                 s.skipped() == skipped
-                    && s.statistic() >= 0.0
+                    && s.statistic() >= T::zero()
                     && alarm == (s.statistic() > c.threshold()),
-                "{DE}: Cusum: statistic {:e} after {q:e} (alarm {alarm})",
+                "{DE}: Cusum: statistic {:?} after {q:?} (alarm {alarm})",
                 s.statistic()
             );
         }
     }
     s.reset();
-    check!(s.statistic() == 0.0, "{DE}: Cusum reset");
+    check!(s.statistic() == T::zero(), "{DE}: Cusum reset");
 }
 
 /// The window's invariant: its fixed-point sum is the exact sum of its stored terms (the
 /// last `W` non-NaN pushes), its length and skipped count those of the pushes.
-fn window<const W: usize>(qs: &[f64]) -> Window<W> {
-    let mut win = Window::<W>::new();
+fn window<T: Real, const W: usize>(qs: &[f64]) -> Window<T, W> {
+    let mut win = Window::<T, W>::at_rest();
     let mut held: Vec<u64> = Vec::new();
     let mut skipped = 0;
     for &q in qs {
+        let q = T::from_f64_rounded(q);
         win.push(q);
+        let q = q.as_f64();
         if q.is_nan() {
             skipped += 1;
         } else {
@@ -344,13 +384,23 @@ fn window<const W: usize>(qs: &[f64]) -> Window<W> {
                 && win.skipped() == skipped
                 && win.is_full() == (held.len() == W)
                 && win.is_empty() == held.is_empty()
-                && win.sum() >= 0.0
-                && win.sum() == win.sum_fixed() as f64 / (1u64 << NIS_FRACTION_BITS) as f64,
+                && win.sum() >= T::zero()
+                && win.sum().as_f64() == fixed_as::<T>(win.sum_fixed()),
             "{DE}: Window after {q:e}: {win:?}, want terms {held:?} (sum {exact})"
         );
         count(DE, "window pushes");
     }
     win
+}
+
+/// A fixed-point sum as `T` reads it: the integer rounded once to `T`, times `2⁻²⁴`.
+fn fixed_as<T: Real>(sum: u64) -> f64 {
+    let scale = (1u64 << NIS_FRACTION_BITS) as f64;
+    if eps::<T>() > 1e-10 {
+        (sum as f32) as f64 / scale
+    } else {
+        sum as f64 / scale
+    }
 }
 
 /// `Whitener::new` against its `const fn` twin; `Ok` ⇒ finite; a non-finite `S` is
@@ -388,11 +438,11 @@ fn whitener<T: Real, const O: usize>(s: &[[f64; O]; O]) -> Result<Whitener<T, O>
 /// `Detector::update` is a push of the normalized innovation squared and the test.
 fn detector<T: Real, const O: usize, const W: usize>(
     wh: &Whitener<T, O>,
-    test: &ChiSquareTest<W>,
-    start: &Window<W>,
+    test: &ChiSquareTest<T, W>,
+    start: &Window<T, W>,
     ys: &[SVector<f64, O>],
 ) {
-    let det = Detector::new(*wh, *test);
+    let det = Detector::from_parts(*wh, *test);
     let mut win = *start;
     for y in ys {
         let nu = to_t::<T, O, 1>(y);
@@ -405,7 +455,7 @@ fn detector<T: Real, const O: usize, const W: usize>(
             );
         }
         let mut want = win;
-        want.push(q.as_f64());
+        want.push(q);
         let alarm = det.update(&mut win, &nu);
         check!(
             win == want && alarm == test.alarm(&win),
@@ -435,10 +485,10 @@ fn bank<T: Real, const O: usize, const W: usize>(
         obs.push(o);
         whs.push(w);
     }
-    let bank = ModelBank::<T, 2, 1, O, 2>::new([obs[0], obs[1]], [whs[0], whs[1]]);
+    let bank = ModelBank::<T, 2, 1, O, 2>::from_parts([obs[0], obs[1]], [whs[0], whs[1]]);
     let Ok(bank) = bank else {
         panic!(
-            "property broken: {DE}: ModelBank::new of two models failed\n  data: {}",
+            "property broken: {DE}: ModelBank::from_parts of two models failed\n  data: {}",
             context()
         );
     };
@@ -480,7 +530,7 @@ fn bank<T: Real, const O: usize, const W: usize>(
                 );
             }
             next_finite &= want[m].is_finite();
-            wins[m].push(whs[m].nis(&nu).as_f64());
+            wins[m].push(whs[m].nis(&nu));
         }
         count(DE, "checked steps");
         match bank.try_step(&mut st, &w, &y) {

@@ -99,15 +99,18 @@ fn damage_run(sc: &Scene, seed: u64, restart: bool) -> DamageRun {
     // stepper handed the displacement and velocity).
     let ys = damage_measurements(ag, k_change, sc.sigma, seed);
 
-    let det = Detector::<f64, 3, W>::new(sc.whs[0], ChiSquareTest::new(3, ALPHA_DAMAGE).unwrap());
-    let bank = ModelBank::<f64, 10, 1, 3, HYPOTHESES>::new(
+    let det = Detector::<f64, 3, W>::from_parts(
+        sc.whs[0],
+        ChiSquareTest::new(&sc.obs[0], ALPHA_DAMAGE).unwrap(),
+    );
+    let bank = ModelBank::<f64, 10, 1, 3, HYPOTHESES>::from_parts(
         core::array::from_fn(|m| sc.obs[m]),
         core::array::from_fn(|m| sc.whs[m]),
     )
     .unwrap();
-    let cusum = Cusum::new(3, LAMBDA, ALPHA_DAMAGE).unwrap();
-    let mut cs = CusumState::new();
-    let mut win = Window::<W>::new();
+    let cusum = Cusum::new(&sc.obs[0], LAMBDA, ALPHA_DAMAGE).unwrap();
+    let mut cs = CusumState::default();
+    let mut win = Window::<f64, W>::at_rest();
     let mut e = sc.obs[0].start_at_rest(&SVector::from([ag[0]])).unwrap();
     let mut st = bank
         .start::<WB>(&SVector::zeros(), &SVector::from([ag[0]]))
@@ -182,12 +185,12 @@ struct Intact {
 const ALPHA_CUSUM: f64 = 1e-3;
 const LAMBDA_INTACT: f64 = 1.5;
 
-fn intact_runs(sc: &Scene, tests: &[ChiSquareTest<W>; ALPHAS.len()]) -> Intact {
+fn intact_runs(sc: &Scene, tests: &[ChiSquareTest<f64, W>; ALPHAS.len()]) -> Intact {
     let ag = sc.ag;
     let md = model([1.0; 5]);
     let (obs, wh, kf) = observer_of(&md, &r_rows(sc.sigma));
     let truth = IntactTruth::new(&md, &kf);
-    let cusum = Cusum::new(3, LAMBDA_INTACT, ALPHA_CUSUM).unwrap();
+    let cusum = Cusum::new(&obs, LAMBDA_INTACT, ALPHA_CUSUM).unwrap();
     let mut out = Intact {
         alarms: [0; ALPHAS.len()],
         trials: 0,
@@ -202,8 +205,8 @@ fn intact_runs(sc: &Scene, tests: &[ChiSquareTest<W>; ALPHAS.len()]) -> Intact {
         let mut g = Gauss::new(1000 + seed);
         let mut x = truth.start(&mut g);
         let mut e = obs.start_at_rest(&SVector::from([ag[0]])).unwrap();
-        let mut win = Window::<W>::new();
-        let mut cs = CusumState::new();
+        let mut win = Window::<f64, W>::at_rest();
+        let mut cs = CusumState::default();
         for n in 1..ag.len() {
             let w1 = SVector::from([ag[n]]);
             let y = truth.step(&mut x, ag, n, &sc.sigma, &mut g);
@@ -260,9 +263,9 @@ fn unknown_load(loss: f64) -> UnknownLoad {
     let f = InputStateObserver::<f64, 10, 1, 4>::new(&estimator::MODEL, &estimator::GAINS)
         .expect("estimator");
     let wh = Whitener::<f64, 4>::new(&estimator::GAINS.innovation_covariance).expect("R̃");
-    let det = Detector::<f64, 4, W_UNKNOWN>::new(
+    let det = Detector::<f64, 4, W_UNKNOWN>::from_parts(
         wh,
-        ChiSquareTest::new(unknown_load::DOF, ALPHA_UNKNOWN).expect("test"),
+        ChiSquareTest::new(&f, ALPHA_UNKNOWN).expect("test"),
     );
     let hurt = unknown_load::damaged(1.0 - loss);
     let (mut before, mut after, mut early) = (0.0, 0.0, 0);
@@ -270,7 +273,7 @@ fn unknown_load(loss: f64) -> UnknownLoad {
     for seed in 0..SEEDS_UNKNOWN {
         let mut truth = unknown_load::Truth::new(100 + seed);
         let mut e = f.start_at_rest();
-        let mut win = Window::<W_UNKNOWN>::new();
+        let mut win = Window::<f64, W_UNKNOWN>::at_rest();
         let mut first = None;
         for n in 1..=STEPS_UNKNOWN {
             if n == DAMAGE_STEP + 1 {
@@ -488,12 +491,12 @@ let (soft1, whitener1) = hypothesis([0.9, 1.0, 1.0, 1.0, 1.0])?;
 
 // The χ² test over 50 samples (150 degrees of freedom), a false alarm with probability
 // 1e-6 per evaluation (at 50 Hz: 0.18 samples in alarm an hour).
-let det = Detector::<f64, 3, 50>::new(whitener, ChiSquareTest::new(3, 1e-6)?);
-let bank = ModelBank::<f64, 10, 1, 3, 2>::new([obs, soft1], [whitener, whitener1])?;
+let det = Detector::<f64, 3, 50>::from_parts(whitener, ChiSquareTest::new(&obs, 1e-6)?);
+let bank = ModelBank::<f64, 10, 1, 3, 2>::from_parts([obs, soft1], [whitener, whitener1])?;
 
 let a_g0 = vector![0.0];
 let mut e = obs.start_at_rest(&a_g0)?;
-let mut win = Window::<50>::new();
+let mut win = Window::<f64, 50>::at_rest();
 let mut st = bank.start::<500>(&SVector::zeros(), &a_g0)?; // a 10 s window per model
 // Each sample: the ground acceleration and the three accelerometers (m/s²).
 let (a_g, y) = (vector![0.5], vector![0.1, 0.3, 0.2]);
@@ -556,11 +559,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let runs_restart: Vec<DamageRun> = (0..DAMAGE_SEEDS)
         .map(|i| damage_run(&sc, 20_261_126 + i, true))
         .collect();
-    let tests: [ChiSquareTest<W>; ALPHAS.len()] =
-        core::array::from_fn(|i| ChiSquareTest::new(3, ALPHAS[i]).unwrap());
+    let tests: [ChiSquareTest<f64, W>; ALPHAS.len()] =
+        core::array::from_fn(|i| ChiSquareTest::new(&sc.obs[0], ALPHAS[i]).unwrap());
     let intact = intact_runs(&sc, &tests);
     let chi_threshold = tests[ALPHAS.len() - 1].threshold();
-    let cusum_threshold = Cusum::new(3, LAMBDA, ALPHA_DAMAGE)?.threshold();
+    let cusum_threshold = Cusum::<f64>::new(&sc.obs[0], LAMBDA, ALPHA_DAMAGE)?.threshold();
 
     let mut md = String::new();
     writeln!(md, "# Change detection: a storey that loses stiffness")?;
