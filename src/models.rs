@@ -139,6 +139,23 @@ pub const fn shear_building<const N: usize>(m: [f64; N], k: [f64; N]) -> (Rows<N
     (mm, kk)
 }
 
+/// `A + B` entrywise (e.g. a numerical stiffness plus a specimen's,
+/// [`StoreySpecimen::stiffness`](crate::hybrid::StoreySpecimen::stiffness)), in the units
+/// of `a` and `b`. `const`; cost `N²` additions.
+pub const fn add<const N: usize>(a: &Rows<N>, b: &Rows<N>) -> Rows<N> {
+    let mut c = [[0.0; N]; N];
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < N {
+            c[i][j] = a[i][j] + b[i][j];
+            j += 1;
+        }
+        i += 1;
+    }
+    c
+}
+
 /// Rayleigh damping `C = a0 M + a1 K`.
 pub const fn rayleigh<const N: usize>(m: &Rows<N>, k: &Rows<N>, a0: f64, a1: f64) -> Rows<N> {
     let mut c = [[0.0; N]; N];
