@@ -322,9 +322,9 @@ const_ctor!(f64, from_rows_f64, from_rows_chen_ricles_f64);
 /// between the model's floor displacements and the one actuator and load cell of the
 /// specimen.
 ///
-/// Storey `i` (`0 ≤ i < N`, DOFs ground storey first, as [`models::shear_building`]
-/// (crate::models::shear_building)) joins floor `i − 1` below to floor `i` above; storey
-/// `0` joins the ground to floor `0`. With `L` the row `e_iᵀ − e_{i−1}ᵀ` (`e_{−1} = 0`):
+/// Storey `i` (`0 ≤ i < N`, DOFs ground storey first, as
+/// [`shear_building`](crate::models::shear_building)) joins floor `i − 1` below to floor
+/// `i` above; storey `0` joins the ground to floor `0`. With `L` the row `e_iᵀ − e_{i−1}ᵀ` (`e_{−1} = 0`):
 ///
 /// ```text
 /// command (deformation):   d = L u = u_i − u_{i−1}            (u_{−1} = 0, the ground)
