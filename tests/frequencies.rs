@@ -3,6 +3,8 @@
 //! polynomial `det(K − λ M) = 0` solved by the quadratic formula (non-diagonal `M`
 //! included); its use in a `const` feeding `rayleigh_coefficients`; the typed errors.
 
+#![allow(clippy::needless_range_loop)]
+
 use aemstep::models::{self, Rows};
 use aemstep::{Error, unwrap_const};
 
