@@ -159,8 +159,7 @@ pub mod nalgebra {
 /// `use aemstep::prelude::*;`.
 ///
 /// - [`Stepper`]: `start`, `step`, `try_step`, `time_step` of every scheme.
-/// - [`Model`]: a nonlinear model's mass, force and tangent
-///   ([`Nonlinear`]).
+/// - [`Model`]: a nonlinear model's mass, force and tangent ([`Nonlinear`]).
 /// - [`HistoryModel`](crate::hysteresis::HistoryModel): a model whose history commits only
 ///   with a successful step (the hysteretic building).
 /// - [`Law`](crate::hysteresis::Law): a hysteretic law's `trial` and `initial_history` (a
