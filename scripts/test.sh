@@ -51,6 +51,17 @@ cargo run -q --release --example spectrum_csv > "$out" || fail "spectrum_csv exa
     fail "spectrum_csv: a header and 50 rows expected"
 cargo run -q --release --example observer > "$out" || fail "observer example"
 grep -q 'RMS drift error (m)' "$out" || fail "observer: RMS drift errors (m) expected"
+cargo run -q --release --example estimation_detection > "$out" || fail "estimation_detection example"
+grep -q 'force RMS error (kN)' "$out" && grep -q 'drift RMS error (mm)' "$out" &&
+    grep -q '^as designed.* no$' "$out" && grep -q '^storey 1 30 % softer.* yes, t = [0-9.]* s$' "$out" ||
+    fail "estimation_detection: force (kN) and drift (mm) RMS errors; no alarm intact, an alarm (s) damaged"
+cargo run -q --release --example hybrid_loop > "$out" || fail "hybrid_loop example"
+grep -q 'peak drift (m)' "$out" && grep -q 'tracking error (m)' "$out" &&
+    grep -q 'specimen force (kN)' "$out" && grep -q 'actuator delay 10 ms' "$out" ||
+    fail "hybrid_loop: peak drift (m), tracking error (m), specimen force (kN) expected"
+cargo run -q --release --features std --example ida > "$out" || fail "ida example"
+grep -q 'PGA (g)' "$out" && grep -q 'drift ratio (%)' "$out" && grep -q 'collapse between PGA' "$out" ||
+    fail "ida: intensity (g) against peak drift ratio (%), a collapse bracket (g) expected"
 rm -f "$out"
 
 step "the Python package: pip install ./python in a fresh virtual environment, pytest python/tests"

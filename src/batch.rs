@@ -1,5 +1,5 @@
 //! Many independent jobs on the host (feature `std`): [`map`] runs a function over a slice
-//! of jobs on a work-stealing pool ([rayon]) of a chosen number of threads and returns the
+//! of jobs on a work-stealing pool ([rayon](https://docs.rs/rayon/1)) of a chosen number of threads and returns the
 //! results in the order of the jobs. For batches whose jobs are coarse and independent: the
 //! spectra of many records ([`spectrum::batch::spectra`](crate::spectrum::batch::spectra)),
 //! the time-history analyses of an incremental dynamic analysis (one per record and

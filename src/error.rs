@@ -109,6 +109,10 @@ pub enum Error {
         /// the line after its last.
         line: u32,
     },
+    /// The stiffness matrix `K` has a negative eigenvalue beyond rounding (`K φ = ω² M φ`
+    /// with `ω² < 0`): the model is unstable and has no real natural frequency
+    /// ([`models::natural_frequencies`](crate::models::natural_frequencies)).
+    StiffnessIndefinite,
 }
 
 /// Which parameter an [`Error::InvalidParameter`] or [`Error::InvalidMaterial`] names; its
@@ -301,6 +305,9 @@ impl Error {
             }
             Error::MalformedRecord { .. } => {
                 "malformed record: header, value count or a value that is not a number"
+            }
+            Error::StiffnessIndefinite => {
+                "the stiffness matrix K is not positive semidefinite: no real natural frequency"
             }
         }
     }

@@ -10,7 +10,9 @@
 //! "fictitious load" of the analog equation `u'' = q`, taken as the mean of its end values
 //! on each step; the equation of motion is enforced at the end of the step. For linear
 //! systems the step is second-order accurate and unconditionally stable (it coincides with
-//! Newmark's average-acceleration rule).
+//! Newmark's average-acceleration rule). The method: J. T. Katsikadelis, *A new direct time
+//! integration method for the equations of motion in structural dynamics*, ZAMM Z. Angew.
+//! Math. Mech. (2013), DOI 10.1002/zamm.201200245.
 //!
 //! - [`Linear`]: constant `M, C, K`; operators built once (at run time, or by the compiler
 //!   into flash with [`Linear::from_rows_f32`]); `3N²` multiply-adds a step.
@@ -29,7 +31,8 @@
 //!   Chen–Ricles algorithm and the KR-α family (ρ∞): displacement and velocity explicit,
 //!   operators built once (also in `const fn`), `5N²` a step.
 //! - [`hybrid`]: real-time hybrid simulation — the KR-α step split into a displacement
-//!   command and a completion with the measured restoring force.
+//!   command and a completion with the measured restoring force, actuator delay
+//!   compensation, a storey specimen mapped onto two degrees of freedom.
 //! - [`hysteresis`]: yielding structures — models with history committed only when a step
 //!   succeeds ([`hysteresis::HistoryModel`]), bilinear, Bouc–Wen and friction laws, a
 //!   hysteretic shear building.
@@ -44,11 +47,18 @@
 //!   (Vamvatsikos & Cornell 2002) or stripes over a suite of records on the batch pool,
 //!   IDA curves and their fractiles, for any analysis given as a closure (`docs/ida.md`).
 //! - `batch` (feature `std`): many independent jobs (records, intensities, periods) on a
-//!   work-stealing pool of a chosen thread count, results in input order.
+//!   work-stealing pool (rayon) of a chosen thread count, results in input order.
 //! - [`observer`]: virtual sensing — the discrete state-space form of the linear schemes,
 //!   a fixed-gain observer with the steady-state Kalman gain (also in `const fn`), a full
 //!   Kalman filter, modal observers.
-//! - [`models`]: `const` builders for shear buildings and Rayleigh damping.
+//! - [`estimation`]: virtual sensing with the load unknown — joint input–state estimation
+//!   (Gillijns & De Moor), the augmented and dual Kalman filters, a fixed-lag smoother, and
+//!   the check that the sensors can identify the input.
+//! - [`detection`]: change detection on an observer's innovations — a windowed χ² test at a
+//!   stated false-alarm probability, CUSUM, and a bank of models that names the storey.
+//! - [`models`]: `const` builders for shear buildings and Rayleigh damping, and a model's
+//!   natural frequencies ([`models::natural_frequencies`], `const`).
+//! - [`prelude`]: the traits every stepping loop imports.
 //! - [`Error`]: the one error type; a failed step never changes the caller's state.
 //! - [`matrix!`], [`vector!`]: nalgebra's literal syntax for the crate's matrix and vector
 //!   types, also in `const` and `static` items, with no `nalgebra` dependency of your own.
@@ -154,9 +164,53 @@
 #[cfg(any(test, feature = "std"))]
 extern crate std;
 
-/// The `nalgebra` this crate's API is written in (version 0.35): use `aemstep::nalgebra`
-/// so your matrices and vectors are the same types as the crate's.
-pub use nalgebra;
+/// The `nalgebra` this crate's API is written in, version 0.35 (its documentation:
+/// <https://docs.rs/nalgebra/0.35.0/nalgebra/>): use `aemstep::nalgebra` so your matrices
+/// and vectors are the same types as the crate's, with no `nalgebra` dependency of your
+/// own. Everything of nalgebra's root is here (`SMatrix`, `SVector`, `matrix!`, …).
+///
+/// A module re-exporting nalgebra's root rather than `pub use nalgebra;`: rustdoc links a
+/// re-exported crate to the docs root that crate declares, and nalgebra 0.35 still declares
+/// 0.25's. Links rustdoc makes to nalgebra's items (e.g. `SMatrix` in a signature) follow
+/// the same root when the docs are built locally with `--no-deps`.
+pub mod nalgebra {
+    #[doc(no_inline)]
+    pub use ::nalgebra::*;
+}
+
+/// The traits a stepping loop calls methods through, in one import:
+/// `use aemstep::prelude::*;`.
+///
+/// - [`Stepper`]: `start`, `step`, `try_step`, `time_step` of every scheme.
+/// - [`Model`]: a nonlinear model's mass, force and tangent ([`Nonlinear`]).
+/// - [`HistoryModel`](crate::hysteresis::HistoryModel): a model whose history commits only
+///   with a successful step (the hysteretic building).
+/// - [`Law`](crate::hysteresis::Law): a hysteretic law's `trial` and `initial_history` (a
+///   specimen or a storey).
+/// - [`Compensator`](crate::hybrid::Compensator): an actuator delay compensator's `rest`
+///   and `command`.
+/// - [`Real`]: the scalar, `f32` or `f64`, for generic code.
+///
+/// ```
+/// use aemstep::prelude::*;
+/// use aemstep::{Linear, vector};
+///
+/// fn settle<T: Real, S: Stepper<T, 1, Input = aemstep::nalgebra::SVector<T, 1>>>(sys: &S, s: &mut S::State) {
+///     for _ in 0..10 {
+///         sys.step(s, &vector![T::zero()]);
+///     }
+/// }
+/// let sys = Linear::<f64, 1>::from_rows_f64([[1.0]], [[0.1]], [[4.0]], 0.01)?;
+/// let mut s = sys.start(&vector![0.01], &vector![0.0], &vector![0.0])?;
+/// settle(&sys, &mut s);
+/// assert_eq!(s.steps(), 10);
+/// # Ok::<(), aemstep::Error>(())
+/// ```
+pub mod prelude {
+    pub use crate::hybrid::Compensator;
+    pub use crate::hysteresis::{HistoryModel, Law};
+    pub use crate::{Model, Real, Stepper};
+}
 
 // `matrix!` and `vector!` (exported at the crate root) and the helper they expand to.
 mod macros;

@@ -68,6 +68,8 @@ class MalformedRecord(AemstepError):
 
     line: int  # the 1-based line where the problem was found
 
+class StiffnessIndefinite(AemstepError): ...
+
 def linear_response(
     m: F64,
     c: F64,

@@ -130,6 +130,7 @@ variants!(
     StateSizeMismatch,
     InputNotIdentifiable,
     MalformedRecord,
+    StiffnessIndefinite,
 );
 
 /// Why a run stopped: a library error (at a step, if a step failed) or a bad argument.

@@ -6,6 +6,8 @@
 //!   [`Split::command`] (the displacement of `t_{n+1}` from the committed state) and
 //!   [`Split::complete`] (the step finished with the measured restoring force). A missing
 //!   or NaN force is a typed error and changes nothing.
+//! - [`StoreySpecimen`]: a storey specimen on two degrees of freedom — the actuator command
+//!   `u_i − u_{i−1}` and the force vector `±f` (`docs/hybrid.md`).
 //! - [`Compensator`]: between the model's target and the actuator — [`Polynomial`]
 //!   extrapolation over a known delay (orders 1–3), [`Adaptive`] extrapolation over a delay
 //!   it estimates from the measured displacement.
@@ -21,4 +23,4 @@ mod split;
 
 pub use actuator::{Actuator, ActuatorState};
 pub use compensation::{Adaptive, Compensator, CompensatorState, Polynomial};
-pub use split::{Split, SplitState};
+pub use split::{Split, SplitState, StoreySpecimen};

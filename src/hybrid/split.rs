@@ -346,3 +346,124 @@ macro_rules! const_ctor {
 }
 const_ctor!(f32, from_rows_f32, from_rows_chen_ricles_f32);
 const_ctor!(f64, from_rows_f64, from_rows_chen_ricles_f64);
+
+/// A storey specimen on two degrees of freedom of a shear-type model, for [`Split`]: the
+/// mapping an experimental setup does (OpenFresco's, for one actuator across a storey)
+/// between the model's floor displacements and the one actuator and load cell of the
+/// specimen.
+///
+/// Storey `i` (`0 ≤ i < N`, DOFs ground storey first, as
+/// [`shear_building`](crate::models::shear_building)) joins floor `i − 1` below to floor
+/// `i` above; storey `0` joins the ground to floor `0`. With `L` the row `e_iᵀ − e_{i−1}ᵀ` (`e_{−1} = 0`):
+///
+/// ```text
+/// command (deformation):   d = L u = u_i − u_{i−1}            (u_{−1} = 0, the ground)
+/// restoring force:         r = Lᵀ f:  r_i = +f,  r_{i−1} = −f (storey 0: r_0 = f only)
+/// stiffness it adds:       Lᵀ k L:    +k at (i, i) and (i−1, i−1), −k at (i, i−1), (i−1, i)
+/// ```
+///
+/// `f` is the force the load cell reads, positive when it resists a positive deformation
+/// (for a linear specimen `f = k d`). `r` is the transpose of the command, so the specimen's
+/// work is the model's (`r · δu = f δd`); for `i > 0` its entries sum to zero (the storey is
+/// internal: no net force on the structure). Give [`Split`] `K_num` without the storey and
+/// `K` with [`StoreySpecimen::stiffness`] of its initial stiffness added; a linear specimen
+/// of stiffness `k` then reproduces the all-numerical model to rounding
+/// (`tests/storey_specimen.rs`).
+///
+/// ```
+/// use aemstep::hybrid::{Split, StoreySpecimen};
+/// use aemstep::models::{self, Rows};
+/// use aemstep::vector;
+///
+/// // 3 storeys (kg, N/m); storey 2 (index 1, between floors 0 and 1) is the specimen.
+/// let (m, k_all) = models::shear_building([1.0e5; 3], [1.0e8; 3]);
+/// let (_, k_num) = models::shear_building([1.0e5; 3], [1.0e8, 0.0, 1.0e8]);
+/// let storey = StoreySpecimen::<3>::new(1)?;
+/// let k = models::add(&k_num, &storey.stiffness(1.0e8)); // what the operators assume
+/// assert_eq!(k, k_all);
+/// let c = models::rayleigh(&m, &k, 0.0, 2e-3);
+/// let sys = Split::<f64, 3>::from_rows_f64(m, c, k, k_num, 1.0 / 1024.0, 0.9)?;
+/// let zero = vector![0.0, 0.0, 0.0];
+/// let mut s = sys.start(&zero, &zero, &zero, &zero)?;
+/// for n in 0..100 {
+///     let p = vector![0.0, 0.0, if n < 10 { 1.0e5 } else { 0.0 }]; // N, at the roof
+///     let d = storey.command(&sys.command(&s)); // m, to the actuator across storey 2
+///     let f = 1.0e8 * d; // N, the load cell (here a linear specimen)
+///     sys.complete(&mut s, &storey.force(f), &p)?;
+/// }
+/// let r = storey.force(1.0);
+/// assert_eq!((r[0], r[1], r[2]), (-1.0, 1.0, 0.0));
+/// # Ok::<(), aemstep::Error>(())
+/// ```
+///
+/// Cost: [`StoreySpecimen::command`] one subtraction, [`StoreySpecimen::force`] `N`
+/// stores; no allocation, no panic. Size: one `usize`.
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StoreySpecimen<const N: usize> {
+    storey: usize,
+}
+
+impl<const N: usize> StoreySpecimen<N> {
+    /// The specimen is storey `storey` (`0 ≤ storey < N`; `0` stands on the ground).
+    ///
+    /// Errors: [`Error::InvalidParameter`] for `storey ≥ N`. Cost: O(1); `const`.
+    pub const fn new(storey: usize) -> Result<Self, Error> {
+        if storey >= N {
+            return Err(Error::InvalidParameter);
+        }
+        Ok(Self { storey })
+    }
+
+    /// The storey index `i` (the specimen joins DOF `i − 1`, or the ground for `i = 0`, to
+    /// DOF `i`). Cost: none.
+    pub const fn storey(&self) -> usize {
+        self.storey
+    }
+
+    /// The actuator command, the storey's deformation `u_i − u_{i−1}` (m when `u` is), of
+    /// the floor displacements `u` (e.g. [`Split::command`]'s). Cost: one subtraction.
+    pub fn command<T: Real>(&self, u: &SVector<T, N>) -> T {
+        let i = self.storey;
+        match i.checked_sub(1) {
+            Some(below) => u[i] - u[below],
+            None => u[i],
+        }
+    }
+
+    /// The restoring force vector (N when `f` is) of a load-cell force `f`: `+f` on DOF
+    /// `i`, `−f` on DOF `i − 1` (none for the ground storey), zero elsewhere; the `r` of
+    /// [`Split::complete`] (add those of several specimens with
+    /// [`StoreySpecimen::add_force`]). Cost: `N` stores.
+    pub fn force<T: Real>(&self, f: T) -> SVector<T, N> {
+        let mut r = SVector::<T, N>::zeros();
+        self.add_force(&mut r, f);
+        r
+    }
+
+    /// Add the force vector of [`StoreySpecimen::force`] to `r` (several specimens, or a
+    /// specimen beside a numerical nonlinear part). Cost: two additions.
+    pub fn add_force<T: Real>(&self, r: &mut SVector<T, N>, f: T) {
+        let i = self.storey;
+        r[i] += f;
+        if let Some(below) = i.checked_sub(1) {
+            r[below] -= f;
+        }
+    }
+
+    /// The stiffness matrix `Lᵀ k L` (row-major, N/m when `k` is) a storey spring of
+    /// stiffness `k` adds to the model's: add the specimen's initial stiffness to `K_num`
+    /// for the `K` the [`Split`] operators assume ([`models::add`](crate::models::add)).
+    /// Cost: `N²` stores; `const`.
+    pub const fn stiffness(&self, k: f64) -> crate::models::Rows<N> {
+        let mut a = [[0.0; N]; N];
+        let i = self.storey;
+        a[i][i] = k;
+        if i > 0 {
+            a[i - 1][i - 1] = k;
+            a[i][i - 1] = -k;
+            a[i - 1][i] = -k;
+        }
+        a
+    }
+}

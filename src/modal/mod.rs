@@ -180,7 +180,10 @@ pub struct Modal<T, const N: usize, const R: usize, const I: usize = 1, const O:
 /// sums of squares inside Cholesky and Jacobi neither overflow nor underflow for any
 /// finite data (`s = 1e±300` gives the modes of `s = 1`); the scales are undone on `ω²`
 /// and `Φ` at the end. [`Error::OperatorOverflow`] if `ω²` or `Φ` then overflows `f64`.
-const fn modes_of<const N: usize>(m: &Rows<N>, k: &Rows<N>) -> Result<([f64; N], Rows<N>), Error> {
+pub(crate) const fn modes_of<const N: usize>(
+    m: &Rows<N>,
+    k: &Rows<N>,
+) -> Result<([f64; N], Rows<N>), Error> {
     if !is_symmetric(m, SYMMETRY_TOL) {
         return Err(Error::MassNotSpd);
     }
