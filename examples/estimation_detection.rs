@@ -82,10 +82,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let drifts = Readout::<f64, 10, 1, 5>::new(
         &ss.outputs(&Outputs::<5, 1, 5>::displacements(models::storey_drifts()))?,
     )?;
-    // The detector on the estimator's residual: 4 sensors, 1 direction spent on the force.
-    let detector = Detector::<f64, 4, WINDOW>::new(
+    // The detector on the estimator's residual: 4 sensors, 1 direction spent on the force
+    // (the test takes its 4 − 1 degrees of freedom a sample from the estimator's type).
+    let detector = Detector::<f64, 4, WINDOW>::from_parts(
         Whitener::new(&gains.innovation_covariance)?,
-        ChiSquareTest::new(3, ALPHA)?,
+        ChiSquareTest::new(&est, ALPHA)?,
     );
 
     let run = |k_true: &Rows<5>| -> Result<Run, aemstep::Error> {
@@ -94,7 +95,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut w = 0.0; // N, the unknown force
         let mut s = truth.start(&zero, &zero, &vector![w])?;
         let mut e = est.start_at_rest();
-        let mut win = Window::<WINDOW>::new();
+        let mut win = Window::<f64, WINDOW>::at_rest();
         let (mut g, mut noise) = (Gauss(0x9E37_79B9_7F4A_7C15), Gauss(0x2545_F491_4F6C_DD1D));
         let (mut sf, mut sw, mut sd) = (0.0, 0.0, [0.0; 5]);
         let mut alarm = None;
@@ -148,7 +149,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          χ² test: {WINDOW} samples, α = {ALPHA:e}, threshold {:.1}",
         SIGMA_D * 1e6,
         STEPS as f64 * H,
-        ChiSquareTest::<WINDOW>::new(3, ALPHA)?.threshold()
+        ChiSquareTest::<f64, WINDOW>::new(&est, ALPHA)?.threshold()
     );
     println!(
         "{:<26} {:>12} {:>18} {:>44} {:>14}",

@@ -172,6 +172,8 @@ pub enum Param {
     CusumDrift,
     /// A model bank's number of models `M` (`≥ 1`).
     BankSize,
+    /// A storey index outside the model (`0 ≤ i < N`, `0` the storey on the ground).
+    Storey,
     /// A law's initial stiffness `k` (finite, `> 0`).
     Stiffness,
     /// A law's yield force `f_y`, or a yield strength (finite, `> 0`, its yield displacement normal).
@@ -231,6 +233,7 @@ impl Param {
             }
             Param::CusumDrift => "the CUSUM lambda must be finite and > 1",
             Param::BankSize => "a model bank needs M >= 1 models",
+            Param::Storey => "the storey index must be below the number of storeys N",
             Param::Stiffness => "the stiffness k must be finite and > 0",
             Param::YieldForce => "the yield force must be finite and > 0",
             Param::PostYieldRatio => "the post-yield ratio alpha must be in [0, 1)",

@@ -8,7 +8,7 @@
 use aemstep::hybrid::{Split, StoreySpecimen};
 use aemstep::models::{self, Rows, base_excitation};
 use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::{Error, KrAlpha, Real, Stepper};
+use aemstep::{Error, KrAlpha, Param, Real, Stepper};
 
 const EPS: f64 = f64::EPSILON;
 const B: (Rows<5>, Rows<5>, Rows<5>) = models::five_storey_building();
@@ -63,8 +63,14 @@ fn mapping_is_the_storey_incidence_and_in_equilibrium() {
         k = models::add(&k, &StoreySpecimen::<5>::new(i).unwrap().stiffness(K1));
     }
     assert_eq!(k, B.2);
-    assert_eq!(StoreySpecimen::<5>::new(5), Err(Error::InvalidParameter));
-    assert_eq!(StoreySpecimen::<0>::new(0), Err(Error::InvalidParameter));
+    assert_eq!(
+        StoreySpecimen::<5>::new(5),
+        Err(Error::InvalidParameter(Param::Storey))
+    );
+    assert_eq!(
+        StoreySpecimen::<0>::new(0),
+        Err(Error::InvalidParameter(Param::Storey))
+    );
     const TOP: StoreySpecimen<5> = aemstep::unwrap_const!(StoreySpecimen::new(4));
     assert_eq!(TOP.storey(), 4);
 }

@@ -5,7 +5,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::linalg::rows_f64;
 use crate::schemes::kr_alpha::{CHEN_RICLES, kr_operators};
-use crate::{AlphaParameters, Error, KrAlpha, Real, State, StepInput, Stepper};
+use crate::{AlphaParameters, Error, KrAlpha, Param, Real, State, StepInput, Stepper};
 
 /// A KR-α step split in two for real-time hybrid simulation: the displacement command of
 /// `t_{n+1}` from the committed state, then the step completed with the restoring force
@@ -410,7 +410,7 @@ impl<const N: usize> StoreySpecimen<N> {
     /// Errors: [`Error::InvalidParameter`] for `storey ≥ N`. Cost: O(1); `const`.
     pub const fn new(storey: usize) -> Result<Self, Error> {
         if storey >= N {
-            return Err(Error::InvalidParameter);
+            return Err(Error::InvalidParameter(Param::Storey));
         }
         Ok(Self { storey })
     }
