@@ -107,6 +107,10 @@ pub enum Error {
         /// the line after its last.
         line: u32,
     },
+    /// An estimator's step counter (or its count of missing samples) would pass
+    /// `u64::MAX`: a checked step refuses rather than wrap to zero; the estimate was left
+    /// unchanged. Start a new estimate (with the old one's state) to go on.
+    StepCountOverflow,
 }
 
 impl Error {
@@ -167,6 +171,9 @@ impl Error {
             }
             Error::MalformedRecord { .. } => {
                 "malformed record: header, value count or a value that is not a number"
+            }
+            Error::StepCountOverflow => {
+                "an estimator's step or missing-sample count would pass u64::MAX; state unchanged"
             }
         }
     }

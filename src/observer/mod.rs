@@ -31,12 +31,17 @@
 
 mod fixed;
 mod kalman;
+// The one Kalman core: the correction and the Riccati equation with the cross covariance.
+mod kalman_core;
 mod riccati;
 mod state_space;
 
 pub use fixed::{Estimate, Observer, Readout};
 pub use kalman::{Kalman, KalmanState};
 // For the joint input–state estimators (`crate::estimation`).
+pub(crate) use kalman_core::{
+    cross_is_valid, cross_riccati_start, gain_t, innovation_parts, innovation_t, is_zero,
+};
 pub(crate) use riccati::{A_SMALL, balance, doubling, inf_norm, is_covariance, symmetrize};
 pub use riccati::{RICCATI_MAX_ITERATIONS, RICCATI_RESIDUAL_UNITS, SteadyState};
 pub(crate) use state_space::lu_of;
