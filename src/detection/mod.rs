@@ -94,15 +94,16 @@ const NIS_SCALE: f64 = (1u64 << NIS_FRACTION_BITS) as f64;
 /// the gain was solved with). With a process–measurement cross covariance `N`
 /// ([`SteadyState::from_parts_cross`], held in [`SteadyState::cross`]) it is
 /// `S = H P Hᵀ + R + H N + Nᵀ Hᵀ`: the force noise that also reaches the sensors
-/// (`docs/observer.md`, "Noise that reaches the sensors"); a zero `N` gives the first
-/// form bit for bit. `const fn`. Errors: [`Error::InvalidCovariance`] (`r` not finite),
+/// ([observer](crate::observer), "Noise that reaches the sensors"); a zero `N` gives the first
+/// form bit for bit. `const fn`. Errors: [`Error::InvalidCovariance`] (`r` or `N` not
+/// finite),
 /// [`Error::OperatorOverflow`] (`S` not finite). Cost: `O·S·(S + O)` flops.
 pub const fn innovation_covariance<const S: usize, const I: usize, const O: usize>(
     kf: &SteadyState<S, O>,
     meas: &Measurement<S, I, O>,
     r: &[[f64; O]; O],
 ) -> Result<[[f64; O]; O], Error> {
-    if !all_finite(r) {
+    if !all_finite(r) || !all_finite(&kf.cross) {
         return Err(Error::InvalidCovariance);
     }
     // The one Kalman core's innovation covariance (the cross term only where N ≠ 0).

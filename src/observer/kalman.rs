@@ -46,7 +46,7 @@ impl<T: Real, const S: usize, const I: usize> KalmanState<T, S, I> {
 /// With a process–measurement cross covariance `N = E q_n r_nᵀ` ([`Kalman::with_cross`]:
 /// a force noise that also reaches the sensors through the feedthrough) the correction is
 /// `K = (P⁻ Hᵀ + N) Σ⁻¹`, `Σ = H P⁻ Hᵀ + R + H N + Nᵀ Hᵀ`, and the Joseph form gains
-/// `− (I − K H) N Kᵀ − K Nᵀ (I − K H)ᵀ` (`docs/observer.md`, "Noise that reaches the
+/// `− (I − K H) N Kᵀ − K Nᵀ (I − K H)ᵀ` ([module docs](super), "Noise that reaches the
 /// sensors").
 ///
 /// Cost of a step: about `3S³ + 3S²·O + 2S·O² + O³/6` multiply-adds (`≈ 3 900` for

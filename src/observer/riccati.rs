@@ -472,7 +472,8 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
     /// ([`StateSpace::input_cross_noise`], with [`StateSpace::feedthrough_noise`] in `r`).
     /// The gain is `L = (P Hᵀ + N) Σ⁻¹`, `Σ = H P Hᵀ + R + H N + Nᵀ Hᵀ` (the innovation
     /// covariance), `P` the a-priori covariance of the Riccati equation with the cross term
-    /// (noise model and derivation: `docs/observer.md`, "Noise that reaches the sensors").
+    /// (noise model and derivation: the [observer module docs](super), "Noise that reaches
+    /// the sensors").
     /// `n = 0` (every entry zero) is [`SteadyState::from_parts`], bit for bit. `const fn`.
     ///
     /// Errors: as [`SteadyState::from_parts`]; [`Error::InvalidCovariance`] also when `n`

@@ -852,7 +852,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// have a feedthrough of the noise input (accelerometers under unmodelled floor
     /// forces) the measurement noise is correlated with `q_n`: give the filters
     /// [`StateSpace::input_cross_noise`] as their cross covariance and add
-    /// [`StateSpace::feedthrough_noise`] to `R` (`docs/observer.md`, "Noise that reaches
+    /// [`StateSpace::feedthrough_noise`] to `R` ([module docs](super), "Noise that reaches
     /// the sensors", derives it and checks it by simulation).
     pub const fn input_noise(&self, qw: &[[f64; I]; I]) -> [[f64; S]; S] {
         let g = add_scaled(&self.gamma0, 1.0, &self.gamma1);
