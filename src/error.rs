@@ -113,6 +113,10 @@ pub enum Error {
     /// with `ω² < 0`): the model is unstable and has no real natural frequency
     /// ([`models::natural_frequencies`](crate::models::natural_frequencies)).
     StiffnessIndefinite,
+    /// An estimator's step counter (or its count of missing samples) would pass
+    /// `u64::MAX`: a checked step refuses rather than wrap to zero; the estimate was left
+    /// unchanged. Start a new estimate (with the old one's state) to go on.
+    StepCountOverflow,
 }
 
 /// Which parameter an [`Error::InvalidParameter`] or [`Error::InvalidMaterial`] names; its
@@ -311,6 +315,9 @@ impl Error {
             }
             Error::StiffnessIndefinite => {
                 "the stiffness matrix K is not positive semidefinite: no real natural frequency"
+            }
+            Error::StepCountOverflow => {
+                "an estimator's step or missing-sample count would pass u64::MAX; state unchanged"
             }
         }
     }

@@ -1198,6 +1198,7 @@ fn innovation_covariance_symmetrized_near_max_overflows() {
         covariance: [[1.0, 0.0], [0.0, 1.0]],
         gain: [[0.0], [0.0]],
         iterations: 1,
+        cross: [[0.0], [0.0]],
     };
     let meas = Measurement::<2, 1, 1> {
         h: [[0.0, 0.0]],

@@ -70,6 +70,7 @@ from ._aemstep import (  # noqa: F401  (re-exported)
     SingularJacobian,
     SingularMass,
     StateSizeMismatch,
+    StepCountOverflow,
     StiffnessIndefinite,
     StiffnessNotSymmetric,
     UnsupportedSize,

@@ -69,6 +69,7 @@ class MalformedRecord(AemstepError):
     line: int  # the 1-based line where the problem was found
 
 class StiffnessIndefinite(AemstepError): ...
+class StepCountOverflow(AemstepError): ...
 
 def linear_response(
     m: F64,

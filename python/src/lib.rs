@@ -131,6 +131,7 @@ variants!(
     InputNotIdentifiable,
     MalformedRecord,
     StiffnessIndefinite,
+    StepCountOverflow,
 );
 
 /// Why a run stopped: a library error (at a step, if a step failed) or a bad argument.

@@ -89,7 +89,7 @@ use core::marker::PhantomData;
 use nalgebra::SVector;
 
 use crate::linalg::cholesky::{cholesky, lower_solve};
-use crate::linalg::{Mat, add_scaled, all_finite, finite_as, identity, mul, round_rows, transpose};
+use crate::linalg::{Mat, all_finite, finite_as, identity, round_rows};
 use crate::observer::{Measurement, SteadyState};
 use crate::scalar::sealed::Sealed;
 use crate::{Error, Param, Real};
@@ -103,18 +103,28 @@ const NIS_SCALE: f64 = (1u64 << NIS_FRACTION_BITS) as f64;
 
 /// The innovation covariance `S = H P Hᵀ + R` (`O×O`, output units squared) of the
 /// steady-state Kalman filter `kf` of a measurement `meas` with noise `r` (the same `R`
-/// the gain was solved with). `const fn`. Errors: [`Error::InvalidCovariance`] (`r`
-/// not finite), [`Error::OperatorOverflow`] (`S` not finite). Cost: `O·S·(S + O)` flops.
+/// the gain was solved with). With a process–measurement cross covariance `N`
+/// ([`SteadyState::from_parts_cross`], held in [`SteadyState::cross`]) it is
+/// `S = H P Hᵀ + R + H N + Nᵀ Hᵀ`: the force noise that also reaches the sensors
+/// ([observer](crate::observer), "Noise that reaches the sensors"); a zero `N` gives the first
+/// form bit for bit. `const fn`. Errors: [`Error::InvalidCovariance`] (`r` or `N` not
+/// finite),
+/// [`Error::OperatorOverflow`] (`S` not finite). Cost: `O·S·(S + O)` flops.
 pub const fn innovation_covariance<const S: usize, const I: usize, const O: usize>(
     kf: &SteadyState<S, O>,
     meas: &Measurement<S, I, O>,
     r: &[[f64; O]; O],
 ) -> Result<[[f64; O]; O], Error> {
-    if !all_finite(r) {
+    if !all_finite(r) || !all_finite(&kf.cross) {
         return Err(Error::InvalidCovariance);
     }
-    let hp = mul(&meas.h, &kf.covariance);
-    let s = add_scaled(r, 1.0, &mul(&hp, &transpose(&meas.h)));
+    // The one Kalman core's innovation covariance (the cross term only where N ≠ 0).
+    let cross = if crate::observer::is_zero(&kf.cross) {
+        None
+    } else {
+        Some(&kf.cross)
+    };
+    let (_, s) = crate::observer::innovation_parts(&kf.covariance, &meas.h, r, cross);
     if !all_finite(&s) {
         return Err(Error::OperatorOverflow);
     }

@@ -41,6 +41,9 @@ pub struct AugmentedModel<const S: usize, const I: usize, const Z: usize, const 
     pub measurement: Measurement<Z, 0, O>,
     /// `diag(Q, Q_w)` (`Z×Z`).
     pub process_noise: [[f64; Z]; Z],
+    /// `[N; 0]` (`Z×O`): the cross covariance of the process noise with the measurement
+    /// noise (zero from [`AugmentedModel::from_parts`]; [`AugmentedModel::from_parts_cross`]).
+    pub cross_noise: [[f64; O]; Z],
     /// `Γ₁` of the physical state `x = ξ + Γ₁ w`.
     pub gamma1: [[f64; I]; S],
 }
@@ -51,21 +54,47 @@ impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedMo
     /// step; it sets how fast the force estimate may move). `const fn`.
     ///
     /// Errors: [`Error::StateSizeMismatch`] (`Z ≠ S + I`), [`Error::InvalidCovariance`],
-    /// [`Error::NonFiniteInput`]. Cost: `O(Z²)`.
+    /// [`Error::NonFiniteInput`] (a non-finite `A`, `B`, `C`, `D̃` or `Γ₁`). Cost: `O(Z²)`.
     pub const fn from_parts(
         m: &InputModel<S, I, O>,
         q: &[[f64; S]; S],
         qw: &[[f64; I]; I],
     ) -> Result<Self, Error> {
+        Self::from_parts_cross(m, q, qw, &[[0.0; O]; S])
+    }
+
+    /// [`AugmentedModel::from_parts`] with a cross covariance `n = E q_n r_nᵀ` (`S×O`) of
+    /// the process noise on `ξ` with the measurement noise (unmodelled forces that also
+    /// reach the sensors, [`StateSpace::input_cross_noise`]; the random walk's noise is
+    /// taken independent of the sensors'): the augmented model's is `[N; 0]`, which
+    /// [`AugmentedModel::steady_state`] passes to [`SteadyState::from_parts_cross`].
+    /// `n = 0` is [`AugmentedModel::from_parts`]. `const fn`.
+    ///
+    /// Errors: as [`AugmentedModel::from_parts`] (a non-finite `n`:
+    /// [`Error::InvalidCovariance`]; whether `[Q N; Nᵀ R]` is a covariance is checked with
+    /// `R` by [`AugmentedModel::steady_state`]). Cost: `O(Z²)`.
+    pub const fn from_parts_cross(
+        m: &InputModel<S, I, O>,
+        q: &[[f64; S]; S],
+        qw: &[[f64; I]; I],
+        n: &[[f64; O]; S],
+    ) -> Result<Self, Error> {
         if Z != S + I {
             return Err(Error::StateSizeMismatch);
         }
-        if !(is_covariance(q, false) && is_covariance(qw, false)) {
+        if !(is_covariance(q, false) && is_covariance(qw, false) && all_finite(n)) {
             return Err(Error::InvalidCovariance);
         }
-        if !(all_finite(&m.a) && all_finite(&m.b) && all_finite(&m.c) && all_finite(&m.d)) {
+        // Γ₁ too: `split` forms x̂ = ξ̂ + Γ₁ ŵ from it (a NaN there gave NaN states).
+        if !(all_finite(&m.a)
+            && all_finite(&m.b)
+            && all_finite(&m.c)
+            && all_finite(&m.d)
+            && all_finite(&m.gamma1))
+        {
             return Err(Error::NonFiniteInput);
         }
+        let mut cross: Mat<Z, O> = [[0.0; O]; Z];
         let mut phi: Mat<Z, Z> = [[0.0; Z]; Z];
         let mut pn: Mat<Z, Z> = [[0.0; Z]; Z];
         let mut h: Mat<O, Z> = [[0.0; Z]; O];
@@ -75,6 +104,11 @@ impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedMo
             while j < S {
                 phi[i][j] = m.a[i][j];
                 pn[i][j] = q[i][j];
+                j += 1;
+            }
+            let mut j = 0;
+            while j < O {
+                cross[i][j] = n[i][j];
                 j += 1;
             }
             let mut j = 0;
@@ -124,22 +158,31 @@ impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedMo
                 d: [[0.0; 0]; O],
             },
             process_noise: pn,
+            cross_noise: cross,
             gamma1: m.gamma1,
         })
     }
 
     /// The steady-state Kalman gain of the augmented model with measurement noise `r`
-    /// ([`SteadyState::from_parts`], `const fn`), for an
+    /// ([`SteadyState::from_parts_cross`] with [`AugmentedModel::cross_noise`], which is
+    /// [`SteadyState::from_parts`] where it is zero; `const fn`), for an
     /// [`Observer`](crate::observer::Observer) on `(self.model, self.measurement)`.
     ///
     /// Errors: [`Error::InputNotIdentifiable`] where the Riccati equation has no
     /// stabilizing solution (the random walk not detectable: an invariant zero at `z = 1`,
     /// acceleration-only sensing), and the other errors of [`SteadyState::from_parts`]
-    /// ([`Error::InvalidCovariance`], [`Error::OperatorOverflow`]).
+    /// ([`Error::InvalidCovariance`] — also `[Q N; Nᵀ R]` not a covariance —,
+    /// [`Error::OperatorOverflow`]).
     ///
     /// Cost: that of [`SteadyState::from_parts`] with `S = Z`.
     pub const fn steady_state(&self, r: &[[f64; O]; O]) -> Result<SteadyState<Z, O>, Error> {
-        match SteadyState::from_parts(&self.model, &self.measurement, &self.process_noise, r) {
+        match SteadyState::from_parts_cross(
+            &self.model,
+            &self.measurement,
+            &self.process_noise,
+            r,
+            &self.cross_noise,
+        ) {
             Ok(s) => Ok(s),
             Err(Error::RiccatiNotConverged) => Err(Error::InputNotIdentifiable),
             Err(e) => Err(e),
@@ -158,5 +201,38 @@ impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedMo
             s
         });
         (x, w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models;
+    use crate::observer::Outputs;
+
+    /// Regression: `from_parts` did not check `Γ₁`, and a NaN there gave NaN states from
+    /// `split`; it is now refused with a typed error.
+    #[test]
+    fn augmented_model_refuses_a_non_finite_gamma1() {
+        let (m, c, k) = models::five_storey_building();
+        let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
+        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02).unwrap();
+        let mut out = Outputs::<5, 1, 2>::zero();
+        out.a[0][4] = 1.0;
+        out.u[1][4] = 1.0;
+        let mut model = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
+        let q = [[0.0; 10]; 10];
+        let qw = [[1.0]];
+        assert!(AugmentedModel::<10, 1, 11, 2>::from_parts(&model, &q, &qw).is_ok());
+        model.gamma1[3][0] = f64::NAN;
+        assert_eq!(
+            AugmentedModel::<10, 1, 11, 2>::from_parts(&model, &q, &qw),
+            Err(Error::NonFiniteInput)
+        );
+        model.gamma1[3][0] = f64::INFINITY;
+        assert_eq!(
+            AugmentedModel::<10, 1, 11, 2>::from_parts(&model, &q, &qw),
+            Err(Error::NonFiniteInput)
+        );
     }
 }

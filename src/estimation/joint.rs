@@ -8,6 +8,9 @@ use super::InputModel;
 use crate::linalg::{self, Mat, add_scaled, all_finite, finite_as, identity, max_abs, mul};
 use crate::linalg::{matrix_t, round_rows, rows_f64, sym, transpose};
 use crate::observer::{A_SMALL, balance, doubling, inf_norm, is_covariance, lu_of, symmetrize};
+use crate::observer::{
+    cross_is_valid, cross_riccati_start, gain_t, innovation_parts, innovation_t, is_zero,
+};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
 
@@ -52,15 +55,17 @@ pub struct InputStateGains<const S: usize, const I: usize, const O: usize> {
 }
 
 /// The gains of one step from an a-priori covariance `p`: `(K, M, Pʷ, R̃)`, or `None` if
-/// `R̃` or `D̃ᵀ R̃⁻¹ D̃` is singular.
+/// `R̃` or `D̃ᵀ R̃⁻¹ D̃` is singular. With a cross covariance `n`, `R̃` and `K` carry it
+/// (the Kalman core's [`innovation_parts`]).
 #[allow(clippy::type_complexity)]
 const fn step_gains<const S: usize, const I: usize, const O: usize>(
     m: &InputModel<S, I, O>,
     p: &Mat<S, S>,
     r: &Mat<O, O>,
+    n: Option<&Mat<S, O>>,
 ) -> Option<(Mat<S, O>, Mat<I, O>, Mat<I, I>, Mat<O, O>)> {
-    let cp = mul(&m.c, p);
-    let rt = symmetrize(&add_scaled(r, 1.0, &mul(&cp, &transpose(&m.c))));
+    let (cp, rt) = innovation_parts(p, &m.c, r, n);
+    let rt = symmetrize(&rt);
     let lu = match lu_of(&rt) {
         Some(lu) => lu,
         None => return None,
@@ -102,6 +107,62 @@ const fn recursion_step<const S: usize, const I: usize, const O: usize>(
 /// `−a`.
 const fn scaled_neg<const R: usize, const C: usize>(a: &Mat<R, C>) -> Mat<R, C> {
     linalg::scaled(-1.0, a)
+}
+
+/// The doubling's start for the steady joint filter with a cross covariance `n` (module
+/// docs, "Noise that reaches the sensors"): with `R₁ = C Q Cᵀ + R + C N + Nᵀ Cᵀ` and
+/// `Π₁ = R₁⁻¹ − R₁⁻¹ D̃ (D̃ᵀ R₁⁻¹ D̃)⁻¹ D̃ᵀ R₁⁻¹`, the Kalman core's predictor form on
+/// `(Ā, C)` with `Q_y = Ā Q Āᵀ + B F₀⁻¹ Bᵀ − Ā N M₀ᵀ Bᵀ − B M₀ Nᵀ Āᵀ`,
+/// `S_y = Ā (Q Cᵀ + N) − B M₀ Nᵀ Cᵀ` and the weight `Π₁`.
+#[allow(clippy::type_complexity)]
+const fn cross_start<const S: usize, const I: usize, const O: usize>(
+    m: &InputModel<S, I, O>,
+    q: &Mat<S, S>,
+    r: &Mat<O, O>,
+    n: &Mat<S, O>,
+    abar: &Mat<S, S>,
+    m0: &Mat<I, O>,
+    f0inv: &Mat<I, I>,
+) -> Result<(Mat<S, S>, Mat<S, S>, Mat<S, S>), Error> {
+    if !cross_is_valid(q, r, n) {
+        return Err(Error::InvalidCovariance);
+    }
+    let (xt, r1) = innovation_parts(q, &m.c, r, Some(n));
+    let lu1 = match lu_of(&symmetrize(&r1)) {
+        Some(lu) => lu,
+        None => return Err(Error::InvalidCovariance),
+    };
+    let r1d = lu1.solve(&m.d);
+    let f1 = symmetrize(&mul(&transpose(&m.d), &r1d));
+    let luf = match lu_of(&f1) {
+        Some(lu) => lu,
+        None => return Err(Error::InputNotIdentifiable),
+    };
+    let pi = symmetrize(&add_scaled(
+        &lu1.inverse(),
+        -1.0,
+        &mul(&r1d, &luf.solve(&transpose(&r1d))),
+    ));
+    let bm0 = mul(&m.b, m0);
+    let anb = mul(abar, &mul(n, &transpose(&bm0)));
+    let qy = symmetrize(&add_scaled(
+        &add_scaled(
+            &mul(abar, &mul(q, &transpose(abar))),
+            1.0,
+            &mul(&m.b, &mul(f0inv, &transpose(&m.b))),
+        ),
+        -1.0,
+        &add_scaled(&anb, 1.0, &transpose(&anb)),
+    ));
+    let sy = add_scaled(
+        &mul(abar, &transpose(&xt)),
+        -1.0,
+        &mul(&bm0, &mul(&transpose(n), &transpose(&m.c))),
+    );
+    if !(all_finite(&qy) && all_finite(&sy) && all_finite(&pi)) {
+        return Err(Error::OperatorOverflow);
+    }
+    Ok(cross_riccati_start(abar, &m.c, &qy, &sy, &pi))
 }
 
 /// The steady filter's error dynamics `E` certified stable within [`ZERO_SQUARINGS`]
@@ -150,9 +211,45 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
         q: &[[f64; S]; S],
         r: &[[f64; O]; O],
     ) -> Result<Self, Error> {
+        Self::solve_with(model, q, r, None)
+    }
+
+    /// [`InputStateGains::solve`] with a process–measurement cross covariance
+    /// `n = E q_n r_nᵀ` (`S×O`): the process noise on `ξ` correlated with the measurement
+    /// noise of the same sample (unmodelled floor forces that also reach the
+    /// accelerometers: [`StateSpace::input_cross_noise`](crate::observer::StateSpace::input_cross_noise)
+    /// of the forces' model, with its
+    /// [`feedthrough_noise`](crate::observer::StateSpace::feedthrough_noise) in `r`). The
+    /// step's `R̃ = C P⁻ Cᵀ + R + C N + Nᵀ C` and `K = (P⁻ Cᵀ + N) R̃⁻¹` ([module
+    /// docs](super), "Noise that reaches the sensors"); `n = 0` is
+    /// [`InputStateGains::solve`], bit for bit. `const fn`.
+    ///
+    /// Errors: as [`InputStateGains::solve`]; [`Error::InvalidCovariance`] also when `n` is
+    /// not finite or `[q n; nᵀ r]` is not a covariance. Cost: as
+    /// [`InputStateGains::solve`] plus `O(S²·O + S·O² + O³)`.
+    pub const fn solve_cross(
+        model: &InputModel<S, I, O>,
+        q: &[[f64; S]; S],
+        r: &[[f64; O]; O],
+        n: &[[f64; O]; S],
+    ) -> Result<Self, Error> {
+        Self::solve_with(model, q, r, Some(n))
+    }
+
+    const fn solve_with(
+        model: &InputModel<S, I, O>,
+        q: &[[f64; S]; S],
+        r: &[[f64; O]; O],
+        n: Option<&[[f64; O]; S]>,
+    ) -> Result<Self, Error> {
         if !is_covariance(q, false) {
             return Err(Error::InvalidCovariance);
         }
+        // A zero cross covariance takes the original path (bit-identical).
+        let n = match n {
+            Some(m) if is_zero(m) => None,
+            other => other,
+        };
         let (f0, rd) = match model.weighted_feedthrough(r) {
             Ok(v) => v,
             Err(e) => return Err(e),
@@ -179,15 +276,28 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
         if !(all_finite(&abar) && all_finite(&qbar) && all_finite(&g)) {
             return Err(Error::OperatorOverflow);
         }
-        // The doubling algorithm (as `SteadyState`): A₀ = Āᵀ, G₀ = G, X₀ = Q̄.
-        let (x, k, converged) = match doubling(transpose(&abar), g, qbar, STEADY_MAX_ITERATIONS) {
+        // The doubling algorithm (as `SteadyState`): A₀ = Āᵀ, G₀ = G, X₀ = Q̄; with a cross
+        // covariance the Kalman core's predictor form on the zero dynamics (module docs).
+        let start = match n {
+            None => (transpose(&abar), g, qbar),
+            Some(n) => match cross_start(model, q, r, n, &abar, &m0, &f0inv) {
+                Ok(v) => v,
+                Err(e) => return Err(e),
+            },
+        };
+        let (x, k, converged) = match doubling(start.0, start.1, start.2, STEADY_MAX_ITERATIONS) {
             Some(v) => v,
             None => return Err(Error::InputNotIdentifiable),
         };
         if !(converged && is_covariance(&x, false)) {
             return Err(Error::InputNotIdentifiable);
         }
-        let (kx, gm, pw, rt) = match step_gains(model, &x, r) {
+        // With the cross term the doubling solved for Y: P⁻ = Y + Q.
+        let x = match n {
+            None => x,
+            Some(_) => symmetrize(&add_scaled(&x, 1.0, &symmetrize(q))),
+        };
+        let (kx, gm, pw, rt) = match step_gains(model, &x, r, n) {
             Some(v) => v,
             None => return Err(Error::InputNotIdentifiable),
         };
@@ -206,6 +316,7 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
             return Err(Error::InputNotIdentifiable);
         }
         let next = recursion_step(model, q, &x, &kx, &pw, &rt);
+        // (With N the step's gains carry it; the recursion's form is unchanged.)
         let res = max_abs(&add_scaled(&next, -1.0, &x));
         // (NaN fails too.)
         if res.is_nan() || res > STEADY_RESIDUAL * max_abs(&x) {
@@ -230,6 +341,18 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
         r: &SMatrix<f64, O, O>,
     ) -> Result<Self, Error> {
         Self::solve(model, &rows_f64(q), &rows_f64(r))
+    }
+
+    /// [`InputStateGains::solve_cross`] with `nalgebra` matrices (run time; same numbers).
+    ///
+    /// Errors and cost: as [`InputStateGains::solve_cross`].
+    pub fn new_cross(
+        model: &InputModel<S, I, O>,
+        q: &SMatrix<f64, S, S>,
+        r: &SMatrix<f64, O, O>,
+        n: &SMatrix<f64, S, O>,
+    ) -> Result<Self, Error> {
+        Self::solve_cross(model, &rows_f64(q), &rows_f64(r), &rows_f64(n))
     }
 
     /// `K` as a `nalgebra` matrix.
@@ -340,6 +463,19 @@ pub(super) fn shift<T: Real, const S: usize, const I: usize>(
     })
 }
 
+/// The checked steps' counters: room for one more step and, if `y` is missing, one more
+/// missing sample. Errors: [`Error::StepCountOverflow`].
+pub(super) fn check_counts<T: Real, const S: usize, const I: usize, const O: usize>(
+    e: &JointEstimate<T, S, I>,
+    y: &SVector<T, O>,
+) -> Result<(), Error> {
+    if e.n == u64::MAX || (e.missing == u64::MAX && !y.iter().all(|v| v.is_finite())) {
+        Err(Error::StepCountOverflow)
+    } else {
+        Ok(())
+    }
+}
+
 /// The start of a joint estimate: `ξ̂_0 = x0 − Γ₁ w0`, `ŵ_0 = w0`, all finite.
 pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
     gamma1: &[[T; I]; S],
@@ -372,7 +508,7 @@ pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
 ///
 /// Cost of a step: `S² + S·I + 2S·O + I·O` multiply-adds, fixed (`S = 10`, `I = 1`,
 /// `O = 4`: 194); [`InputStateObserver::state`] adds `S·I`. Size:
-/// `S² + 3S·I + 2S·O + I·O + 1` values of `T`. Every operator is computed in `f64` and
+/// `S² + 2S·I + 2S·O + 2I·O + 1` values of `T` (`A`, `B`, `C`, `L`, `M`, `D̃`, `Γ₁`, `h`). Every operator is computed in `f64` and
 /// rounded once to `T`; [`InputStateObserver::new`] and `from_parts_f32`/`_f64` (`const fn`: a
 /// `static` keeps the gains in flash) are bit-identical.
 ///
@@ -580,20 +716,26 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
     /// [`InputStateObserver::step`], checked: the new estimate must be finite, else `e` is
     /// left bit-identical. A non-finite measurement is a missing sample, not an error.
     ///
-    /// Errors: [`Error::NonFiniteState`]. Cost: a step plus a copy and a scan.
+    /// Errors: [`Error::NonFiniteState`], [`Error::StepCountOverflow`] (the step count, or
+    /// the count of missing samples, would pass `u64::MAX`: refused rather than wrapped;
+    /// the unchecked [`InputStateObserver::step`] wraps after `2⁶⁴` steps). Cost: a step
+    /// plus a copy and a scan.
     pub fn try_step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) -> Result<(), Error> {
+        check_counts(e, y)?;
         commit_if_finite(e, |next| self.step(next, y))
     }
 
     /// [`InputStateObserver::step_innovation`], checked as [`InputStateObserver::try_step`]:
     /// on an error `e` is left bit-identical and no residual is returned.
     ///
-    /// Errors: [`Error::NonFiniteState`]. Cost: a step plus a copy and a scan.
+    /// Errors: [`Error::NonFiniteState`], [`Error::StepCountOverflow`]. Cost: a step plus
+    /// a copy and a scan.
     pub fn try_step_innovation(
         &self,
         e: &mut JointEstimate<T, S, I>,
         y: &SVector<T, O>,
     ) -> Result<SVector<T, O>, Error> {
+        check_counts(e, y)?;
         let mut nu = SVector::zeros();
         commit_if_finite(e, |next| nu = self.step_innovation(next, y))?;
         Ok(nu)
@@ -694,6 +836,8 @@ pub struct InputStateFilter<T, const S: usize, const I: usize, const O: usize> {
     gamma1: [[T; I]; S],
     q: SMatrix<T, S, S>,
     r: SMatrix<T, O, O>,
+    /// `N`, or `None` when it is zero (the original code path, bit for bit).
+    cross: Option<SMatrix<T, S, O>>,
 }
 
 impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T, S, I, O> {
@@ -709,13 +853,44 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         q: &SMatrix<f64, S, S>,
         r: &SMatrix<f64, O, O>,
     ) -> Result<Self, Error> {
+        Self::build(model, q, r, &[[0.0; O]; S])
+    }
+
+    /// [`InputStateFilter::new`] with a process–measurement cross covariance
+    /// `n = E q_n r_nᵀ` (`S×O`, as [`InputStateGains::solve_cross`]): `R̃` and `K` of each
+    /// step carry it. `n = 0` is [`InputStateFilter::new`], bit for bit.
+    ///
+    /// Errors: as [`InputStateFilter::new`]; [`Error::InvalidCovariance`] also when `n` is
+    /// not finite or `[q n; nᵀ r]` is not a covariance. Cost: `O(S³)`.
+    pub fn with_cross(
+        model: &InputModel<S, I, O>,
+        q: &SMatrix<f64, S, S>,
+        r: &SMatrix<f64, O, O>,
+        n: &SMatrix<f64, S, O>,
+    ) -> Result<Self, Error> {
+        Self::build(model, q, r, &rows_f64(n))
+    }
+
+    fn build(
+        model: &InputModel<S, I, O>,
+        q: &SMatrix<f64, S, S>,
+        r: &SMatrix<f64, O, O>,
+        n: &Mat<S, O>,
+    ) -> Result<Self, Error> {
         let (qr, rr) = (rows_f64(q), rows_f64(r));
         if !is_covariance(&qr, false) {
             return Err(Error::InvalidCovariance);
         }
         model.check_finite()?;
         model.weighted_feedthrough(&rr)?;
-        let fits = model.fits(T::MAX) && finite_as(&qr, T::MAX) && finite_as(&rr, T::MAX);
+        let zero = is_zero(n);
+        if !zero && !cross_is_valid(&qr, &rr, n) {
+            return Err(Error::InvalidCovariance);
+        }
+        let fits = model.fits(T::MAX)
+            && finite_as(&qr, T::MAX)
+            && finite_as(&rr, T::MAX)
+            && finite_as(n, T::MAX);
         if !fits {
             return Err(Error::OperatorOverflow);
         }
@@ -727,6 +902,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
             gamma1: round_rows(&model.gamma1),
             q: matrix_t(&qr),
             r: matrix_t(&rr),
+            cross: if zero { None } else { Some(matrix_t(n)) },
         })
     }
 
@@ -776,8 +952,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
     /// One filter step with the measurement `y` (`y_n`; a non-finite entry: missing).
     ///
     /// Errors, `s` unchanged: [`Error::InvalidCovariance`] (`R̃ = C P⁻ Cᵀ + R` or
-    /// `D̃ᵀ R̃⁻¹ D̃` not positive definite to working precision), [`Error::NonFiniteState`].
-    /// No allocation, no panic; cost in the type docs.
+    /// `D̃ᵀ R̃⁻¹ D̃` not positive definite to working precision), [`Error::NonFiniteState`],
+    /// [`Error::StepCountOverflow`] (the step count, or the count of missing samples, would
+    /// pass `u64::MAX`). No allocation, no panic; cost in the type docs.
     pub fn try_step(
         &self,
         s: &mut InputStateFilterState<T, S, I, O>,
@@ -788,11 +965,10 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         let pm = self.predicted_covariance(s);
         let mut next = *s;
         if y.iter().all(|v| v.is_finite()) {
-            let cp = self.c * pm;
-            let rt = cp * self.c.transpose() + self.r;
-            let rt = (rt + rt.transpose()) * T::from_f64_rounded(0.5);
+            // R̃ and K from the one Kalman core (with N where it is set).
+            let (cp, rt) = innovation_t(&pm, &self.c, &self.r, self.cross.as_ref());
             let chol = rt.cholesky().ok_or(Error::InvalidCovariance)?;
-            let k = chol.solve(&cp).transpose();
+            let k = gain_t(&chol, &cp);
             let rtd = chol.solve(&self.d);
             let f = self.d.transpose() * rtd;
             let f = (f + f.transpose()) * T::from_f64_rounded(0.5);
@@ -812,9 +988,17 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         } else {
             next.estimate.xi = xp;
             next.p = pm;
-            next.estimate.missing = next.estimate.missing.wrapping_add(1);
+            next.estimate.missing = next
+                .estimate
+                .missing
+                .checked_add(1)
+                .ok_or(Error::StepCountOverflow)?;
         }
-        next.estimate.n = next.estimate.n.wrapping_add(1);
+        next.estimate.n = next
+            .estimate
+            .n
+            .checked_add(1)
+            .ok_or(Error::StepCountOverflow)?;
         let finite = next
             .estimate
             .xi
@@ -829,5 +1013,69 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         }
         *s = next;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models;
+    use crate::observer::{Outputs, StateSpace};
+
+    fn model() -> InputModel<10, 1, 2> {
+        let (m, c, k) = models::five_storey_building();
+        let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
+        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02).unwrap();
+        let mut out = Outputs::<5, 1, 2>::zero();
+        out.a[0][4] = 1.0;
+        out.u[1][4] = 1.0;
+        InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap()
+    }
+
+    /// Regression: the checked steps of the joint estimators wrapped their counters
+    /// (`u64::MAX + 1 = 0`); they now refuse with a typed error, the state unchanged.
+    #[test]
+    fn joint_estimators_refuse_to_wrap_their_counters() {
+        let md = model();
+        let q = SMatrix::<f64, 10, 10>::identity() * 1e-14;
+        let r = SMatrix::<f64, 2, 2>::from_diagonal(&nalgebra::vector![1e-4, 1e-8]);
+        let gains = InputStateGains::new(&md, &q, &r).unwrap();
+        let obs = InputStateObserver::<f64, 10, 1, 2>::new(&md, &gains).unwrap();
+        let (y, gap) = (SVector::from([0.01, 1e-4]), SVector::from([f64::NAN, 0.0]));
+        let mut e = obs.start_at_rest();
+        e.n = u64::MAX;
+        let before = e;
+        assert_eq!(obs.try_step(&mut e, &y), Err(Error::StepCountOverflow));
+        assert_eq!(
+            obs.try_step_innovation(&mut e, &y),
+            Err(Error::StepCountOverflow)
+        );
+        assert_eq!(e, before);
+        e.n = 1;
+        e.missing = u64::MAX;
+        let before = e;
+        assert_eq!(obs.try_step(&mut e, &gap), Err(Error::StepCountOverflow));
+        assert_eq!(e, before);
+        obs.try_step(&mut e, &y).unwrap();
+        assert_eq!((e.steps(), e.missing()), (2, u64::MAX));
+
+        let f = InputStateFilter::<f64, 10, 1, 2>::new(&md, &q, &r).unwrap();
+        let mut s = f
+            .start(
+                &SVector::zeros(),
+                &(q * 1e3),
+                &SVector::zeros(),
+                &SMatrix::identity(),
+            )
+            .unwrap();
+        s.estimate.n = u64::MAX;
+        let before = s;
+        assert_eq!(f.try_step(&mut s, &y), Err(Error::StepCountOverflow));
+        assert_eq!(s, before);
+        s.estimate.n = 0;
+        s.estimate.missing = u64::MAX;
+        let before = s;
+        assert_eq!(f.try_step(&mut s, &gap), Err(Error::StepCountOverflow));
+        assert_eq!(s, before);
     }
 }

@@ -113,6 +113,27 @@
 //! algorithm as [`SteadyState`](crate::observer::SteadyState) and forms `K`, `M`, `Pʷ`
 //! from its `P⁻` with the step's equations above. `tests/estimation.rs` checks them
 //! against the limit of the paper's time-varying recursion.
+//!
+//! ## Noise that reaches the sensors
+//!
+//! Unmodelled floor forces as process noise on `ξ` also reach the accelerometers (noise
+//! model: [`observer`](crate::observer), "Noise that reaches the sensors"). With
+//! `ξ = x − Γ₁ w` of the *estimated* input the forces' noise enters `ξ_n` exactly as it
+//! enters `x_n`, so the same `N = E q_n r_nᵀ` applies ([`InputStateGains::solve_cross`],
+//! [`InputStateFilter::with_cross`], [`augmented::AugmentedModel::from_parts_cross`] with
+//! `[N; 0]`). In the step only `R̃ = C P⁻ Cᵀ + R + C N + Nᵀ Cᵀ` and
+//! `K = (P⁻ Cᵀ + N) R̃⁻¹` change (the unbiased minimum-variance derivation goes through
+//! with `Cov(e⁻, C e⁻ + r) = P⁻ Cᵀ + N`; `P`, `Pˣʷ`, `Pʷ`, `M` keep their form). The
+//! steady state: the a-priori error obeys
+//! `e⁻_{n+1} = Ā e⁻_n − B M₀ r_n + q_{n+1} − 𝒦 z_n`, `z_n = Vᵀ (C e⁻_n + r_n)` (`V` the
+//! left null basis of `D̃`), with `e⁻_n` correlated with `r_n` through `N`. Writing
+//! `P⁻ = Y + Q` turns it into the Kalman core's predictor form on `(Ā, C)`:
+//! `Q_y = Ā Q Āᵀ + B F₀⁻¹ Bᵀ − Ā N M₀ᵀ Bᵀ − B M₀ Nᵀ Āᵀ`,
+//! `S_y = Ā (Q Cᵀ + N) − B M₀ Nᵀ Cᵀ` and the weight
+//! `Π₁ = V (Vᵀ R₁ V)⁻¹ Vᵀ = R₁⁻¹ − R₁⁻¹ D̃ (D̃ᵀ R₁⁻¹ D̃)⁻¹ D̃ᵀ R₁⁻¹`,
+//! `R₁ = C Q Cᵀ + R + C N + Nᵀ Cᵀ`, solved by the same doubling. `tests/cross_covariance.rs`
+//! checks it against the paper's recursion with the cross term written in the test, and the
+//! residual's `χ²_{O−I}` mean by simulation. (The dual filter does not take `N`.)
 
 pub mod augmented;
 pub mod dual;

@@ -13,7 +13,11 @@
 //! ```
 //!
 //! since the cross covariance of the a-priori errors `n − i` and `n` is `P (Āᵀ)^i` in the
-//! steady state (`i = 0` is the filter's own correction). A step is the fixed-gain
+//! steady state (`i = 0` is the filter's own correction). With a process–measurement cross
+//! covariance `N` ([`SteadyState::from_parts_cross`], held in [`SteadyState::cross`]) the
+//! a-priori error is correlated with its own sample's measurement noise, so
+//! `Σ = H P Hᵀ + R + H N + Nᵀ Hᵀ`, `K_0 = (P Hᵀ + N) Σ⁻¹` and
+//! `K_i = (P Āᵀ − N L₀ᵀ Φᵀ) (Āᵀ)^(i−1) Hᵀ Σ⁻¹`. A step is the fixed-gain
 //! observer's plus the `L` updates of a ring of past estimates.
 
 use nalgebra::{SMatrix, SVector};
@@ -21,6 +25,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::linalg::{self, Mat, add_scaled, all_finite, finite_as, identity, mul, round_rows};
 use crate::linalg::{rows_f64, transpose};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance, lu_of, symmetrize};
+use crate::observer::{innovation_parts, is_zero};
 use crate::{Error, Real, StepState};
 
 /// The gains `K_1 … K_L` (`K_0` is the filter gain), from the steady solution and `r`.
@@ -50,24 +55,50 @@ const fn lag_gains<
     }
     let p = &steady.covariance;
     let h = &meas.h;
-    let sigma = symmetrize(&add_scaled(r, 1.0, &mul(h, &mul(p, &transpose(h)))));
+    if !all_finite(&steady.cross) {
+        return Err(Error::NonFiniteInput);
+    }
+    let cross = if is_zero(&steady.cross) {
+        None
+    } else {
+        Some(&steady.cross)
+    };
+    let sigma = match cross {
+        None => symmetrize(&add_scaled(r, 1.0, &mul(h, &mul(p, &transpose(h))))),
+        Some(n) => symmetrize(&innovation_parts(p, h, r, Some(n)).1),
+    };
     let lu = match lu_of(&sigma) {
         Some(lu) => lu,
         None => return Err(Error::InvalidCovariance),
     };
-    // V₀ = Hᵀ Σ⁻¹ = (Σ⁻¹ H)ᵀ; V_i = Āᵀ V_{i−1}; K_i = P V_i.
+    // V₀ = Hᵀ Σ⁻¹ = (Σ⁻¹ H)ᵀ; V_i = Āᵀ V_{i−1}; K_i = P V_i. With the cross covariance N
+    // (E e⁻_m r_mᵀ = N) the filter's own gain is K₀ = P V₀ + N Σ⁻¹, and the a-priori
+    // errors m and m + 1 have the cross covariance P Āᵀ − N Lᵀ Φᵀ, so
+    // K_i = P V_i − N Lᵀ Φᵀ V_{i−1}.
     let mut v = transpose(&lu.solve(h));
-    let k0 = mul(p, &v);
+    let k0 = match cross {
+        None => mul(p, &v),
+        Some(n) => add_scaled(&mul(p, &v), 1.0, &transpose(&lu.solve(&transpose(n)))),
+    };
     let abar = mul(
         &model.phi,
         &add_scaled(&identity(), -1.0, &mul(&steady.gain, h)),
     );
     let abt = transpose(&abar);
+    // N Lᵀ Φᵀ (S×S), only with the cross term.
+    let nlp = match cross {
+        None => [[0.0; S]; S],
+        Some(n) => mul(n, &transpose(&mul(&model.phi, &steady.gain))),
+    };
     let mut ks = [[[0.0; O]; S]; L];
     let mut i = 0;
     while i < L {
+        let prev = v;
         v = mul(&abt, &v);
-        ks[i] = mul(p, &v);
+        ks[i] = match cross {
+            None => mul(p, &v),
+            Some(_) => add_scaled(&mul(p, &v), -1.0, &mul(&nlp, &prev)),
+        };
         i += 1;
     }
     Ok((k0, ks))
@@ -229,7 +260,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize>
     /// missing, nothing corrected, counted). Checked: a non-finite input or result leaves
     /// `s` unchanged.
     ///
-    /// Errors: [`Error::NonFiniteInput`] (`w`), [`Error::NonFiniteState`]. No allocation,
+    /// Errors: [`Error::NonFiniteInput`] (`w`), [`Error::NonFiniteState`],
+    /// [`Error::StepCountOverflow`] (the step count, or the count of missing samples, would
+    /// pass `u64::MAX`: refused rather than wrapped). No allocation,
     /// no panic; cost in the type docs.
     pub fn try_step(
         &self,
@@ -292,10 +325,13 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize>
             next.head = (head + 1) % L;
         }
         if !measured {
-            next.missing = next.missing.wrapping_add(1);
+            next.missing = next
+                .missing
+                .checked_add(1)
+                .ok_or(Error::StepCountOverflow)?;
         }
         next.w = *w;
-        next.n = next.n.wrapping_add(1);
+        next.n = next.n.checked_add(1).ok_or(Error::StepCountOverflow)?;
         if !next.is_finite() {
             return Err(Error::NonFiniteState);
         }
@@ -347,3 +383,41 @@ macro_rules! lag_const {
 }
 lag_const!(f32, from_parts_f32);
 lag_const!(f64, from_parts_f64);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::{self, base_excitation};
+    use crate::observer::Outputs;
+
+    /// Regression: the smoother's step wrapped its counters (`u64::MAX + 1 = 0`); it now
+    /// refuses with a typed error, the state unchanged.
+    #[test]
+    fn smoother_refuses_to_wrap_its_counters() {
+        let (m, c, k) = models::five_storey_building();
+        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02).unwrap();
+        let meas = ss
+            .outputs(&Outputs::absolute_accelerations(
+                Outputs::<5, 1, 2>::select([1, 4]),
+                0,
+            ))
+            .unwrap();
+        let q = SMatrix::<f64, 10, 10>::identity() * 1e-10;
+        let r = SMatrix::<f64, 2, 2>::identity() * 0.01;
+        let kf = SteadyState::new(&ss, &meas, &q, &r).unwrap();
+        let sm = FixedLag::<f64, 10, 1, 2, 3>::new(&ss, &meas, &kf, &r).unwrap();
+        let w = SVector::from([0.1]);
+        let mut s = sm.start(&SVector::zeros(), &w).unwrap();
+        s.n = u64::MAX;
+        let before = s;
+        let y = SVector::from([0.0, 0.0]);
+        assert_eq!(sm.try_step(&mut s, &w, &y), Err(Error::StepCountOverflow));
+        assert_eq!(s, before);
+        s.n = 0;
+        s.missing = u64::MAX;
+        let before = s;
+        let gap = SVector::from([f64::NAN, 0.0]);
+        assert_eq!(sm.try_step(&mut s, &w, &gap), Err(Error::StepCountOverflow));
+        assert_eq!(s, before);
+    }
+}

@@ -50,6 +50,21 @@ impl<T: Real, const S: usize, const I: usize> StepState for Estimate<T, S, I> {
     }
 }
 
+/// The checked steps' counter check: the step count `n` and, if `y` is missing (a
+/// non-finite entry), the count of missing samples `missing` must have room for one more.
+/// Errors: [`Error::StepCountOverflow`].
+pub(crate) fn check_counts<T: Real, const O: usize>(
+    n: u64,
+    missing: u64,
+    y: &SVector<T, O>,
+) -> Result<(), Error> {
+    if n == u64::MAX || (missing == u64::MAX && !y.iter().all(|v| v.is_finite())) {
+        Err(Error::StepCountOverflow)
+    } else {
+        Ok(())
+    }
+}
+
 /// The start of any observer: `x̂_0 = x0`, input `w0`, both finite.
 pub(crate) fn initial_estimate<T: Real, const S: usize, const I: usize>(
     x0: &SVector<T, S>,
@@ -217,8 +232,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
     /// missing sample) the correction is skipped and counted ([`Estimate::missing`]).
     ///
     /// Fixed cost (`S² + 2S·I + 2S·O + O·I` multiply-adds), no allocation, no panic. A
-    /// non-finite input `w` gives a non-finite estimate: use [`Observer::try_step`] where
-    /// that must not happen.
+    /// non-finite input `w` gives a non-finite estimate, and the counters wrap after
+    /// `2⁶⁴` steps (`10¹⁰` years at 50 Hz): use [`Observer::try_step`] where that must not
+    /// happen.
     #[inline]
     pub fn step(&self, e: &mut Estimate<T, S, I>, w: &SVector<T, I>, y: &SVector<T, O>) {
         self.step_innovation(e, w, y);
@@ -283,8 +299,10 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
     /// finite, else `e` is left bit-identical. A non-finite measurement is not an error
     /// (it is a missing sample, counted).
     ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::NonFiniteState`]. Cost: a step plus a
-    /// copy and a scan.
+    /// Errors: [`Error::NonFiniteInput`], [`Error::NonFiniteState`],
+    /// [`Error::StepCountOverflow`] (the step count, or the count of missing samples,
+    /// would pass `u64::MAX`: refused rather than wrapped). Cost: a step plus a copy and a
+    /// scan.
     pub fn try_step(
         &self,
         e: &mut Estimate<T, S, I>,
@@ -294,6 +312,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
         if !w.iter().all(|v| v.is_finite()) {
             return Err(Error::NonFiniteInput);
         }
+        check_counts(e.n, e.missing, y)?;
         commit_if_finite(e, |next| self.step(next, w, y))
     }
 }
@@ -414,3 +433,47 @@ macro_rules! readout_const {
 }
 readout_const!(f32, from_parts_f32);
 readout_const!(f64, from_parts_f64);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::{self, base_excitation};
+    use crate::observer::Outputs;
+
+    /// Regression: the checked step wrapped its counters (`u64::MAX + 1 = 0`); it now
+    /// refuses with a typed error and leaves the estimate bit-identical.
+    #[test]
+    fn observer_try_step_refuses_to_wrap_its_counters() {
+        let (m, c, k) = models::five_storey_building();
+        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02).unwrap();
+        let meas = ss
+            .outputs(&Outputs::absolute_accelerations(
+                Outputs::<5, 1, 2>::select([1, 4]),
+                0,
+            ))
+            .unwrap();
+        let obs = Observer::<f64, 10, 1, 2>::new(&ss, &meas, &SMatrix::zeros()).unwrap();
+        let w = SVector::from([0.1]);
+        let mut e = obs.start_at_rest(&w).unwrap();
+        e.n = u64::MAX;
+        let before = e;
+        assert_eq!(
+            obs.try_step(&mut e, &w, &SVector::from([0.0, 0.0])),
+            Err(Error::StepCountOverflow)
+        );
+        assert_eq!(e, before);
+        // The missing-sample count: at its limit a missing sample is refused, a measured
+        // one is taken.
+        e.n = 7;
+        e.missing = u64::MAX;
+        let before = e;
+        assert_eq!(
+            obs.try_step(&mut e, &w, &SVector::from([f64::NAN, 0.0])),
+            Err(Error::StepCountOverflow)
+        );
+        assert_eq!(e, before);
+        obs.try_step(&mut e, &w, &SVector::from([0.0, 0.0]))
+            .unwrap();
+        assert_eq!((e.steps(), e.missing()), (8, u64::MAX));
+    }
+}

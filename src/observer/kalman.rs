@@ -4,9 +4,10 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::fixed::{Estimate, initial_estimate};
+use super::kalman_core::{cross_is_valid, gain_t, innovation_t, is_zero, joseph_t};
 use super::riccati::is_covariance;
 use super::state_space::{Measurement, StateSpace};
-use crate::linalg::{all_finite, finite_as, matrix_t, rows_f64, sym};
+use crate::linalg::{Mat, all_finite, finite_as, matrix_t, rows_f64, sym};
 use crate::{Error, Real};
 
 /// The state of a [`Kalman`] filter: the [`Estimate`] and its a-posteriori error
@@ -42,10 +43,16 @@ impl<T: Real, const S: usize, const I: usize> KalmanState<T, S, I> {
 /// Only a checked step ([`Kalman::try_step`]): the innovation covariance can lose
 /// definiteness in `f32`, and a failed step changes nothing.
 ///
+/// With a process–measurement cross covariance `N = E q_n r_nᵀ` ([`Kalman::with_cross`]:
+/// a force noise that also reaches the sensors through the feedthrough) the correction is
+/// `K = (P⁻ Hᵀ + N) Σ⁻¹`, `Σ = H P⁻ Hᵀ + R + H N + Nᵀ Hᵀ`, and the Joseph form gains
+/// `− (I − K H) N Kᵀ − K Nᵀ (I − K H)ᵀ` ([module docs](super), "Noise that reaches the
+/// sensors").
+///
 /// Cost of a step: about `3S³ + 3S²·O + 2S·O² + O³/6` multiply-adds (`≈ 3 900` for
-/// `S = 10`, `O = 2`): for the host and small firmware models; on a microcontroller the
-/// [`Observer`](super::Observer) with the steady-state gain costs `S²`. Size:
-/// `S² + 2S·I + O·(S + I) + O²` values of `T`.
+/// `S = 10`, `O = 2`; `3S²·O` more with `N`): for the host and small firmware models; on a
+/// microcontroller the [`Observer`](super::Observer) with the steady-state gain costs
+/// `S²`. Size: `S² + 2S·I + O·(S + I) + O² + S·O` values of `T` and a flag.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Kalman<T, const S: usize, const I: usize, const O: usize> {
     phi: SMatrix<T, S, S>,
@@ -55,6 +62,8 @@ pub struct Kalman<T, const S: usize, const I: usize, const O: usize> {
     d: SMatrix<T, O, I>,
     q: SMatrix<T, S, S>,
     r: SMatrix<T, O, O>,
+    /// `N`, or `None` when it is zero (the original code path, bit for bit).
+    cross: Option<SMatrix<T, S, O>>,
 }
 
 impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O> {
@@ -70,8 +79,38 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         q: &SMatrix<f64, S, S>,
         r: &SMatrix<f64, O, O>,
     ) -> Result<Self, Error> {
+        Self::build(model, meas, q, r, &[[0.0; O]; S])
+    }
+
+    /// [`Kalman::new`] with a process–measurement cross covariance `n = E q_n r_nᵀ`
+    /// (`S×O`, units of `x` times output units; e.g.
+    /// [`StateSpace::input_cross_noise`]). `n = 0` is [`Kalman::new`], bit for bit.
+    ///
+    /// Errors: as [`Kalman::new`]; [`Error::InvalidCovariance`] also when `n` is not
+    /// finite or `[q n; nᵀ r]` is not a covariance. Cost: `O(S³)`.
+    pub fn with_cross<const N: usize>(
+        model: &StateSpace<N, S, I>,
+        meas: &Measurement<S, I, O>,
+        q: &SMatrix<f64, S, S>,
+        r: &SMatrix<f64, O, O>,
+        n: &SMatrix<f64, S, O>,
+    ) -> Result<Self, Error> {
+        Self::build(model, meas, q, r, &rows_f64(n))
+    }
+
+    fn build<const N: usize>(
+        model: &StateSpace<N, S, I>,
+        meas: &Measurement<S, I, O>,
+        q: &SMatrix<f64, S, S>,
+        r: &SMatrix<f64, O, O>,
+        n: &Mat<S, O>,
+    ) -> Result<Self, Error> {
         let (qr, rr) = (rows_f64(q), rows_f64(r));
         if !(is_covariance(&qr, false) && is_covariance(&rr, true)) {
+            return Err(Error::InvalidCovariance);
+        }
+        let zero = is_zero(n);
+        if !zero && !cross_is_valid(&qr, &rr, n) {
             return Err(Error::InvalidCovariance);
         }
         if !(all_finite(&meas.h) && all_finite(&meas.d)) {
@@ -83,7 +122,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
             && finite_as(&meas.h, T::MAX)
             && finite_as(&meas.d, T::MAX)
             && finite_as(&qr, T::MAX)
-            && finite_as(&rr, T::MAX);
+            && finite_as(&rr, T::MAX)
+            && finite_as(n, T::MAX);
         if !fits {
             return Err(Error::OperatorOverflow);
         }
@@ -95,6 +135,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
             d: matrix_t(&meas.d),
             q: matrix_t(&qr),
             r: matrix_t(&rr),
+            cross: if zero { None } else { Some(matrix_t(n)) },
         })
     }
 
@@ -127,8 +168,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
     ///
     /// Errors, `s` unchanged: [`Error::NonFiniteInput`] (`w` not finite),
     /// [`Error::InvalidCovariance`] (the innovation covariance `H P⁻ Hᵀ + R` is not
-    /// positive definite to working precision), [`Error::NonFiniteState`]. No allocation,
-    /// no panic; cost in the type docs.
+    /// positive definite to working precision), [`Error::NonFiniteState`],
+    /// [`Error::StepCountOverflow`] (the step count, or the count of missing samples,
+    /// would pass `u64::MAX`). No allocation, no panic; cost in the type docs.
     pub fn try_step(
         &self,
         s: &mut KalmanState<T, S, I>,
@@ -140,7 +182,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
 
     /// [`Kalman::try_step`], returning this step's innovation `ν = y − H x̂⁻ − D w`
     /// (output units; non-finite where `y` is missing) and its covariance
-    /// `H P⁻ Hᵀ + R` (`ν ~ N(0, ·)` under the model) — what a change detector tests
+    /// `H P⁻ Hᵀ + R` (`+ H N + Nᵀ Hᵀ` with a cross covariance; `ν ~ N(0, ·)` under the
+    /// model) — what a change detector tests
     /// ([`detection`](crate::detection)). Errors and cost: as [`Kalman::try_step`]
     /// (plus `S²·O` for the covariance of a missing sample).
     pub fn try_step_innovation(
@@ -156,24 +199,31 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         let xp = self.phi * e.x + self.gamma0 * e.w + self.gamma1 * w;
         let pm = self.predicted_covariance(s);
         let mut next = *s;
-        let hp = self.h * pm;
-        let si = hp * self.h.transpose() + self.r;
-        let si = (si + si.transpose()) * T::from_f64_rounded(0.5);
+        let cross = self.cross.as_ref();
+        // Xᵀ = H P⁻ (+ Nᵀ), Σ = H P⁻ Hᵀ + R (+ H N + Nᵀ Hᵀ): the one Kalman core.
+        let (xt, si) = innovation_t(&pm, &self.h, &self.r, cross);
         let innov = y - self.h * xp - self.d * w;
         if y.iter().all(|v| v.is_finite()) {
             let chol = si.cholesky().ok_or(Error::InvalidCovariance)?;
-            // Kᵀ = (H P⁻ Hᵀ + R)⁻¹ H P⁻.
-            let k = chol.solve(&hp).transpose();
-            let ikh = SMatrix::<T, S, S>::identity() - k * self.h;
+            // Kᵀ = Σ⁻¹ Xᵀ.
+            let k = gain_t(&chol, &xt);
             next.estimate.x = xp + k * innov;
-            next.p = sym(&(ikh * pm * ikh.transpose() + k * self.r * k.transpose()));
+            next.p = joseph_t(&pm, &k, &self.h, &self.r, cross);
         } else {
             next.estimate.x = xp;
             next.p = pm;
-            next.estimate.missing = next.estimate.missing.wrapping_add(1);
+            next.estimate.missing = next
+                .estimate
+                .missing
+                .checked_add(1)
+                .ok_or(Error::StepCountOverflow)?;
         }
         next.estimate.w = *w;
-        next.estimate.n = next.estimate.n.wrapping_add(1);
+        next.estimate.n = next
+            .estimate
+            .n
+            .checked_add(1)
+            .ok_or(Error::StepCountOverflow)?;
         let finite = next
             .estimate
             .x
@@ -185,5 +235,47 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         }
         *s = next;
         Ok((innov, si))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::{self, base_excitation};
+    use crate::observer::Outputs;
+
+    /// Regression: the checked step wrapped its counters (`u64::MAX + 1 = 0`); it now
+    /// refuses with a typed error and leaves the state bit-identical.
+    #[test]
+    fn kalman_step_refuses_to_wrap_its_counters() {
+        let (m, c, k) = models::five_storey_building();
+        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02).unwrap();
+        let meas = ss
+            .outputs(&Outputs::absolute_accelerations(
+                Outputs::<5, 1, 2>::select([1, 4]),
+                0,
+            ))
+            .unwrap();
+        let q = SMatrix::<f64, 10, 10>::identity() * 1e-10;
+        let r = SMatrix::<f64, 2, 2>::identity() * 0.01;
+        let kal = Kalman::<f64, 10, 1, 2>::new(&ss, &meas, &q, &r).unwrap();
+        let w = SVector::from([0.1]);
+        let mut s = kal.start(&SVector::zeros(), &(q * 10.0), &w).unwrap();
+        s.estimate.n = u64::MAX;
+        let before = s;
+        let y = SVector::from([0.0, 0.0]);
+        assert_eq!(kal.try_step(&mut s, &w, &y), Err(Error::StepCountOverflow));
+        assert_eq!(s, before);
+        s.estimate.n = 3;
+        s.estimate.missing = u64::MAX;
+        let before = s;
+        let gap = SVector::from([f64::NAN, 0.0]);
+        assert_eq!(
+            kal.try_step(&mut s, &w, &gap),
+            Err(Error::StepCountOverflow)
+        );
+        assert_eq!(s, before);
+        kal.try_step(&mut s, &w, &y).unwrap();
+        assert_eq!((s.estimate.steps(), s.estimate.missing()), (4, u64::MAX));
     }
 }

@@ -24,6 +24,7 @@
 
 use nalgebra::SMatrix;
 
+use super::kalman_core::{cross_is_valid, cross_riccati_start, innovation_parts, is_zero};
 use super::state_space::{Measurement, StateSpace, lu_of};
 use crate::Error;
 use crate::linalg::cholesky::cholesky;
@@ -57,10 +58,16 @@ pub struct SteadyState<const S: usize, const O: usize> {
     /// `P` (`S×S`): the a-priori (predicted) error covariance, the DARE solution (units of
     /// `x` squared).
     pub covariance: [[f64; S]; S],
-    /// `L = P Hᵀ (H P Hᵀ + R)⁻¹` (`S×O`): the observer gain.
+    /// `L = P Hᵀ (H P Hᵀ + R)⁻¹` (`S×O`): the observer gain; with a cross covariance
+    /// `N`, `L = (P Hᵀ + N) (H P Hᵀ + R + H N + Nᵀ Hᵀ)⁻¹` ([`SteadyState::from_parts_cross`]).
     pub gain: [[f64; O]; S],
     /// Doubling iterations taken (`≤` [`RICCATI_MAX_ITERATIONS`]).
     pub iterations: u32,
+    /// The process–measurement cross covariance `N = E q_n r_nᵀ` (`S×O`) the solution was
+    /// computed with (zero from [`SteadyState::from_parts`]), so that
+    /// [`innovation_covariance`](crate::detection::innovation_covariance) and the
+    /// [smoother](crate::estimation::smoother) use the same noise model.
+    pub cross: [[f64; O]; S],
 }
 
 /// `a` symmetric to `64 ε max|a|` and all finite.
@@ -119,14 +126,15 @@ pub(crate) const fn is_covariance<const N: usize>(a: &Mat<N, N>, definite: bool)
 }
 
 /// `L = P Hᵀ (H P Hᵀ + R)⁻¹` for a covariance `P` (a solve with the `O×O` innovation
-/// covariance). `None` if it is singular.
+/// covariance), or with a cross covariance `n`, `(P Hᵀ + N) Σ⁻¹` (the core's
+/// [`innovation_parts`]). `None` if `Σ` is singular.
 pub(crate) const fn gain_of<const S: usize, const O: usize>(
     p: &Mat<S, S>,
     h: &Mat<O, S>,
     r: &Mat<O, O>,
+    n: Option<&Mat<S, O>>,
 ) -> Option<Mat<S, O>> {
-    let hp = mul(h, p);
-    let si = add_scaled(r, 1.0, &mul(&hp, &transpose(h)));
+    let (hp, si) = innovation_parts(p, h, r, n);
     let lu = match lu_of(&symmetrize(&si)) {
         Some(lu) => lu,
         None => return None,
@@ -211,6 +219,9 @@ const fn abs_of<const R: usize, const C: usize>(a: &Mat<R, C>) -> Mat<R, C> {
 /// The Riccati equation's residual in Joseph form, `A P Aᵀ + K R Kᵀ + Q − P` with the
 /// predictor gain `K = Φ L` and the closed loop `A = Φ − K H` (the a-priori error
 /// dynamics), the size of its terms `B = |A||P||A|ᵀ + |K||R||K|ᵀ + |Q| + |P|`, and `A`.
+/// With a cross covariance `n` the a-priori error `e⁻` and the measurement noise are
+/// correlated (`E e⁻ rᵀ = N`): the residual gains `− A N Kᵀ − K Nᵀ Aᵀ` and the size
+/// `2 |A||N||K|ᵀ`.
 ///
 /// The Joseph form is the Riccati equation where `L` is its gain, and it is stationary in
 /// `L`: an error `δL` changes it by `δK S δKᵀ` only (second order), so the residual is not
@@ -223,12 +234,13 @@ const fn joseph_residual<const S: usize, const O: usize>(
     r: &Mat<O, O>,
     p: &Mat<S, S>,
     l: &Mat<S, O>,
+    n: Option<&Mat<S, O>>,
 ) -> (Mat<S, S>, Mat<S, S>, Mat<S, S>) {
     let k = mul(phi, l);
     let a = add_scaled(phi, -1.0, &mul(&k, h));
     let kt = transpose(&k);
     let at = transpose(&a);
-    let res = add_scaled(
+    let mut res = add_scaled(
         &add_scaled(
             &add_scaled(&mul(&a, &mul(p, &at)), 1.0, &mul(&k, &mul(r, &kt))),
             1.0,
@@ -238,7 +250,7 @@ const fn joseph_residual<const S: usize, const O: usize>(
         p,
     );
     let (aa, ka) = (abs_of(&a), abs_of(&k));
-    let bound = add_scaled(
+    let mut bound = add_scaled(
         &add_scaled(
             &add_scaled(
                 &mul(&aa, &mul(&abs_of(p), &transpose(&aa))),
@@ -251,6 +263,12 @@ const fn joseph_residual<const S: usize, const O: usize>(
         1.0,
         &abs_of(p),
     );
+    if let Some(n) = n {
+        let ank = mul(&a, &mul(n, &kt));
+        res = add_scaled(&res, -1.0, &add_scaled(&ank, 1.0, &transpose(&ank)));
+        let sz = mul(&aa, &mul(&abs_of(n), &transpose(&ka)));
+        bound = add_scaled(&bound, 1.0, &add_scaled(&sz, 1.0, &transpose(&sz)));
+    }
     (res, bound, a)
 }
 
@@ -444,6 +462,43 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         q: &[[f64; S]; S],
         r: &[[f64; O]; O],
     ) -> Result<Self, Error> {
+        Self::solve(model, meas, q, r, None)
+    }
+
+    /// [`SteadyState::from_parts`] with a process–measurement cross covariance
+    /// `n = E q_n r_nᵀ` (`S×O`, units of `x` times output units): the noise that drives the
+    /// state into sample `n` correlated with the noise of the measurement at `n` — a force
+    /// noise that also reaches the accelerometers through the feedthrough
+    /// ([`StateSpace::input_cross_noise`], with [`StateSpace::feedthrough_noise`] in `r`).
+    /// The gain is `L = (P Hᵀ + N) Σ⁻¹`, `Σ = H P Hᵀ + R + H N + Nᵀ Hᵀ` (the innovation
+    /// covariance), `P` the a-priori covariance of the Riccati equation with the cross term
+    /// (noise model and derivation: the [observer module docs](super), "Noise that reaches
+    /// the sensors").
+    /// `n = 0` (every entry zero) is [`SteadyState::from_parts`], bit for bit. `const fn`.
+    ///
+    /// Errors: as [`SteadyState::from_parts`]; [`Error::InvalidCovariance`] also when `n`
+    /// is not finite or `[q n; nᵀ r]` is not a covariance (`q − n r⁻¹ nᵀ` not positive
+    /// semidefinite). Cost: as [`SteadyState::from_parts`], plus `O(S²·O + O³)` flops for
+    /// the cross term's form and check.
+    pub const fn from_parts_cross<const N: usize, const I: usize>(
+        model: &StateSpace<N, S, I>,
+        meas: &Measurement<S, I, O>,
+        q: &[[f64; S]; S],
+        r: &[[f64; O]; O],
+        n: &[[f64; O]; S],
+    ) -> Result<Self, Error> {
+        Self::solve(model, meas, q, r, Some(n))
+    }
+
+    /// The solution of [`SteadyState::from_parts`] (`n` absent or zero) and
+    /// [`SteadyState::from_parts_cross`].
+    const fn solve<const N: usize, const I: usize>(
+        model: &StateSpace<N, S, I>,
+        meas: &Measurement<S, I, O>,
+        q: &[[f64; S]; S],
+        r: &[[f64; O]; O],
+        n: Option<&[[f64; O]; S]>,
+    ) -> Result<Self, Error> {
         if !is_covariance(q, false) {
             return Err(Error::InvalidCovariance);
         }
@@ -455,13 +510,43 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         if !all_finite(h) {
             return Err(Error::NonFiniteInput);
         }
-        let g = symmetrize(&mul(&transpose(h), &lu_r.solve(h)));
-        let (x, k, converged) = match doubling(
-            transpose(&model.phi),
-            g,
-            symmetrize(q),
-            RICCATI_MAX_ITERATIONS,
-        ) {
+        let cross: Mat<S, O> = match n {
+            Some(n) => *n,
+            None => [[0.0; O]; S],
+        };
+        // A zero cross covariance takes the original path (bit-identical).
+        let n = match n {
+            Some(m) if is_zero(m) => None,
+            other => other,
+        };
+        let start = match n {
+            None => (
+                transpose(&model.phi),
+                symmetrize(&mul(&transpose(h), &lu_r.solve(h))),
+                symmetrize(q),
+            ),
+            Some(n) => {
+                if !cross_is_valid(q, r, n) {
+                    return Err(Error::InvalidCovariance);
+                }
+                // The predictor form of the core (`P = Y + Q`): R_y = H Q Hᵀ + R + H N + Nᵀ Hᵀ,
+                // S_y = Φ (Q Hᵀ + N), Q_y = Φ Q Φᵀ.
+                let (xt, ry) = innovation_parts(q, h, r, Some(n));
+                let lu_y = match definite_lu(&symmetrize(&ry)) {
+                    Some(lu) => lu,
+                    None => return Err(Error::InvalidCovariance),
+                };
+                let phi = &model.phi;
+                let qy = symmetrize(&mul(phi, &mul(q, &transpose(phi))));
+                let sy = mul(phi, &transpose(&xt));
+                let pi = symmetrize(&lu_y.inverse());
+                if !(all_finite(&qy) && all_finite(&sy) && all_finite(&pi)) {
+                    return Err(Error::OperatorOverflow);
+                }
+                cross_riccati_start(phi, h, &qy, &sy, &pi)
+            }
+        };
+        let (x, k, converged) = match doubling(start.0, start.1, start.2, RICCATI_MAX_ITERATIONS) {
             Some(v) => v,
             None => return Err(Error::RiccatiNotConverged),
         };
@@ -471,6 +556,11 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         if !(converged && is_covariance(&x, false)) {
             return Err(Error::RiccatiNotConverged);
         }
+        // With the cross term the doubling solved for Y: the a-priori covariance is Y + Q.
+        let x = match n {
+            None => x,
+            Some(_) => symmetrize(&add_scaled(&x, 1.0, &symmetrize(q))),
+        };
         // The solution verified, not trusted: an iterate that stops moving is not
         // necessarily the stabilizing solution to working accuracy (found by fuzzing). Its
         // closed loop is certified stable and its residual measured; one above
@@ -482,7 +572,7 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         let mut best: Option<(Mat<S, S>, Mat<S, O>, f64)> = None;
         let mut step = 0;
         while step <= RICCATI_REFINEMENTS {
-            let gain = match gain_of(&p, h, r) {
+            let gain = match gain_of(&p, h, r, n) {
                 Some(l) => l,
                 None => break,
             };
@@ -492,7 +582,7 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
                 }
                 break;
             }
-            let (res, bound, a_cl) = joseph_residual(&model.phi, h, q, r, &p, &gain);
+            let (res, bound, a_cl) = joseph_residual(&model.phi, h, q, r, &p, &gain, n);
             let units = residual_units(&res, &bound);
             // Hewer's step needs a stabilizing gain: its Stein solve is the certificate.
             let delta = match stein(&a_cl, &res) {
@@ -517,6 +607,7 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
                 covariance: p,
                 gain,
                 iterations: k,
+                cross,
             }),
             _ => Err(Error::RiccatiNotConverged),
         }
@@ -532,6 +623,24 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         r: &SMatrix<f64, O, O>,
     ) -> Result<Self, Error> {
         Self::from_parts(model, meas, &rows_f64(q), &rows_f64(r))
+    }
+
+    /// [`SteadyState::from_parts_cross`] with `nalgebra` matrices (run time; same numbers).
+    ///
+    /// Errors and cost: as [`SteadyState::from_parts_cross`].
+    pub fn new_cross<const N: usize, const I: usize>(
+        model: &StateSpace<N, S, I>,
+        meas: &Measurement<S, I, O>,
+        q: &SMatrix<f64, S, S>,
+        r: &SMatrix<f64, O, O>,
+        n: &SMatrix<f64, S, O>,
+    ) -> Result<Self, Error> {
+        Self::from_parts_cross(model, meas, &rows_f64(q), &rows_f64(r), &rows_f64(n))
+    }
+
+    /// `N` as a `nalgebra` matrix.
+    pub fn cross_matrix(&self) -> SMatrix<f64, S, O> {
+        SMatrix::from_fn(|i, j| self.cross[i][j])
     }
 
     /// `P` as a `nalgebra` matrix.

@@ -845,6 +845,15 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// `Q = (Γ₀ + Γ₁) Q_w (Γ₀ + Γ₁)ᵀ` (`S×S`) for an input-noise covariance `Q_w`
     /// (`I×I`, input units squared). For unmodelled forces on every DOF, build the model
     /// with `B = I` (`I = N`) and `Q_w = σ_f² I`. `const fn`; cost `S²·I + S·I²` flops.
+    ///
+    /// The noise model: the noise input is `η_n` over step `n` (independent from step to
+    /// step, `E η ηᵀ = Q_w`) at both of its ends, so the step adds `q_n = (Γ₀ + Γ₁) η_n`;
+    /// a sensor at `t_n` reads the input the step ended with, `D η_n`. Where the outputs
+    /// have a feedthrough of the noise input (accelerometers under unmodelled floor
+    /// forces) the measurement noise is correlated with `q_n`: give the filters
+    /// [`StateSpace::input_cross_noise`] as their cross covariance and add
+    /// [`StateSpace::feedthrough_noise`] to `R` ([module docs](super), "Noise that reaches
+    /// the sensors", derives it and checks it by simulation).
     pub const fn input_noise(&self, qw: &[[f64; I]; I]) -> [[f64; S]; S] {
         let g = add_scaled(&self.gamma0, 1.0, &self.gamma1);
         let gq = mul(&g, qw);
@@ -865,6 +874,71 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
             i += 1;
         }
         q
+    }
+
+    /// The feedthrough companion of [`StateSpace::input_noise`]: the cross covariance
+    /// `N = E q_n r_nᵀ = (Γ₀ + Γ₁) Q_w Dᵀ` (`S×O`) of the process noise `q_n` with the part
+    /// `D η_n` of the measurement noise that the same noise input puts in the sensors
+    /// (noise model in [`StateSpace::input_noise`]). `meas` is the sensors' measurement of
+    /// *this* (noise-input) model: its `D` maps the noise input to the outputs. For
+    /// accelerometers under unmodelled floor forces: `Outputs::accelerations` of the
+    /// sensors' DOFs on the model with `B = I` (a known ground input's own terms belong to
+    /// the model of the known input). For the filters' `cross` argument
+    /// ([`SteadyState::from_parts_cross`](super::SteadyState::from_parts_cross),
+    /// [`Kalman::with_cross`](super::Kalman::with_cross)). `const fn`; cost
+    /// `S·I² + S·I·O` flops.
+    pub const fn input_cross_noise<const O: usize>(
+        &self,
+        meas: &Measurement<S, I, O>,
+        qw: &[[f64; I]; I],
+    ) -> [[f64; O]; S] {
+        let gq = mul(&add_scaled(&self.gamma0, 1.0, &self.gamma1), qw);
+        let mut n = [[0.0; O]; S];
+        let mut i = 0;
+        while i < S {
+            let mut j = 0;
+            while j < O {
+                let mut s = 0.0;
+                let mut l = 0;
+                while l < I {
+                    s += gq[i][l] * meas.d[j][l];
+                    l += 1;
+                }
+                n[i][j] = s;
+                j += 1;
+            }
+            i += 1;
+        }
+        n
+    }
+
+    /// The measurement noise `D Q_w Dᵀ` (`O×O`, output units squared) that a white input
+    /// noise of covariance `Q_w` puts in the sensors through the feedthrough `D` of `meas`
+    /// (the noise-input model's measurement, as in [`StateSpace::input_cross_noise`]): add
+    /// it to the sensors' own noise to form `R`. `const fn`; cost `O·I² + O²·I` flops.
+    pub const fn feedthrough_noise<const O: usize>(
+        &self,
+        meas: &Measurement<S, I, O>,
+        qw: &[[f64; I]; I],
+    ) -> [[f64; O]; O] {
+        let dq = mul(&meas.d, qw);
+        let mut out = [[0.0; O]; O];
+        let mut i = 0;
+        while i < O {
+            let mut j = 0;
+            while j < O {
+                let mut s = 0.0;
+                let mut l = 0;
+                while l < I {
+                    s += dq[i][l] * meas.d[j][l];
+                    l += 1;
+                }
+                out[i][j] = s;
+                j += 1;
+            }
+            i += 1;
+        }
+        out
     }
 
     /// `Φ` as a `nalgebra` matrix.

@@ -1,0 +1,188 @@
+//! The Kalman core shared by every filter: the correction with a process–measurement cross
+//! covariance, and the start of the doubling algorithm for its Riccati equation.
+//!
+//! # The noise model
+//!
+//! Every filter of the crate is written for
+//!
+//! ```text
+//! x_n = Φ x_{n−1} + (known input) + q_n,      y_n = H x_n + (known input) + r_n,
+//! E q_n q_nᵀ = Q,   E r_n r_nᵀ = R,   E q_n r_nᵀ = N,   (q_n, r_n) independent of (q_m, r_m), m ≠ n
+//! ```
+//!
+//! (`N`, `S×O`: the noise that drives the state into sample `n` and the noise of the
+//! measurement at `n` are correlated; a force noise that reaches the accelerometers
+//! through the feedthrough, [`StateSpace::input_cross_noise`](super::StateSpace::input_cross_noise)).
+//! The a-priori error `e⁻ = x_n − x̂⁻_n = Φ e_{n−1} + q_n` is independent of the past
+//! measurements and has `E e⁻ r_nᵀ = N`, so the innovation `ν = H e⁻ + r_n` and the
+//! correction are
+//!
+//! ```text
+//! Σ = H P⁻ Hᵀ + R + H N + Nᵀ Hᵀ,     K = (P⁻ Hᵀ + N) Σ⁻¹,
+//! P = [I − K H, −K] [P⁻ N; Nᵀ R] [I − K H, −K]ᵀ
+//!   = (I − K H) P⁻ (I − K H)ᵀ + K R Kᵀ − (I − K H) N Kᵀ − K Nᵀ (I − K H)ᵀ   (Joseph form)
+//! ```
+//!
+//! With `N = 0` (every entry exactly zero) the filters take their original code path, bit
+//! for bit.
+//!
+//! # The Riccati equation with the cross term
+//!
+//! Write the a-priori covariance as `P⁻_n = Y_n + Q` (`Y_n` the covariance of the part of
+//! `e⁻_n` that is not `q_n`, `ε_n`). Then `Y_{n+1}` is the covariance of `A ε + A q` given
+//! `C ε + C q + r` — the Riccati difference equation of a *predictor* on `(A, C)` with
+//! state noise `A q` and measurement noise `C q + r`, whose cross covariance is
+//! `A (Q Cᵀ + N)`. Taking the cross term out in the usual way (`Ā = A − S_y R_y⁻¹ C`,
+//! `Q̃ = Q_y − S_y R_y⁻¹ S_yᵀ`) leaves the form the doubling algorithm solves,
+//! [`cross_riccati_start`]. For the Kalman filter `A = Φ`, `C = H`, `Q_y = Φ Q Φᵀ`,
+//! `S_y = Φ (Q Hᵀ + N)`, `R_y = H Q Hᵀ + R + H N + Nᵀ Hᵀ` (the covariance of `H q + r`:
+//! positive definite whenever `R` is and `[Q N; Nᵀ R]` is a covariance); the joint
+//! input–state filter uses the same form on its zero dynamics
+//! ([`estimation`](crate::estimation)).
+
+use nalgebra::{Cholesky, SMatrix};
+
+use super::riccati::{is_covariance, symmetrize};
+use super::state_space::lu_of;
+use crate::Real;
+use crate::linalg::{Mat, add_scaled, all_finite, mul, sym, transpose};
+
+/// Every entry of `a` is exactly zero (`±0`): no cross covariance.
+pub(crate) const fn is_zero<const R: usize, const C: usize>(a: &Mat<R, C>) -> bool {
+    let mut i = 0;
+    while i < R {
+        let mut j = 0;
+        while j < C {
+            if a[i][j] != 0.0 {
+                return false;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    true
+}
+
+/// The cross covariance `n` (`S×O`) is finite and `[q n; nᵀ r]` is a covariance, for a
+/// positive semidefinite `q` and a positive definite `r` (checked by the caller): the Schur
+/// complement `q − n r⁻¹ nᵀ` is positive semidefinite (as [`is_covariance`] judges it).
+/// Cost: `O³/3 + S·O² + S²·O + S³/6` flops.
+pub(crate) const fn cross_is_valid<const S: usize, const O: usize>(
+    q: &Mat<S, S>,
+    r: &Mat<O, O>,
+    n: &Mat<S, O>,
+) -> bool {
+    if !all_finite(n) {
+        return false;
+    }
+    let lu = match lu_of(r) {
+        Some(lu) => lu,
+        None => return false,
+    };
+    // r⁻¹ nᵀ (O×S).
+    let rn = lu.solve(&transpose(n));
+    let schur = symmetrize(&add_scaled(q, -1.0, &mul(n, &rn)));
+    all_finite(&schur) && is_covariance(&schur, false)
+}
+
+/// The innovation's parts for an a-priori covariance `p`: `Xᵀ = H P + Nᵀ` (`O×S`, the
+/// transpose of the covariance of the a-priori error with the innovation) and
+/// `Σ = H P Hᵀ + R + H N + Nᵀ Hᵀ` (`O×O`, not symmetrized); without `n` exactly
+/// `H P` and `R + H P Hᵀ` as the filters have always formed them. Cost: `S²·O + S·O²`
+/// flops (`2 S·O²` more with `n`).
+pub(crate) const fn innovation_parts<const S: usize, const O: usize>(
+    p: &Mat<S, S>,
+    h: &Mat<O, S>,
+    r: &Mat<O, O>,
+    n: Option<&Mat<S, O>>,
+) -> (Mat<O, S>, Mat<O, O>) {
+    let hp = mul(h, p);
+    let si = add_scaled(r, 1.0, &mul(&hp, &transpose(h)));
+    match n {
+        None => (hp, si),
+        Some(n) => {
+            let hn = mul(h, n);
+            (
+                add_scaled(&hp, 1.0, &transpose(n)),
+                add_scaled(&si, 1.0, &add_scaled(&hn, 1.0, &transpose(&hn))),
+            )
+        }
+    }
+}
+
+/// The doubling algorithm's start `(A₀, G₀, X₀)` for the Riccati equation with a cross
+/// term in the predictor form of the [module docs](self): the recursion
+/// `Y' = a Y aᵀ + q_y − (a Y cᵀ + s_y) (c Y cᵀ + R_y)⁻¹ (a Y cᵀ + s_y)ᵀ` with the weight
+/// `pi = R_y⁻¹` (or, for the joint filter, the inverse of `R_y` on the output directions
+/// the input does not take), decorrelated: `Ā = a − s_y π c`, `A₀ = Āᵀ`,
+/// `G₀ = cᵀ π c`, `X₀ = q_y − s_y π s_yᵀ`. The doubling's `X` is then the fixed point `Y`,
+/// and the a-priori covariance is `Y + Q`. Cost: about `3 S²·O + S·O² + S³` flops.
+#[allow(clippy::type_complexity)]
+pub(crate) const fn cross_riccati_start<const S: usize, const O: usize>(
+    a: &Mat<S, S>,
+    c: &Mat<O, S>,
+    qy: &Mat<S, S>,
+    sy: &Mat<S, O>,
+    pi: &Mat<O, O>,
+) -> (Mat<S, S>, Mat<S, S>, Mat<S, S>) {
+    let sp = mul(sy, pi);
+    let abar = add_scaled(a, -1.0, &mul(&sp, c));
+    let g = symmetrize(&mul(&transpose(c), &mul(pi, c)));
+    let x0 = symmetrize(&add_scaled(qy, -1.0, &mul(&sp, &transpose(sy))));
+    (transpose(&abar), g, x0)
+}
+
+/// The innovation's parts in the filter's scalar type (as [`innovation_parts`]):
+/// `Xᵀ = H P⁻ (+ Nᵀ)` and `Σ` symmetrized, `(Σ + Σᵀ)/2`. Without `n` exactly the operations
+/// the time-varying filters have always done. Cost: `S²·O + S·O²` multiply-adds (`S·O²`
+/// more with `n`).
+pub(crate) fn innovation_t<T: Real, const S: usize, const O: usize>(
+    pm: &SMatrix<T, S, S>,
+    h: &SMatrix<T, O, S>,
+    r: &SMatrix<T, O, O>,
+    n: Option<&SMatrix<T, S, O>>,
+) -> (SMatrix<T, O, S>, SMatrix<T, O, O>) {
+    let hp = h * pm;
+    let si = hp * h.transpose() + r;
+    match n {
+        None => (hp, (si + si.transpose()) * T::from_f64_rounded(0.5)),
+        Some(n) => {
+            let hn = h * n;
+            let si = si + hn + hn.transpose();
+            (
+                hp + n.transpose(),
+                (si + si.transpose()) * T::from_f64_rounded(0.5),
+            )
+        }
+    }
+}
+
+/// The gain `K = Xᵀᵀ Σ⁻¹` from the factored `Σ` and `Xᵀ` of [`innovation_t`].
+/// Cost: `S·O²` multiply-adds.
+pub(crate) fn gain_t<T: Real, const S: usize, const O: usize>(
+    chol: &Cholesky<T, nalgebra::Const<O>>,
+    xt: &SMatrix<T, O, S>,
+) -> SMatrix<T, S, O> {
+    chol.solve(xt).transpose()
+}
+
+/// The a-posteriori covariance in Joseph form, `(I − K H) P⁻ (I − K H)ᵀ + K R Kᵀ` and,
+/// with `n`, `− (I − K H) N Kᵀ − K Nᵀ (I − K H)ᵀ` ([module docs](self)), symmetrized.
+/// Cost: about `2S³ + 2S²·O + S·O²` multiply-adds (`2S²·O` more with `n`).
+pub(crate) fn joseph_t<T: Real, const S: usize, const O: usize>(
+    pm: &SMatrix<T, S, S>,
+    k: &SMatrix<T, S, O>,
+    h: &SMatrix<T, O, S>,
+    r: &SMatrix<T, O, O>,
+    n: Option<&SMatrix<T, S, O>>,
+) -> SMatrix<T, S, S> {
+    let ikh = SMatrix::<T, S, S>::identity() - k * h;
+    let p = ikh * pm * ikh.transpose() + k * r * k.transpose();
+    match n {
+        None => sym(&p),
+        Some(n) => {
+            let c = ikh * n * k.transpose();
+            sym(&(p - c - c.transpose()))
+        }
+    }
+}
