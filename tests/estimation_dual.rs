@@ -283,8 +283,7 @@ fn time_varying_dual_filter_matches_the_paper() {
     assert_eq!((s.estimate().steps(), s.estimate().missing()), (1499, 0));
     // The estimate is a dual filter's, not noise: its RMS force error after 10 s is below
     // the force's own RMS (what estimating zero would give; a loose sanity bound, not a
-    // tuned value: at 50 Hz the paper's order, whose input stage sees the previous step's
-    // state, lags this 0.25–5 Hz force; measured 0.5 of it).
+    // tuned value; measured 0.49 of it).
     assert!(se < sw, "force error RMS {} N", (se / count).sqrt());
 }
 
