@@ -917,8 +917,10 @@ fn dual_filter_matches_an_independent_filter_and_drifts_without_displacement() {
     let (mut dw, mut wmax, mut err, mut peak) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for n in 1..ys.len() {
         f.try_step(&mut e, &ys[n]).unwrap();
+        // The paper's order: the input from the previous filtered state, the state
+        // predicted with the new input.
+        wh += gw * (ys[n] - cm * xi - dmx * wh);
         let xp = am * xi + bm * wh;
-        wh += gw * (ys[n] - cm * xp - dmx * wh);
         xi = xp + gx * (ys[n] - cm * xp - dmx * wh);
         dw = dw.max((e.input()[0] - wh[0]).abs());
         wmax = wmax.max(wh[0].abs());

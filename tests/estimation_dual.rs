@@ -130,7 +130,8 @@ fn data(n: usize, seed: u64) -> (Vec<f64>, Vec<SVector<f64, 4>>) {
 }
 
 /// The dual Kalman filter as Eftekhar Azam, Chatzi & Papadimitriou (2015) write it (their
-/// input stage, then their state stage), on the standard form formed here from the plain
+/// Steps 1–3 for the input from the previous filtered state, then Steps 4–6 for the state
+/// predicted with the new input), on the standard form formed here from the plain
 /// matrices: `A = Φ`, `B = ΦΓ₁ + Γ₀`, `C = H`, `D̃ = HΓ₁ + D`. Explicit inverses.
 struct Paper {
     a: DMatrix<f64>,
@@ -182,18 +183,19 @@ impl Paper {
     }
 
     fn step(&mut self, y: &DVector<f64>) {
-        // Input stage: w_k⁻ = w_{k−1}, Pʷ⁻ = Pʷ + Q_w, gain, update with the state
-        // prediction's output.
-        let xp = &self.a * &self.x + &self.b * &self.w;
+        // Steps 1–3, the input: p_k⁻ = p_{k−1}, Pᵖ⁻ = Pᵖ + Q_p, the gain, and the update
+        // with the previous filtered state's output, d_k − G x̂_{k−1} − J p̂_{k−1}.
         let pwm = &self.pw + &self.qw;
         let gw = &pwm
             * self.d.transpose()
             * (&self.d * &pwm * self.d.transpose() + &self.r)
                 .try_inverse()
                 .unwrap();
-        let w = &self.w + &gw * (y - &self.c * &xp - &self.d * &self.w);
+        let w = &self.w + &gw * (y - &self.c * &self.x - &self.d * &self.w);
         let pw = &pwm - &gw * &self.d * &pwm;
-        // State stage with the new input.
+        // Steps 4–6, the state: predicted with the new input, x_k⁻ = A x̂_{k−1} + B p̂_k,
+        // then corrected with d_k − G x_k⁻ − J p̂_k.
+        let xp = &self.a * &self.x + &self.b * &w;
         let pm = &self.a * &self.p * self.a.transpose() + &self.q;
         let gx = &pm
             * self.c.transpose()
@@ -245,6 +247,7 @@ fn time_varying_dual_filter_matches_the_paper() {
     let (mut dw, mut dx, mut dp, mut dpw, mut dgx, mut dgw) =
         (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let (mut wmax, mut xmax, mut err, mut pw_ratio) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut se, mut sw, mut count) = (0.0f64, 0.0f64, 0.0f64);
     for n in 1..ys.len() {
         f.try_step(&mut s, &ys[n]).unwrap();
         g.step(&DVector::from_column_slice(ys[n].as_slice()));
@@ -263,19 +266,25 @@ fn time_varying_dual_filter_matches_the_paper() {
         dgw = dgw.max(rel(s.input_gain(), &g.gw));
         if n > 500 {
             err = err.max((e.input()[0] - w[n]).abs());
+            se += (e.input()[0] - w[n]).powi(2);
+            sw += w[n] * w[n];
+            count += 1.0;
         }
     }
     println!(
-        "time-varying dual vs paper: force {:.3e}, ξ {:.3e} (relative); P {dp:.3e}, Pʷ {dpw:.3e} (of the a-priori; Pʷ⁻/Pʷ up to {pw_ratio:.1e}), G_x {dgx:.3e}, G_w {dgw:.3e}; force error after 10 s {err:.3e} N",
+        "time-varying dual vs paper: force {:.3e}, ξ {:.3e} (relative); P {dp:.3e}, Pʷ {dpw:.3e} (of the a-priori; Pʷ⁻/Pʷ up to {pw_ratio:.1e}), G_x {dgx:.3e}, G_w {dgw:.3e}; force error after 10 s {err:.3e} N (RMS {:.3e} N of a force of RMS {:.3e} N)",
         dw / wmax,
-        dx / xmax
+        dx / xmax,
+        (se / count).sqrt(),
+        (sw / count).sqrt()
     );
     assert!(dp <= 1e-12 && dpw <= 1e-12 && dgx <= 1e-12 && dgw <= 1e-12);
     assert!(dw <= 1e-12 * wmax && dx <= 1e-12 * xmax);
     assert_eq!((s.estimate().steps(), s.estimate().missing()), (1499, 0));
-    // The estimate is a dual filter's, not noise: its force error is a fraction of the
-    // 50 kN RMS force (a loose sanity bound, not a tuned value).
-    assert!(err < 5e4, "force error {err}");
+    // The estimate is a dual filter's, not noise: its RMS force error after 10 s is below
+    // the force's own RMS (what estimating zero would give; a loose sanity bound, not a
+    // tuned value; measured 0.49 of it).
+    assert!(se < sw, "force error RMS {} N", (se / count).sqrt());
 }
 
 #[test]

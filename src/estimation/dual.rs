@@ -4,27 +4,45 @@
 //! covariances propagated as in the paper ([`DualKalmanFilter`]).
 //!
 //! On the standard form of [`InputModel`] (`ξ_n = A ξ_{n−1} + B w_{n−1}`,
-//! `y_n = C ξ_n + D̃ w_n`) a step is
+//! `y_n = C ξ_n + D̃ w_n`) a step is, in the paper's order (its Steps 1–6):
 //!
 //! ```text
-//! ξ⁻ = A ξ̂_{n−1} + B ŵ_{n−1}
-//! ŵ_n = ŵ_{n−1} + G_w (y_n − C ξ⁻ − D̃ ŵ_{n−1})      (input filter: w_n = w_{n−1} + η)
-//! ξ̂_n = ξ⁻ + G_x (y_n − C ξ⁻ − D̃ ŵ_n)              (state filter, with the new ŵ_n)
+//! ŵ_n = ŵ_{n−1} + G_w (y_n − C ξ̂_{n−1} − D̃ ŵ_{n−1})   (input filter: w_n = w_{n−1} + η)
+//! ξ⁻  = A ξ̂_{n−1} + B ŵ_n                              (state prediction, the new input)
+//! ξ̂_n = ξ⁻ + G_x (y_n − C ξ⁻ − D̃ ŵ_n)                  (state filter)
 //! ```
 //!
-//! The paper writes the input stage's innovation with `C x̂_{k−1}` and the state's
-//! prediction with `B p̂_k`; in the `ξ` form the prediction `ξ⁻` needs only `ŵ_{n−1}`, so
-//! both stages use it (the same structure, with the model's own timing). The gains are the
-//! steady-state Kalman gains of the two stages, each from the crate's
-//! [`SteadyState`]: `G_w` of the model `(I, D̃)` with process noise `Q_w` (the random
-//! walk), `G_x` of `(A, C)` with `Q`, both with measurement noise `R`.
+//! The input stage's innovation uses the filtered state of the previous step, `C ξ̂_{n−1}`,
+//! and the state is predicted with the new input `ŵ_n` — as the paper writes it (its
+//! `d_k − G x̂_{k−1} − J p̂_{k−1}` and `A x̂_{k−1} + B p̂_k`). The gains are the
+//! steady-state Kalman gains of the two stages, each from the crate's [`SteadyState`]:
+//! `G_w` of the model `(I, D̃)` with process noise `Q_w` (the random walk), `G_x` of
+//! `(A, C)` with `Q`, both with measurement noise `R`.
 //!
-//! The stages ignore their coupling, so no covariance of the joint error is propagated;
-//! the joint error dynamics are those of [`DualFilter::error_step`]. With
-//! acceleration-only sensing the static force–displacement pair `(ξ_s, w_c)`, `ξ_s =
-//! A ξ_s + B w_c`, `C ξ_s + D̃ w_c = 0`, is a fixed point of them for any gains (both
-//! innovations vanish on it): the dual filter drifts like every estimator that uses only
-//! these data; `tests/estimation.rs` shows it, and that a displacement removes it.
+//! Until issue 31 the crate ran the stages in another order ([`DualOrder::PredictedState`]:
+//! the input updated from the predicted state `ξ⁻ = A ξ̂_{n−1} + B ŵ_{n−1}`, the state
+//! predicted with the old input), arguing that `ξ⁻` is the model's own prediction. A scene
+//! refutes that: the 5-storey building with an unknown roof force, the exact zero-order
+//! hold at 200 Hz ([`StateSpace::zero_order_hold`]), accelerations of floors 1, 3, 5
+//! (σ = 1 mm/s²) and the roof displacement (σ = 10 µm), process noise `Q = 1e-14 I`: with
+//! the same gains, that order's error dynamics have a spectral radius of 1.0014 to 1.0018
+//! for every random-walk variance `Q_w` from 1e4 to 1e10 N² (the force estimate grows
+//! without bound), the paper's 0.9970 to 0.9989 (`tests/dual_order.rs` certifies both,
+//! and a second scene, and runs them for 10⁶ steps). The old order stays as an option of the fixed-gain filter
+//! ([`DualFilter::with_order`]) for models where it is shown stable (e.g. the crate's AEM
+//! scene at 50 Hz, radius 0.9862); [`DualKalmanFilter`] runs the paper's order only.
+//!
+//! Neither order is stable for every tuning: the stages ignore their coupling, so no
+//! covariance of the joint error is propagated and nothing guarantees that the joint
+//! error dynamics ([`DualFilter::error_step`]) contract. On the scene above with
+//! σ = 10 mm/s² accelerometers both orders have a radius above 1 (1.0002 to 1.0013 the
+//! paper's, over the same `Q_w`). Certify the radius of the filter you deploy
+//! (`tests/dual_order.rs` shows how: a power of the error matrix in a norm, with its
+//! rounding bounded). With acceleration-only sensing the static force–displacement pair
+//! `(ξ_s, w_c)`, `ξ_s = A ξ_s + B w_c`, `C ξ_s + D̃ w_c = 0`, is a fixed point of the
+//! error dynamics of both orders for any gains (both innovations vanish on it): the dual
+//! filter drifts like every estimator that uses only these data; `tests/estimation.rs`
+//! shows it, and that a displacement removes it.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -116,13 +134,36 @@ impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
     }
 }
 
-/// The fixed-gain dual Kalman filter (the steps of the [module docs](self)), `S` states,
-/// `I` inputs, `O` measurements, stepping in `T`. A measurement with a non-finite entry is
-/// missing: `ξ̂_n = ξ⁻`, the input estimate held, counted.
+/// The order of the two stages of a [`DualFilter`] step (see the [module docs](self)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DualOrder {
+    /// Eftekhar Azam, Chatzi & Papadimitriou (2015): the input from the previous filtered
+    /// state, `ŵ_n = ŵ_{n−1} + G_w (y_n − C ξ̂_{n−1} − D̃ ŵ_{n−1})`, then the state
+    /// predicted with the new input, `ξ⁻ = A ξ̂_{n−1} + B ŵ_n`. The default.
+    #[default]
+    Paper,
+    /// The crate's order before issue 31: `ξ⁻ = A ξ̂_{n−1} + B ŵ_{n−1}` first, the input
+    /// from it, `ŵ_n = ŵ_{n−1} + G_w (y_n − C ξ⁻ − D̃ ŵ_{n−1})`, then
+    /// `ξ̂_n = ξ⁻ + G_x (y_n − C ξ⁻ − D̃ ŵ_n)`. Stable on some models (the AEM 5-storey
+    /// building at 50 Hz with three accelerometers and the roof displacement: radius
+    /// 0.9862), **unstable on others** where the paper's order is stable (the same
+    /// building as a zero-order hold at 200 Hz with quieter sensors: radius ≥ 1.0013,
+    /// `tests/dual_order.rs`). Use it only with a certified radius of
+    /// [`DualFilter::error_step`] below 1.
+    PredictedState,
+}
+
+/// The fixed-gain dual Kalman filter (the steps of the [module docs](self), in the
+/// paper's order unless [`DualFilter::with_order`] says otherwise), `S` states, `I`
+/// inputs, `O` measurements, stepping in `T`. A measurement with a non-finite entry is
+/// missing: `ξ̂_n = A ξ̂_{n−1} + B ŵ_{n−1}`, the input estimate held, counted.
 ///
-/// Cost of a step: `S² + S·I + 2S·O + 3O·I` multiply-adds, fixed. Size:
-/// `S² + 3S·I + 2S·O + 2O·I + 1` values of `T`. [`DualFilter::new`] and `from_parts_f32`/`_f64`
-/// (`const fn`) are bit-identical.
+/// Cost of a step: `S² + S·I + 3S·O + 3O·I` multiply-adds in the paper's order,
+/// `S² + S·I + 2S·O + 3O·I` in [`DualOrder::PredictedState`], fixed. Size:
+/// `S² + 2S·I + 2S·O + 2O·I + 1` values of `T` (`A`, `B`, `C`, `D̃`, `G_w`, `G_x`, `Γ₁`,
+/// `h`) and a [`DualOrder`]. [`DualFilter::new`] and `from_parts_f32`/`_f64` (`const fn`)
+/// are bit-identical.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DualFilter<T, const S: usize, const I: usize, const O: usize> {
     a: [[T; S]; S],
@@ -133,6 +174,7 @@ pub struct DualFilter<T, const S: usize, const I: usize, const O: usize> {
     gain_x: [[T; O]; S],
     gamma1: [[T; I]; S],
     time_step: T,
+    order: DualOrder,
 }
 
 /// Every operator finite and fitting `T`.
@@ -184,7 +226,20 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
             gain_x: round_rows(&gains.state.gain),
             gamma1: round_rows(&model.gamma1),
             time_step: T::from_f64_rounded(model.time_step),
+            order: DualOrder::Paper,
         })
+    }
+
+    /// The same filter with its stages in `order` (`const fn`; [`DualFilter::new`] gives
+    /// [`DualOrder::Paper`]). Cost: a copy.
+    pub const fn with_order(mut self, order: DualOrder) -> Self {
+        self.order = order;
+        self
+    }
+
+    /// The order of the stages.
+    pub const fn order(&self) -> DualOrder {
+        self.order
     }
 
     /// The time step `h` (s).
@@ -207,52 +262,71 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
         shift(&self.gamma1, &e.xi, &e.w, T::one())
     }
 
-    /// One step of the joint error dynamics without noise (a constant input, exact
-    /// data): the errors `(ξ − ξ̂, w − ŵ)` of a step from the errors `(ex, ew)` before
-    /// it ([module docs](self)):
+    /// One step of the joint error dynamics without noise (a constant input and state
+    /// increment, exact data): the errors `(ξ − ξ̂, w − ŵ)` of a step from the errors
+    /// `(ex, ew)` before it, in the filter's [`DualOrder`]:
     ///
     /// ```text
-    /// e⁻ = A e_ξ + B e_w,  e_w' = e_w − G_w (C e⁻ + D̃ e_w),  e_ξ' = e⁻ − G_x (C e⁻ + D̃ e_w')
+    /// Paper:          e_w' = e_w − G_w (C e_ξ + D̃ e_w),  e⁻ = A e_ξ + B e_w',
+    ///                 e_ξ' = e⁻ − G_x (C e⁻ + D̃ e_w')
+    /// PredictedState: e⁻ = A e_ξ + B e_w,  e_w' = e_w − G_w (C e⁻ + D̃ e_w),
+    ///                 e_ξ' = e⁻ − G_x (C e⁻ + D̃ e_w')
     /// ```
     ///
     /// Applied to the unit vectors it gives the matrix whose spectral radius says whether
-    /// the filter's errors die out. Cost: about a step.
+    /// the filter's errors die out. In the paper's order the errors are also driven by the
+    /// increments of the true state and input (`C (ξ_n − ξ_{n−1})` in the input stage's
+    /// innovation, `B (w_{n−1} − w_n)` in the prediction), bounded when the structure's
+    /// response is: with a radius below 1 the errors stay bounded. Cost: about a step.
     pub fn error_step(
         &self,
         ex: &SVector<T, S>,
         ew: &SVector<T, I>,
     ) -> (SVector<T, S>, SVector<T, I>) {
-        let em = SVector::<T, S>::from_fn(|i, _| {
-            let mut s = T::zero();
-            for j in 0..S {
-                s += self.a[i][j] * ex[j];
-            }
-            for j in 0..I {
-                s += self.b[i][j] * ew[j];
-            }
-            s
-        });
-        let innov = |w: &SVector<T, I>| {
-            SVector::<T, O>::from_fn(|o, _| {
+        let predict = |ex: &SVector<T, S>, ew: &SVector<T, I>| {
+            SVector::<T, S>::from_fn(|i, _| {
                 let mut s = T::zero();
                 for j in 0..S {
-                    s += self.c[o][j] * em[j];
+                    s += self.a[i][j] * ex[j];
                 }
                 for j in 0..I {
-                    s += self.d[o][j] * w[j];
+                    s += self.b[i][j] * ew[j];
                 }
                 s
             })
         };
-        let nu = innov(ew);
-        let ew1 = SVector::<T, I>::from_fn(|i, _| {
-            let mut s = ew[i];
-            for o in 0..O {
-                s -= self.gain_w[i][o] * nu[o];
+        let output = |ex: &SVector<T, S>, ew: &SVector<T, I>| {
+            SVector::<T, O>::from_fn(|o, _| {
+                let mut s = T::zero();
+                for j in 0..S {
+                    s += self.c[o][j] * ex[j];
+                }
+                for j in 0..I {
+                    s += self.d[o][j] * ew[j];
+                }
+                s
+            })
+        };
+        let input_stage = |nu: &SVector<T, O>| {
+            SVector::<T, I>::from_fn(|i, _| {
+                let mut s = ew[i];
+                for o in 0..O {
+                    s -= self.gain_w[i][o] * nu[o];
+                }
+                s
+            })
+        };
+        let (em, ew1) = match self.order {
+            DualOrder::Paper => {
+                let ew1 = input_stage(&output(ex, ew));
+                (predict(ex, &ew1), ew1)
             }
-            s
-        });
-        let nu2 = innov(&ew1);
+            DualOrder::PredictedState => {
+                let em = predict(ex, ew);
+                (em, input_stage(&output(&em, ew)))
+            }
+        };
+        let nu2 = output(&em, &ew1);
         let ex1 = SVector::<T, S>::from_fn(|i, _| {
             let mut s = em[i];
             for o in 0..O {
@@ -264,68 +338,110 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
     }
 
     /// One step with the measurement `y` (`y_n`; a non-finite entry: missing). Fixed cost
-    /// (type docs), no allocation, no panic.
+    /// (type docs), no allocation, no panic. A step whose step or missing-sample counter
+    /// would pass `u64::MAX` is refused and changes nothing ([`DualFilter::try_step`]
+    /// reports it).
     #[inline]
     pub fn step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) {
-        let neg_zero = -T::zero();
-        let xp: [T; S] = core::array::from_fn(|i| {
-            let mut s = neg_zero;
-            for j in 0..I {
-                s += self.b[i][j] * e.w[j];
-            }
-            for j in 0..S {
-                s += self.a[i][j] * e.xi[j];
-            }
-            s
-        });
-        if !y.iter().all(|v| v.is_finite()) {
-            e.xi = xp.into();
-            e.missing = e.missing.wrapping_add(1);
-            e.n = e.n.wrapping_add(1);
+        let present = y.iter().all(|v| v.is_finite());
+        let (Some(n), Some(missing)) = (
+            e.n.checked_add(1),
+            e.missing.checked_add(u64::from(!present)),
+        ) else {
+            return;
+        };
+        e.n = n;
+        e.missing = missing;
+        if !present {
+            e.xi = self.predict(&e.xi, &e.w).into();
             return;
         }
-        // ν₀ = y − C ξ⁻; the input stage's innovation ν₀ − D̃ ŵ_{n−1}.
-        let nu0: [T; O] = core::array::from_fn(|o| {
-            let mut s = y[o];
-            for j in 0..S {
-                s -= self.c[o][j] * xp[j];
+        match self.order {
+            DualOrder::Paper => {
+                // Input stage: ν = y − C ξ̂_{n−1} − D̃ ŵ_{n−1}, ŵ_n = ŵ_{n−1} + G_w ν.
+                let nu = self.innovation(y, &e.xi.into(), &e.w);
+                self.correct_input(&mut e.w, &nu);
+                // State stage: ξ⁻ = A ξ̂_{n−1} + B ŵ_n, ξ̂_n = ξ⁻ + G_x (y − C ξ⁻ − D̃ ŵ_n).
+                let xp = self.predict(&e.xi, &e.w);
+                let nu = self.innovation(y, &xp, &e.w);
+                self.correct_state(&mut e.xi, &xp, &nu);
             }
-            s
-        });
-        let mut nu = nu0;
-        for o in 0..O {
-            for j in 0..I {
-                nu[o] -= self.d[o][j] * e.w[j];
+            DualOrder::PredictedState => {
+                let xp = self.predict(&e.xi, &e.w);
+                let nu = self.innovation(y, &xp, &e.w);
+                self.correct_input(&mut e.w, &nu);
+                let nu = self.innovation(y, &xp, &e.w);
+                self.correct_state(&mut e.xi, &xp, &nu);
             }
         }
+    }
+
+    /// `B w + A ξ` (in that order, from `−0`).
+    #[inline(always)]
+    fn predict(&self, xi: &SVector<T, S>, w: &SVector<T, I>) -> [T; S] {
+        let neg_zero = -T::zero();
+        core::array::from_fn(|i| {
+            let mut s = neg_zero;
+            for j in 0..I {
+                s += self.b[i][j] * w[j];
+            }
+            for j in 0..S {
+                s += self.a[i][j] * xi[j];
+            }
+            s
+        })
+    }
+
+    /// `y − C ξ − D̃ w`.
+    #[inline(always)]
+    fn innovation(&self, y: &SVector<T, O>, xi: &[T; S], w: &SVector<T, I>) -> [T; O] {
+        core::array::from_fn(|o| {
+            let mut s = y[o];
+            for j in 0..S {
+                s -= self.c[o][j] * xi[j];
+            }
+            for j in 0..I {
+                s -= self.d[o][j] * w[j];
+            }
+            s
+        })
+    }
+
+    /// `w += G_w ν`.
+    #[inline(always)]
+    fn correct_input(&self, w: &mut SVector<T, I>, nu: &[T; O]) {
         for i in 0..I {
-            let mut s = e.w[i];
+            let mut s = w[i];
             for o in 0..O {
                 s += self.gain_w[i][o] * nu[o];
             }
-            e.w[i] = s;
+            w[i] = s;
         }
-        // The state stage's innovation ν₀ − D̃ ŵ_n.
-        for o in 0..O {
-            let mut s = nu0[o];
-            for j in 0..I {
-                s -= self.d[o][j] * e.w[j];
-            }
-            nu[o] = s;
-        }
+    }
+
+    /// `ξ = ξ⁻ + G_x ν`.
+    #[inline(always)]
+    fn correct_state(&self, xi: &mut SVector<T, S>, xp: &[T; S], nu: &[T; O]) {
         for i in 0..S {
             let mut s = xp[i];
             for o in 0..O {
                 s += self.gain_x[i][o] * nu[o];
             }
-            e.xi[i] = s;
+            xi[i] = s;
         }
-        e.n = e.n.wrapping_add(1);
     }
 
     /// [`DualFilter::step`], checked: the new estimate must be finite, else `e` is left
-    /// bit-identical. Errors: [`Error::NonFiniteState`].
+    /// bit-identical.
+    ///
+    /// Errors: [`Error::NonFiniteState`]; [`Error::StepCountOverflow`] when the step
+    /// counter would pass `u64::MAX` (1.8e19 steps: 2.9 million years at 200 kHz, so only
+    /// a corrupted or forged estimate), `e` unchanged.
     pub fn try_step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) -> Result<(), Error> {
+        let missing = u64::from(!y.iter().all(|v| v.is_finite()));
+        if e.n.checked_add(1).is_none() || e.missing.checked_add(missing).is_none() {
+            return Err(Error::StepCountOverflow);
+        }
         commit_if_finite(e, |next| self.step(next, y))
     }
 }
@@ -352,6 +468,7 @@ macro_rules! dual_const {
                     gain_x: linalg::const_round!($t, rows gains.state.gain),
                     gamma1: linalg::const_round!($t, rows model.gamma1),
                     time_step: model.time_step as $t,
+                    order: DualOrder::Paper,
                 })
             }
         }
@@ -401,17 +518,18 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilterSt
 }
 
 /// The time-varying dual Kalman filter of Eftekhar Azam, Chatzi & Papadimitriou (2015):
-/// the step of the [module docs](self) with both stages' covariances propagated, as the
-/// paper writes it:
+/// the step of the [module docs](self) (the paper's order) with both stages' covariances
+/// propagated, as the paper writes it:
 ///
 /// ```text
 /// input stage:  Pʷ⁻ = Pʷ_{n−1} + Q_w        G_w = Pʷ⁻ D̃ᵀ (D̃ Pʷ⁻ D̃ᵀ + R)⁻¹
-///               ŵ_n = ŵ_{n−1} + G_w (y_n − C ξ⁻ − D̃ ŵ_{n−1})     Pʷ_n = Pʷ⁻ − G_w D̃ Pʷ⁻
-/// state stage:  P⁻ = A P_{n−1} Aᵀ + Q          G_x = P⁻ Cᵀ (C P⁻ Cᵀ + R)⁻¹
-///               ξ̂_n = ξ⁻ + G_x (y_n − C ξ⁻ − D̃ ŵ_n)              P_n = P⁻ − G_x C P⁻
+///               ŵ_n = ŵ_{n−1} + G_w (y_n − C ξ̂_{n−1} − D̃ ŵ_{n−1})    Pʷ_n = Pʷ⁻ − G_w D̃ Pʷ⁻
+/// state stage:  ξ⁻ = A ξ̂_{n−1} + B ŵ_n      P⁻ = A P_{n−1} Aᵀ + Q
+///               G_x = P⁻ Cᵀ (C P⁻ Cᵀ + R)⁻¹
+///               ξ̂_n = ξ⁻ + G_x (y_n − C ξ⁻ − D̃ ŵ_n)                 P_n = P⁻ − G_x C P⁻
 /// ```
 ///
-/// with `ξ⁻ = A ξ̂_{n−1} + B ŵ_{n−1}`. As in the paper, each stage's innovation
+/// As in the paper, each stage's innovation
 /// covariance holds only its own uncertainty and `R`: the input stage's leaves out
 /// `C P⁻ Cᵀ` (the state's error in its innovation), the state stage's leaves out
 /// `D̃ Pʷ D̃ᵀ`, and `P⁻` leaves out `B Pʷ Bᵀ`. The two recursions are therefore
@@ -421,13 +539,14 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilterSt
 /// The covariances are those of the stages' models, not the errors of the coupled
 /// filter.
 ///
-/// A measurement with a non-finite entry is missing: predict only (`ξ̂_n = ξ⁻`,
-/// `P_n = P⁻`, `ŵ_n = ŵ_{n−1}` with `Pʷ_n = Pʷ⁻`: the random walk's prediction), counted.
+/// A measurement with a non-finite entry is missing: predict only (`ŵ_n = ŵ_{n−1}` with
+/// `Pʷ_n = Pʷ⁻`: the random walk's prediction; `ξ̂_n = A ξ̂_{n−1} + B ŵ_{n−1}`,
+/// `P_n = P⁻`), counted.
 /// Only a checked step: a failed step changes nothing.
 ///
 /// Cost of a step: about `2S³ + 2S²·O + 2S·O² + O³/3` multiply-adds for the state stage
 /// and `2O·I² + 2O²·I + O³/3` for the input stage, plus the fixed filter's
-/// `S² + S·I + 2S·O + 3O·I` (`≈ 3 400` for `S = 10`, `I = 1`, `O = 4`): for the host and
+/// `S² + S·I + 3S·O + 3O·I` (`≈ 3 400` for `S = 10`, `I = 1`, `O = 4`): for the host and
 /// small firmware models; the [`DualFilter`] with the steady [`DualGains`] costs the last
 /// term only. Size: `2S² + 2S·I + S·O + O·I + I² + O² + 1` values of `T`; its state
 /// ([`DualKalmanFilterState`]) `S² + S + I² + I + S·O + I·O` values and two `u64`. No
@@ -579,7 +698,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
     ///
     /// Errors, `s` left bit-identical: [`Error::InvalidCovariance`] (`D̃ Pʷ⁻ D̃ᵀ + R` or
     /// `C P⁻ Cᵀ + R` not positive definite to working precision),
-    /// [`Error::NonFiniteState`] (a non-finite estimate, covariance or gain). No
+    /// [`Error::NonFiniteState`] (a non-finite estimate, covariance or gain),
+    /// [`Error::StepCountOverflow`] (the step or missing-sample counter would pass
+    /// `u64::MAX`: only a corrupted or forged state, see [`DualFilter::try_step`]). No
     /// allocation, no panic; cost in the type docs.
     pub fn try_step(
         &self,
@@ -587,36 +708,42 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
         y: &SVector<T, O>,
     ) -> Result<(), Error> {
         let e = &s.estimate;
-        let xp = self.a * e.xi + self.b * e.w;
+        let present = y.iter().all(|v| v.is_finite());
+        let (Some(n), Some(missing)) = (
+            e.n.checked_add(1),
+            e.missing.checked_add(u64::from(!present)),
+        ) else {
+            return Err(Error::StepCountOverflow);
+        };
         let (pm, pwm) = self.predicted_covariances(s);
         let mut next = *s;
-        if y.iter().all(|v| v.is_finite()) {
-            // ν₀ = y − C ξ⁻.
-            let nu0 = y - self.c * xp;
-            // Input stage: the random walk measured through D̃.
+        if present {
+            // Input stage (the paper's Steps 1–3): the random walk measured through D̃,
+            // its innovation from the previous filtered state.
             let dp = self.d * pwm;
             let sw = sym(&(dp * self.d.transpose() + self.r));
             let cw = sw.cholesky().ok_or(Error::InvalidCovariance)?;
             let gw = cw.solve(&dp).transpose();
-            let w = e.w + gw * (nu0 - self.d * e.w);
-            // State stage, with the new ŵ_n.
+            let w = e.w + gw * (y - self.c * e.xi - self.d * e.w);
+            // State stage (Steps 4–6): predicted with the new ŵ_n.
+            let xp = self.a * e.xi + self.b * w;
             let cp = self.c * pm;
             let sx = sym(&(cp * self.c.transpose() + self.r));
             let cx = sx.cholesky().ok_or(Error::InvalidCovariance)?;
             let gx = cx.solve(&cp).transpose();
-            next.estimate.xi = xp + gx * (nu0 - self.d * w);
+            next.estimate.xi = xp + gx * (y - self.c * xp - self.d * w);
             next.estimate.w = w;
             next.pw = sym(&(pwm - gw * dp));
             next.p = sym(&(pm - gx * cp));
             next.gain_w = gw;
             next.gain_x = gx;
         } else {
-            next.estimate.xi = xp;
+            next.estimate.xi = self.a * e.xi + self.b * e.w;
             next.p = pm;
             next.pw = pwm;
-            next.estimate.missing = next.estimate.missing.wrapping_add(1);
         }
-        next.estimate.n = next.estimate.n.wrapping_add(1);
+        next.estimate.n = n;
+        next.estimate.missing = missing;
         let finite = next
             .estimate
             .xi
@@ -632,5 +759,84 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
         }
         *s = next;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The counters of a step (issue 31): a step whose step or missing-sample counter
+    //! would pass `u64::MAX` is refused, typed, and changes nothing (the counters used to
+    //! wrap to 0). Here because only the crate can make an estimate that old.
+
+    use super::*;
+    use crate::models;
+    use crate::observer::Outputs;
+
+    fn model() -> InputModel<4, 1, 2> {
+        let (m, k) = models::shear_building([1.0e3, 1.0e3], [1.0e6, 1.0e6]);
+        let c = models::rayleigh(&m, &k, 0.1, 1e-3);
+        let ss = StateSpace::<2, 4, 1>::from_rows_aem(m, c, k, [[0.0], [1.0]], 0.01).unwrap();
+        let mut out = Outputs::<2, 1, 2>::zero();
+        out.a[0][1] = 1.0;
+        out.u[1][1] = 1.0;
+        InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn dual_counters_that_would_overflow_refuse_the_step() {
+        let model = model();
+        let (q, qw) = (
+            SMatrix::<f64, 4, 4>::identity() * 1e-10,
+            SMatrix::from([[1e4]]),
+        );
+        let r = SMatrix::<f64, 2, 2>::from_diagonal(&SVector::from([1e-4, 1e-10]));
+        let y = SVector::<f64, 2>::from([0.1, 1e-4]);
+        let gap = SVector::<f64, 2>::from([f64::NAN, 1e-4]);
+        let fixed =
+            DualFilter::<f64, 4, 1, 2>::new(&model, &DualGains::new(&model, &q, &qw, &r).unwrap())
+                .unwrap();
+        for order in [DualOrder::Paper, DualOrder::PredictedState] {
+            let f = fixed.with_order(order);
+            let mut e = f.start(&SVector::zeros(), &SVector::zeros()).unwrap();
+            e.n = u64::MAX;
+            e.missing = 7;
+            let before = e;
+            assert_eq!(f.try_step(&mut e, &y), Err(Error::StepCountOverflow));
+            assert_eq!(f.try_step(&mut e, &gap), Err(Error::StepCountOverflow));
+            f.step(&mut e, &y);
+            f.step(&mut e, &gap);
+            assert_eq!(e, before);
+            // The missing-sample counter alone (a forged estimate): refused only when the
+            // sample is missing.
+            e.n = 5;
+            e.missing = u64::MAX;
+            let before = e;
+            assert_eq!(f.try_step(&mut e, &gap), Err(Error::StepCountOverflow));
+            f.step(&mut e, &gap);
+            assert_eq!(e, before);
+            assert_eq!(f.try_step(&mut e, &y), Ok(()));
+            assert_eq!((e.n, e.missing), (6, u64::MAX));
+        }
+        let tv = DualKalmanFilter::<f64, 4, 1, 2>::new(&model, &q, &qw, &r).unwrap();
+        let mut s = tv
+            .start(
+                &SVector::zeros(),
+                &SMatrix::identity(),
+                &SVector::zeros(),
+                &SMatrix::identity(),
+            )
+            .unwrap();
+        s.estimate.n = u64::MAX;
+        let before = s;
+        assert_eq!(tv.try_step(&mut s, &y), Err(Error::StepCountOverflow));
+        assert_eq!(tv.try_step(&mut s, &gap), Err(Error::StepCountOverflow));
+        assert_eq!(s, before);
+        s.estimate.n = 5;
+        s.estimate.missing = u64::MAX;
+        let before = s;
+        assert_eq!(tv.try_step(&mut s, &gap), Err(Error::StepCountOverflow));
+        assert_eq!(s, before);
+        assert_eq!(tv.try_step(&mut s, &y), Ok(()));
+        assert_eq!((s.estimate.n, s.estimate.missing), (6, u64::MAX));
     }
 }

@@ -29,7 +29,9 @@
 //! the `u` and `v` rows (`u_n = û + βh² a_n`, `v_n = v̂ + γh a_n`). ([`StateSpace::generalized_alpha`].)
 //!
 //! **Exact** ([`Exact`](crate::Exact)): the blocks of its matrix exponential, the
-//! first-order-hold load `p = B w` linear over the step. **Modal**
+//! first-order-hold load `p = B w` linear over the step. **Zero-order hold**
+//! ([`StateSpace::zero_order_hold`]): the same exponential with the input held over the
+//! step at its first sample (`Γ₀ = ∫₀ʰ e^{F s} ds [0; M⁻¹] B`, `Γ₁ = 0`). **Modal**
 //! ([`Modal`](crate::Modal)): the scalar AEM of each kept mode, `x = [η; η']` (`2R` values);
 //! each of the four `R×R` blocks of `Φ` is diagonal.
 //!
@@ -42,9 +44,11 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{newmark_operators, start_operators};
+use crate::kernel::{checked_rows, newmark_operators, start_operators};
+use crate::kinematics::check_time_step_as;
+use crate::linalg::expm::{Blk, blk_expm, norm1};
 use crate::linalg::lu::{Lu, row_scales};
-use crate::linalg::{Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled};
+use crate::linalg::{Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled, sqrt};
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
 use crate::{AlphaParameters, Error, Exact};
@@ -61,10 +65,12 @@ use crate::{AlphaParameters, Error, Exact};
 /// modal, `[η; η']`. Plain matrices a user can check; [`StateSpace::outputs`] makes the
 /// output matrices of any [`Outputs`]. Built by [`StateSpace::aem`],
 /// [`StateSpace::newmark`], [`StateSpace::generalized_alpha`], [`StateSpace::exact`],
-/// [`StateSpace::modal`] (run time) or the `const fn` [`StateSpace::from_rows_aem`],
-/// [`StateSpace::from_rows_newmark`], [`StateSpace::from_rows_generalized_alpha`],
-/// [`StateSpace::from_rows_modal`] (in a `static`: computed by the compiler). Each
-/// reproduces its stepper to rounding (`tests/state_space.rs`).
+/// [`StateSpace::zero_order_hold`], [`StateSpace::modal`] (run time) or the `const fn`
+/// [`StateSpace::from_rows_aem`], [`StateSpace::from_rows_newmark`],
+/// [`StateSpace::from_rows_generalized_alpha`], [`StateSpace::from_rows_modal`] (in a
+/// `static`: computed by the compiler). Each reproduces its stepper to rounding
+/// (`tests/state_space.rs`); the zero-order hold, which has no stepper, its closed form
+/// and an independent exponential (`tests/zoh.rs`).
 ///
 /// Size: `S² + 2S·I + N·(3S + I) + 1` values of `f64` (a build-time object: the
 /// observers keep only what they step with).
@@ -653,6 +659,93 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         put(&mut ss.gamma1, &mul(&ex.au[3], &bb), 0, 0);
         put(&mut ss.gamma1, &mul(&ex.av[3], &bb), N, 0);
         let (au, av) = (scaled(-1.0, &st.minv_k), scaled(-1.0, &st.minv_c));
+        ss.full_outputs(&au, &av, lu_m.solve(&bb))
+    }
+
+    /// The zero-order-hold discretization (`x = [u; v]`, `S = 2N`): the input held
+    /// constant over each step at its sample from the step's start, as a DAC or a
+    /// sample-and-hold drives it and as sampled-data models are written,
+    ///
+    /// ```text
+    /// x_n = Φ x_{n−1} + Γ w_{n−1},   Φ = e^{F h},   Γ = ∫₀ʰ e^{F s} ds · [0; M⁻¹] B,
+    /// F = [[0, I], [−M⁻¹K, −M⁻¹C]]
+    /// ```
+    ///
+    /// exactly (no truncation error, only rounding) — so in the two-ended form
+    /// `Γ₀ = Γ`, `Γ₁ = 0` (for the filters of [`estimation`](crate::estimation):
+    /// `B = Γ`, `D̃ = D`). `Φ` and `Γ` are blocks of one matrix exponential (Van Loan)
+    /// of `h [[0, I, 0], [−M⁻¹K, −M⁻¹C, M⁻¹], [0, 0, 0]]`, balanced and computed as for
+    /// [`Exact`] (same `Φ`). The outputs are those of every full-state builder:
+    /// `u = U x`, `v = V x`, `a = M⁻¹ (B w − C v − K u)` — the acceleration at `t_n` with
+    /// the sample `w_n` that is held from `t_n` on (the right limit at a switch of the
+    /// input), so an acceleration output has the direct feedthrough `D = Y_a M⁻¹ B`, the
+    /// standard `y_n = H x_n + D w_n` of a sampled system. [`StateSpace::exact`] is the
+    /// first-order hold (the input linear between its samples). Run time only.
+    ///
+    /// ```
+    /// use aemstep::observer::StateSpace;
+    /// use aemstep::matrix;
+    /// // u'' + ω² u = w/m, ω = 5 rad/s, m = 2 kg, h = 0.1 s: Γ = [(1 − cos ωh)/ω²; sin(ωh)/ω] / m.
+    /// let (w, h) = (5.0f64, 0.1);
+    /// let ss = StateSpace::<1, 2, 1>::zero_order_hold(
+    ///     &matrix![2.0], &matrix![0.0], &matrix![2.0 * w * w], &matrix![1.0], h)?;
+    /// assert!((ss.phi[0][0] - (w * h).cos()).abs() < 1e-15);
+    /// assert!((ss.gamma0[0][0] - (1.0 - (w * h).cos()) / (w * w) / 2.0).abs() < 1e-16);
+    /// assert!((ss.gamma0[1][0] - (w * h).sin() / w / 2.0).abs() < 1e-16);
+    /// assert_eq!(ss.gamma1, [[0.0], [0.0]]);
+    /// # Ok::<(), aemstep::Error>(())
+    /// ```
+    ///
+    /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`] (`M`,
+    /// `C`, `K` or `B`), [`Error::InvalidTimeStep`], [`Error::SingularMass`],
+    /// [`Error::OperatorOverflow`].
+    ///
+    /// Cost: about `(4N)³ (19 + s)` `f64` flops (`s` squarings, as [`Exact::new`]) plus
+    /// `4N²·I`, and three `16N²` `f64` temporaries on the stack.
+    pub fn zero_order_hold(
+        m: &SMatrix<f64, N, N>,
+        c: &SMatrix<f64, N, N>,
+        k: &SMatrix<f64, N, N>,
+        b: &SMatrix<f64, N, I>,
+        h: f64,
+    ) -> Result<Self, Error> {
+        if S != 2 * N {
+            return Err(Error::StateSizeMismatch);
+        }
+        let bb = rows_f64(b);
+        if !all_finite(&bb) {
+            return Err(Error::NonFiniteInput);
+        }
+        let (mm, cc, kk) = checked_rows(m, c, k)?;
+        let hf = check_time_step_as(h, f64::MAX)?;
+        let (lu_m, st) = start_operators(&mm, &cc, &kk, f64::MAX)?.ok_or(Error::SingularMass)?;
+        let (mi, mic, mik) = (&st.minv, &st.minv_c, &st.minv_k);
+        // The balancing of `Exact::new`, D = diag(1, σ, τ, 1): block (i, j) scaled by
+        // d_j / d_i, which leaves the exponential's blocks scaled the same way.
+        let kn = norm1(mik);
+        let sigma = if kn > 0.0 { sqrt(kn) } else { 1.0 / hf };
+        let theta = (sigma * hf).max(norm1(mic) * hf);
+        let tau = sigma * theta / (norm1(mi) * hf);
+        let d = [1.0, sigma, tau, 1.0];
+        let z = [[0.0; N]; N];
+        let id: Mat<N, N> = identity();
+        let mut x: Blk<N> = [[z; 4]; 4];
+        x[0][1] = scaled(hf * d[1] / d[0], &id);
+        x[1][0] = scaled(-hf * d[0] / d[1], mik);
+        x[1][1] = scaled(-hf, mic);
+        x[1][2] = scaled(hf * d[2] / d[1], mi);
+        let mut work: Blk<N> = [[z; 4]; 4];
+        let mut e: Blk<N> = [[z; 4]; 4];
+        blk_expm(&mut x, &mut work, &mut e);
+        let blk = |i: usize, j: usize| scaled(d[i] / d[j], &e[i][j]);
+        let mut ss = Self::zero(hf);
+        put(&mut ss.phi, &blk(0, 0), 0, 0);
+        put(&mut ss.phi, &blk(0, 1), 0, N);
+        put(&mut ss.phi, &blk(1, 0), N, 0);
+        put(&mut ss.phi, &blk(1, 1), N, N);
+        put(&mut ss.gamma0, &mul(&blk(0, 2), &bb), 0, 0);
+        put(&mut ss.gamma0, &mul(&blk(1, 2), &bb), N, 0);
+        let (au, av) = (scaled(-1.0, mik), scaled(-1.0, mic));
         ss.full_outputs(&au, &av, lu_m.solve(&bb))
     }
 

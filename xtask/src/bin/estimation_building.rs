@@ -405,12 +405,7 @@ fn sweep(
     let r = SMatrix::<f64, 4, 4>::from_fn(|i, j| if i == j { sigma[i] * sigma[i] } else { 0.0 });
     let skip = (T_SKIP / H) as usize;
     let force_rms = |we: &[f64]| rms_peak((skip..we.len()).map(|n| we[n] - w[n][0])).0;
-    let (am, bm, cm, dm) = (
-        model.a_matrix(),
-        model.b_matrix(),
-        model.c_matrix(),
-        model.d_matrix(),
-    );
+    let (bm, cm, dm) = (model.b_matrix(), model.c_matrix(), model.d_matrix());
     let _ = writeln!(
         md,
         "| σ_rw (kN per step) | Q_w (N²) | dual KF: force (kN) | dual KF: drift 1 (mm) | dual KF: G_w on the roof displacement (kN/mm) | augmented KF: force (kN) | augmented KF: force gain on the roof displacement (kN/mm) |"
@@ -456,17 +451,16 @@ fn sweep(
         rows_out.push((s_rw, fd, fa));
     }
 
-    // At the shared tuning: the input stage's innovation ν = y − C ξ⁻ − D̃ ŵ_{n−1}, its
-    // mean square per channel against the covariance its gain assumes, D̃ Pʷ⁻ D̃ᵀ + R, and
-    // against that plus the state stage's own C P⁻ Cᵀ.
+    // At the shared tuning: the input stage's innovation ν = y − C ξ̂_{n−1} − D̃ ŵ_{n−1}
+    // (the paper's order), its mean square per channel against the covariance its gain
+    // assumes, D̃ Pʷ⁻ D̃ᵀ + R, and against that plus the state stage's own C P⁻ Cᵀ.
     let qw = SMatrix::<f64, 1, 1>::identity() * (SIGMA_RW * SIGMA_RW);
     let dg = DualGains::new(&model, &q, &qw, &r).unwrap();
     let df = DualFilter::<f64, 10, 1, 4>::new(&model, &dg).unwrap();
     let mut e = df.start(&SVector::zeros(), &SVector::zeros()).unwrap();
     let mut ms = [0.0f64; 4];
     for (n, y) in ys.iter().enumerate().skip(1) {
-        let xp = am * e.xi() + bm * e.input();
-        let nu = y - cm * xp - dm * e.input();
+        let nu = y - cm * e.xi() - dm * e.input();
         if n >= skip {
             for o in 0..4 {
                 ms[o] += nu[o] * nu[o] / (ys.len() - skip) as f64;
@@ -488,7 +482,7 @@ fn sweep(
     ];
     let _ = writeln!(
         md,
-        "\nAt the shared tuning (σ_rw = {:.0} kN), the dual KF's input-stage innovation ν = y − C ξ⁻ − D̃ ŵ_(n−1): \
+        "\nAt the shared tuning (σ_rw = {:.0} kN), the dual KF's input-stage innovation ν = y − C ξ̂_(n−1) − D̃ ŵ_(n−1) (the paper's order): \
          the covariance its gain assumes (D̃ Pʷ⁻ D̃ᵀ + R, diagonal), that plus the state stage's own C P⁻ Cᵀ, and its \
          mean square measured over t ≥ {T_SKIP:.0} s:\n",
         SIGMA_RW * 1e-3
@@ -564,8 +558,9 @@ fn sweep(
          correlates the state's error with the force's, so a roof-displacement innovation moves its force by \
          {:.2} kN/mm, against the dual KF's {:.2} kN/mm. The dual KF's stages carry no such correlation: the input \
          stage sees the displacement only through its small direct feedthrough D̃, and its innovation covariance \
-         D̃ Pʷ⁻ D̃ᵀ + R leaves out the error of the state prediction ξ⁻, which the state stage's P⁻ = A P Aᵀ + Q does \
-         not hold either (it leaves out the past force errors that ξ⁻ has integrated) — on the roof displacement the \
+         D̃ Pʷ⁻ D̃ᵀ + R leaves out the error of the previous filtered state ξ̂_(n−1) it is taken from (in the \
+         paper's order) and that state's change over the step, which the state stage's P = P⁻ − G_x C P⁻ does not \
+         hold either (it leaves out the past force errors that ξ̂ has integrated) — on the roof displacement the \
          gain assumes {:.4} mm² where the innovation's mean square is {:.2} mm² ({:.0} times). So its gain is \
          mis-scaled: it takes the force from the accelerations' feedthrough against an uncorrected state, and no \
          Q_w fixes that; propagating the stages' covariances does not either ({:.2} kN time-varying against {:.2} kN \
