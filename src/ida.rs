@@ -549,8 +549,12 @@ pub fn fractiles(curves: &[Curve], edp: &[f64], q: &[f64]) -> Result<Vec<Vec<f64
 ///
 /// Errors: as [`spectrum::Bank::new`](crate::spectrum::Bank::new)
 /// ([`Error::InvalidPeriod`], [`Error::InvalidDamping`], [`Error::InvalidTimeStep`]);
-/// [`Error::NonFiniteInput`] if a sample is not finite. Cost: one pass of a one-oscillator
-/// bank over the record.
+/// [`Error::NonFiniteInput`] if a sample is not finite; [`Error::NonFiniteState`] if finite
+/// samples make the response overflow, [`Error::OperatorOverflow`] if `ω² max|u|` does
+/// ([`spectrum::Bank::response`](crate::spectrum::Bank::response));
+/// [`Error::InvalidTimeStep`] if one period is more than
+/// [`MAX_FREE_VIBRATION_SAMPLES`](crate::spectrum::MAX_FREE_VIBRATION_SAMPLES) samples.
+/// Cost: one pass of a one-oscillator bank over the record.
 ///
 /// ```
 /// // A record of 1 s of a 2 Hz sine (m/s²), Sa at 0.5 s, 5 % damping: the resonance.
@@ -571,10 +575,11 @@ pub fn spectral_acceleration(
         return Err(Error::NonFiniteInput);
     }
     let bank = crate::spectrum::Bank::<f64, 1>::new([period], [damping], h)?;
-    let mut r = bank.at_rest();
-    for &a in record {
-        bank.step(&mut r, a);
+    let r = bank.response(record)?;
+    let sa = bank.psa(r.sd())[0];
+    if sa.is_finite() {
+        Ok(sa)
+    } else {
+        Err(Error::OperatorOverflow)
     }
-    bank.free_vibration(&mut r, bank.free_vibration_samples());
-    Ok(bank.psa(r.sd())[0])
 }

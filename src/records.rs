@@ -396,10 +396,33 @@ impl Record {
         Ok(r)
     }
 
-    /// The samples times `factor` (e.g. [`G`] for a record in g to m/s²). Cost: one pass;
-    /// allocates the result.
-    pub fn scaled(&self, factor: f64) -> std::vec::Vec<f64> {
-        self.samples.iter().map(|&a| a * factor).collect()
+    /// The samples times `factor` (e.g. [`G`] for a record in g to m/s²), every one
+    /// finite.
+    ///
+    /// Errors: [`Error::NonFiniteInput`] if `factor` or a sample is not finite (a NaN
+    /// factor gave a record of NaN); [`Error::OperatorOverflow`] if a product overflows
+    /// (e.g. a record times `1e300`). Cost: one pass; allocates the result.
+    ///
+    /// ```
+    /// use aemstep::{Error, records::{G, Record}};
+    /// let r = Record::from_column("0.5\n-0.25\n", 0.01)?; // g
+    /// assert_eq!(r.scaled(G)?, [0.5 * G, -0.25 * G]); // m/s²
+    /// assert_eq!(r.scaled(f64::NAN), Err(Error::NonFiniteInput));
+    /// assert_eq!(r.scaled(1e308), Err(Error::OperatorOverflow));
+    /// # Ok::<(), Error>(())
+    /// ```
+    pub fn scaled(&self, factor: f64) -> Result<std::vec::Vec<f64>, Error> {
+        if !factor.is_finite() {
+            return Err(Error::NonFiniteInput);
+        }
+        self.samples
+            .iter()
+            .map(|&a| match a * factor {
+                x if x.is_finite() => Ok(x),
+                _ if !a.is_finite() => Err(Error::NonFiniteInput),
+                _ => Err(Error::OperatorOverflow),
+            })
+            .collect()
     }
 }
 

@@ -168,7 +168,7 @@ fn std_records_from_text_and_files() {
     assert!(r.title.starts_with("PEER-format"));
     let c = records::Record::from_column(TXT, 0.02).unwrap();
     assert_eq!(c.samples, r.samples);
-    assert_eq!(r.scaled(records::G)[0], -6.4031800e-3 * 9.80665);
+    assert_eq!(r.scaled(records::G).unwrap()[0], -6.4031800e-3 * 9.80665);
     for dt in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert_eq!(
             records::Record::from_column(TXT, dt),

@@ -169,7 +169,7 @@ fn first_period() -> f64 {
 fn suite(t1: f64) -> Result<Vec<Rec>, aemstep::Error> {
     // The real record through the AT2 reader (the same samples as the `.txt` the scenes use).
     let at2 = records::Record::from_at2(include_str!("../../../data/elcentro-ns-1940.AT2"))?;
-    let el: Vec<f64> = at2.scaled(G);
+    let el: Vec<f64> = at2.scaled(G)?;
     assert_eq!(el.as_slice(), &elcentro::AG_F64[..]);
     let mut list = vec![
         (
@@ -247,7 +247,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::array::from_fn(|i| 0.05 * (3.0f64 / 0.05).powf(i as f64 / (P - 1) as f64));
     let bank = Yielding::<f64, P>::new(periods, [ZETA; P], 0.0, elcentro::DT)?;
     let el = &recs[0].ag;
-    let elastic = bank.elastic_strength(el);
+    let elastic = bank.elastic_strength(el)?;
     let mut spectra: Vec<[f64; P]> = vec![elastic.map(|a| a / G)];
     let mut passes = Vec::new();
     let mut unconverged = 0;
