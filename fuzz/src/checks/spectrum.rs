@@ -691,8 +691,13 @@ fn ida_checks(b: &mut Bytes) {
             let q = [b.value(), b.param(0.0, 1.0)];
             match ida::fractiles(core::slice::from_ref(&c), &edp, &q) {
                 Ok(f) => check!(
-                    f.len() == 2 && f.iter().all(|r| r.len() == 2),
-                    "ida: fractile shape"
+                    f.quantiles() == q
+                        && f.edp() == edp
+                        && f.as_slice().len() == 4
+                        && f.at(1, 1) == f.curve(1).map(|c| c[1])
+                        && f.at(2, 0).is_none()
+                        && f.at(0, 2).is_none(),
+                    "ida: fractile axes"
                 ),
                 Err(e) => check!(e == Error::InvalidParameter, "ida: fractiles {e:?}"),
             }
