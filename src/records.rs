@@ -63,6 +63,12 @@
 //! count [`column()`]'s values first). Nothing here panics, on any bytes (a property test
 //! feeds random text).
 //!
+//! **Resampling** to a stepper's step `h` ([`resample_into`], buffer in, buffer out, no
+//! allocation; [`resampled_len`] sizes the buffer; `Record::resampled` with `std`): linear
+//! interpolation between samples, and when downsampling (`h > dt`) a Blackman-windowed
+//! sinc low-pass first, cutoff [`ANTI_ALIAS_CUTOFF`] `= 0.8` of the new Nyquist frequency,
+//! so content the coarser step would alias is removed (about 74 dB down) before it can be.
+//!
 //! **Cost**: one pass over the text, no allocation (except `Record`'s `Vec`); each value
 //! is parsed by `core`'s correctly rounded `f64` parser (`str::parse`), so the values are
 //! exactly those of the text, rounded once (to `f32` from that `f64` for `f32` buffers).
@@ -430,7 +436,13 @@ impl AntiAlias {
         // The Blackman window's transition band is about 5.5/(2M + 1) cycles a sample
         // wide, centred on f: with 2M + 1 ≥ 27.5 h/dt it spans f ± 0.1·dt/h, so the stop
         // band (≥ 74 dB down) starts at (0.8 + 0.2)·dt/(2h), the new Nyquist frequency.
-        let half = (13.75 * h / dt).ceil() as usize;
+        let x = 13.75 * h / dt;
+        let half = x as usize; // saturating cast; then rounded up (`ceil` is not in `core`)
+        let half = if (half as f64) < x {
+            half.saturating_add(1)
+        } else {
+            half
+        };
         let f = ANTI_ALIAS_CUTOFF * dt / (2.0 * h);
         let mut a = AntiAlias { half, f, norm: 1.0 };
         let sum: f64 = (0..=2 * half).map(|i| a.tap(i as f64 - half as f64)).sum();
@@ -698,7 +710,7 @@ impl Record {
     /// let r = Record::from_column("0.5\n-0.25\n", 0.01)?; // g
     /// assert_eq!(r.scaled(G)?, [0.5 * G, -0.25 * G]); // m/s²
     /// assert_eq!(r.scaled(f64::NAN), Err(Error::NonFiniteInput));
-    /// assert_eq!(r.scaled(1e308), Err(Error::OperatorOverflow));
+    /// assert_eq!(Record::from_column("3\n", 0.01)?.scaled(1e308), Err(Error::OperatorOverflow));
     /// # Ok::<(), Error>(())
     /// ```
     pub fn scaled(&self, factor: f64) -> Result<std::vec::Vec<f64>, Error> {

@@ -65,6 +65,7 @@
 //! [`MAX_FREE_VIBRATION_SAMPLES`] is [`Error::InvalidTimeStep`] in the record-level calls.
 //!
 //! [`Error::NonFiniteState`]: crate::Error::NonFiniteState
+//! [`Error::InvalidTimeStep`]: crate::Error::InvalidTimeStep
 //! [`Error::OperatorOverflow`]: crate::Error::OperatorOverflow
 //!
 //! [`Error::InvalidPeriod`]: crate::Error::InvalidPeriod
@@ -132,7 +133,7 @@ pub(crate) fn longest_period_samples(periods: &[f64], h: f64) -> u32 {
 
 /// The longest free-vibration tail (samples of `h`) the record-level calls append
 /// ([`inelastic::Yielding::response`], [`Bank::response`],
-/// [`ida::spectral_acceleration`](crate::ida)): `2²⁰ = 1 048 576`, one period of
+/// `ida::spectral_acceleration` with `std`): `2²⁰ = 1 048 576`, one period of
 /// `T_max = 10 s` down to `h ≈ 1e-5 s`. A tail of one longest period
 /// (`⌈T_max/h⌉`, [`Bank::free_vibration_samples`]) longer than this is refused with
 /// [`Error::InvalidTimeStep`](crate::Error::InvalidTimeStep) rather than stepped: at
