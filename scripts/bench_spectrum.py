@@ -59,6 +59,15 @@ assert!(sd.iter().chain(psa.iter()).all(|x| *x > 0.0));
 ```
 
 Many records on the host, in parallel: `spectrum::batch` (feature `std`).
+
+Extreme records: `bank.step` is the bare recurrence (its cost above, unchecked).
+`bank.try_step` commits a sample only if the response stays finite, and
+`bank.response(&record)` (the record, then one longest period of free vibration) and
+`batch::spectra` check the response once at the end: a finite sample that overflows it
+(`1.5e308` then `-1.5e308`) is `Error::NonFiniteState`, never a spectrum with `inf` or
+`NaN` in it; non-finite samples are still skipped and counted. A free-vibration tail longer
+than `spectrum::MAX_FREE_VIBRATION_SAMPLES` (2^20 samples: a step far below the record's) is
+`Error::InvalidTimeStep`: resample the record first (`records::resample_into`).
 """
 
 def sh(cmd, **kw):

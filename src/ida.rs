@@ -29,7 +29,8 @@
 //!
 //! // Median and 16/84 % intensity at drifts 0.5 %, 1 %, 2 %.
 //! let f = ida::fractiles(&curves, &[0.005, 0.01, 0.02], &[0.16, 0.5, 0.84])?;
-//! assert!(f[0][2] <= f[1][2] && f[1][2] <= f[2][2]);
+//! let at_2pc = |k| f.at(k, 2).unwrap(); // quantile k, drift 2 %
+//! assert!(at_2pc(0) <= at_2pc(1) && at_2pc(1) <= at_2pc(2));
 //! # Ok::<(), Error>(())
 //! ```
 //!
@@ -43,7 +44,8 @@
 //! **Collapse** ([`Collapse`]): a run collapses if its EDP is at least
 //! [`Collapse::edp`] (`+∞`: never by EDP), or, with [`OnFailure::Collapse`], if the
 //! analysis fails (returns `Err`, e.g. [`Error::NotConverged`] when Newton cannot follow a
-//! structure losing its stiffness, or an EDP that is NaN): the run is kept as a collapsed
+//! structure losing its stiffness, or an EDP that is NaN or `−∞`, a failure with
+//! [`Error::NonFiniteState`]): the run is kept as a collapsed
 //! [`Point`] with `edp = +∞` and the error. With [`OnFailure::Abort`] a failed analysis
 //! ends the record's trace and the call returns the error.
 //!
@@ -99,7 +101,8 @@ use std::vec::Vec;
 
 use crate::{Error, Param};
 
-/// What a failed analysis (an `Err` from the closure, or an EDP that is NaN) means.
+/// What a failed analysis (an `Err` from the closure, or an EDP that is NaN or `−∞`) means.
+/// An EDP of `+∞` is a collapse by the EDP rule (it is at least any [`Collapse::edp`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum OnFailure {
     /// The run collapsed (the usual reading of a dynamic instability that the solver
@@ -278,7 +281,8 @@ where
         OnFailure::Abort => Err(e),
     };
     match analysis(record, im) {
-        Ok(edp) if edp.is_nan() => failed(Error::NonFiniteState),
+        // NaN and −∞ are no EDP (+∞ is a collapse, as the EDP rule reads it)
+        Ok(edp) if edp.is_nan() || edp == f64::NEG_INFINITY => failed(Error::NonFiniteState),
         Ok(edp) => Ok(Point {
             intensity: im,
             edp,
@@ -503,27 +507,89 @@ fn quantile(x: &[f64], q: f64) -> f64 {
     }
 }
 
+/// The fractile IDA curves of a suite ([`fractiles`]): the intensity (the closure's
+/// units) on two named axes, the quantiles `q` (axis 0, as given) and the EDP levels
+/// (axis 1, as given). `NaN` where the quantile depends on records censored at that level.
+///
+/// ```
+/// use aemstep::ida::{Curve, Point, fractiles};
+/// let p = |intensity, edp| Point { intensity, edp, collapsed: false, error: None };
+/// let curves = [
+///     Curve::from_points(vec![p(1.0, 0.01), p(2.0, 0.02)]),
+///     Curve::from_points(vec![p(1.0, 0.02), p(2.0, 0.04)]),
+/// ];
+/// let f = fractiles(&curves, &[0.01, 0.02], &[0.0, 0.5, 1.0])?;
+/// assert_eq!((f.quantiles(), f.edp()), (&[0.0, 0.5, 1.0][..], &[0.01, 0.02][..]));
+/// assert_eq!(f.at(1, 1), Some(1.5)); // median intensity at 2 % drift: between 1 and 2
+/// assert_eq!(f.curve(2), Some(&[1.0, 2.0][..])); // the 100 % fractile curve
+/// assert_eq!(f.at(3, 0), None); // no 4th quantile
+/// # Ok::<(), aemstep::Error>(())
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fractiles {
+    quantiles: Vec<f64>,
+    edp: Vec<f64>,
+    /// Quantile-major: `intensity[k · edp.len() + j]`.
+    intensity: Vec<f64>,
+}
+
+impl Fractiles {
+    /// The quantiles, axis 0 (in `[0, 1]`, as given). Cost: none.
+    pub fn quantiles(&self) -> &[f64] {
+        &self.quantiles
+    }
+    /// The EDP levels, axis 1 (EDP units, as given). Cost: none.
+    pub fn edp(&self) -> &[f64] {
+        &self.edp
+    }
+    /// The `quantiles()[q_index]` quantile of the intensity at which the curves first reach
+    /// `edp()[edp_index]`; `None` for an index out of range. Cost: O(1).
+    pub fn at(&self, q_index: usize, edp_index: usize) -> Option<f64> {
+        if edp_index < self.edp.len() {
+            self.curve(q_index)?.get(edp_index).copied()
+        } else {
+            None
+        }
+    }
+    /// The fractile curve of quantile `quantiles()[q_index]`: its intensity at every EDP
+    /// level, in the order of [`Fractiles::edp`]; `None` for an index out of range.
+    /// Cost: O(1).
+    pub fn curve(&self, q_index: usize) -> Option<&[f64]> {
+        let n = self.edp.len();
+        let start = q_index.checked_mul(n)?;
+        self.intensity.get(start..start.checked_add(n)?)
+    }
+    /// Every intensity, quantile-major (`[k · levels + j]` for quantile `k`, level `j`):
+    /// a `quantiles × levels` row-major matrix. Cost: none.
+    pub fn as_slice(&self) -> &[f64] {
+        &self.intensity
+    }
+}
+
 /// The fractile IDA curves of `curves`: for each quantile `q[k]` (in `[0, 1]`) and EDP
 /// level `edp[j]` (finite, `≥ 0`), the `q[k]` quantile across the curves of the
 /// intensity at which each first reaches `edp[j]` ([`Curve::intensity_at`]; see the
-/// [module](self) for the rule and why the intensity given the EDP). Returns
-/// `out[k][j]`; `NaN` where the quantile depends on records censored at that level.
+/// [module](self) for the rule and why the intensity given the EDP). Returns them on named
+/// axes ([`Fractiles::at`]`(k, j)`); `NaN` where the quantile depends on records censored
+/// at that level.
 ///
 /// Errors: [`Error::InvalidParameter`] if `curves` is empty, a level is not finite and
 /// `≥ 0`, or a `q` is outside `[0, 1]`. Cost: `O(curves × levels × points)` plus a sort
 /// of `curves` values a level.
-pub fn fractiles(curves: &[Curve], edp: &[f64], q: &[f64]) -> Result<Vec<Vec<f64>>, Error> {
+pub fn fractiles(curves: &[Curve], edp: &[f64], q: &[f64]) -> Result<Fractiles, Error> {
     if curves.is_empty()
         || edp.iter().any(|&e| !(e.is_finite() && e >= 0.0))
         || q.iter().any(|&x| !(0.0..=1.0).contains(&x))
     {
         return Err(Error::InvalidParameter(Param::Fractiles));
     }
-    let mut out: Vec<Vec<f64>> = (0..q.len())
-        .map(|_| Vec::with_capacity(edp.len()))
-        .collect();
+    let mut out = Fractiles {
+        quantiles: q.to_vec(),
+        edp: edp.to_vec(),
+        intensity: std::vec![0.0; q.len() * edp.len()],
+    };
     let (mut low, mut high) = (Vec::new(), Vec::new());
-    for &e in edp {
+    for (j, &e) in edp.iter().enumerate() {
         low.clear();
         high.clear();
         for c in curves {
@@ -535,7 +601,7 @@ pub fn fractiles(curves: &[Curve], edp: &[f64], q: &[f64]) -> Result<Vec<Vec<f64
         high.sort_by(f64::total_cmp);
         for (k, &qk) in q.iter().enumerate() {
             let (a, b) = (quantile(&low, qk), quantile(&high, qk));
-            out[k].push(if a == b { a } else { f64::NAN });
+            out.intensity[k * edp.len() + j] = if a == b { a } else { f64::NAN };
         }
     }
     Ok(out)
@@ -549,8 +615,12 @@ pub fn fractiles(curves: &[Curve], edp: &[f64], q: &[f64]) -> Result<Vec<Vec<f64
 ///
 /// Errors: as [`spectrum::Bank::new`](crate::spectrum::Bank::new)
 /// ([`Error::InvalidPeriod`], [`Error::InvalidDamping`], [`Error::InvalidTimeStep`]);
-/// [`Error::NonFiniteInput`] if a sample is not finite. Cost: one pass of a one-oscillator
-/// bank over the record.
+/// [`Error::NonFiniteInput`] if a sample is not finite; [`Error::NonFiniteState`] if finite
+/// samples make the response overflow, [`Error::OperatorOverflow`] if `ω² max|u|` does
+/// ([`spectrum::Bank::response`](crate::spectrum::Bank::response));
+/// [`Error::InvalidTimeStep`] if one period is more than
+/// [`MAX_FREE_VIBRATION_SAMPLES`](crate::spectrum::MAX_FREE_VIBRATION_SAMPLES) samples.
+/// Cost: one pass of a one-oscillator bank over the record.
 ///
 /// ```
 /// // A record of 1 s of a 2 Hz sine (m/s²), Sa at 0.5 s, 5 % damping: the resonance.
@@ -571,10 +641,11 @@ pub fn spectral_acceleration(
         return Err(Error::NonFiniteInput);
     }
     let bank = crate::spectrum::Bank::<f64, 1>::new([period], [damping], h)?;
-    let mut r = bank.at_rest();
-    for &a in record {
-        bank.step(&mut r, a);
+    let r = bank.response(record)?;
+    let sa = bank.psa(r.sd())[0];
+    if sa.is_finite() {
+        Ok(sa)
+    } else {
+        Err(Error::OperatorOverflow)
     }
-    bank.free_vibration(&mut r, bank.free_vibration_samples());
-    Ok(bank.psa(r.sd())[0])
 }

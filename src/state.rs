@@ -20,11 +20,21 @@ pub struct State<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> State<T, N> {
+    /// The largest step count [`State::restore`] accepts, `2⁶³ − 1`. The steppers count
+    /// steps in a `u64` and do not check it (a check would cost every step); from a count
+    /// at most this, `2⁶³` more steps (about 300 years at one step a nanosecond) are needed
+    /// before it could wrap, so no run ever sees its time `n·h` wrap to 0. A state from a
+    /// stepper's `start` begins at 0.
+    pub const MAX_RESTORED_STEPS: u64 = u64::MAX / 2;
+
     /// A state restored from saved parts: displacement `u`, velocity `v`, acceleration `a`
     /// (model units, as [`State::u`], [`State::v`], [`State::a`]) and the step count
-    /// `steps` (time `steps·h`). Give it to the stepper the parts came from.
+    /// `steps` (time `steps·h`, `0 ..= State::MAX_RESTORED_STEPS`). Give it to the stepper
+    /// the parts came from.
     ///
-    /// Errors: [`Error::NonFiniteInput`] if any entry of `u`, `v`, `a` is not finite.
+    /// Errors: [`Error::NonFiniteInput`] if any entry of `u`, `v`, `a` is not finite;
+    /// [`Error::StepCountOverflow`] if `steps > State::MAX_RESTORED_STEPS` (a count the
+    /// steps could wrap: `u64::MAX` wrapped to `0` on the next step, its time to `0`).
     /// Cost: a scan of the `3N` entries.
     ///
     /// ```
@@ -36,6 +46,7 @@ impl<T: Real, const N: usize> State<T, N> {
     ///     State::restore(vector![f64::NAN], vector![0.0], vector![0.0], 0),
     ///     Err(Error::NonFiniteInput)
     /// );
+    /// assert!(State::restore(vector![0.0], vector![0.0], vector![0.0], u64::MAX).is_err());
     /// # Ok::<(), aemstep::Error>(())
     /// ```
     pub fn restore(
@@ -44,6 +55,9 @@ impl<T: Real, const N: usize> State<T, N> {
         a: SVector<T, N>,
         steps: u64,
     ) -> Result<Self, Error> {
+        if steps > Self::MAX_RESTORED_STEPS {
+            return Err(Error::StepCountOverflow);
+        }
         let s = Self::unchecked(u, v, a, steps);
         if s.is_finite() {
             Ok(s)

@@ -141,7 +141,7 @@ fn spectra_equal_one_record_at_a_time() {
             let mut resp = b.at_rest();
             r.iter().for_each(|&a| b.step(&mut resp, a));
             b.free_vibration(&mut resp, 30);
-            resp
+            Ok(resp)
         })
         .collect();
     for threads in [0, 1, 2, 9] {

@@ -28,6 +28,7 @@ const SKIP: &[(&str, &str)] = &[
     ("Collapse", "std only"),
     ("HuntFill", "std only"),
     ("Point", "std only"),
+    ("Fractiles", "std only"),
     ("Curve", "std only"),
 ];
 

@@ -125,7 +125,7 @@ fn run(h: f64) -> Compared {
     }
     out.bound = 0.25 * h * h * DURATION * max_pdot * max_a;
     out.max_input = acc.max_input();
-    out.lib_balance = acc.max_balance_error();
+    out.lib_balance = acc.max_balance_error().unwrap();
     out.hysteretic = acc.hysteretic;
     out
 }
@@ -184,4 +184,42 @@ fn energy_account_matches_an_independent_trapezoidal_account_at_order_2() {
             assert!((3.0..=5.0).contains(&ratio), "quantity {j}: ratio {ratio}");
         }
     }
+}
+
+/// Issue 31: a NaN balance was dropped by the running `max` (f64::max ignores NaN), so
+/// `max_balance_error` reported the largest *finite* error of a run whose balance had gone
+/// NaN. Now the NaN sticks and the call is a typed error.
+#[test]
+fn max_balance_error_refuses_a_nan_balance() {
+    type B = ShearBuilding<f64, BoucWen<f64>, 3>;
+    let b: B = building::bouc_wen::<f64>().unwrap();
+    let h = 0.01;
+    let stepper = Nonlinear::<f64, 3>::new(h, NewtonSettings::default()).unwrap();
+    let zero = SVector::<f64, 3>::zeros();
+    let p0 = b.ground_load(ag(0.0));
+    let (mut s, mut hist) = stepper
+        .start_with_history(&b, &zero, &zero, &p0, &b.initial_history())
+        .unwrap();
+    let mut acc = EnergyAccount::start(&b, &s, &hist, &p0);
+    let mut step = |acc: &mut EnergyAccount<f64, 3>, n: u32, bad: bool| {
+        let p = b.ground_load(ag(h * f64::from(n)));
+        let previous = hist;
+        stepper
+            .try_step_with_history(&b, &mut s, &mut hist, &p)
+            .unwrap();
+        // the account told a NaN load (a caller's bug it must not hide)
+        let told = if bad { p.map(|_| f64::NAN) } else { p };
+        acc.step(&b, &previous, &s, &hist, &told);
+    };
+    for n in 1..=20 {
+        step(&mut acc, n, false);
+    }
+    let finite = acc.max_balance_error().unwrap();
+    assert!(finite.is_finite() && finite >= 0.0);
+    step(&mut acc, 21, true);
+    assert!(acc.balance_error().is_nan());
+    assert_eq!(acc.max_balance_error(), Err(aemstep::Error::NonFiniteState));
+    // and it stays refused after later finite steps
+    step(&mut acc, 22, false);
+    assert_eq!(acc.max_balance_error(), Err(aemstep::Error::NonFiniteState));
 }

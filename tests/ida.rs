@@ -228,6 +228,39 @@ fn failures_collapse_or_abort() {
     );
 }
 
+/// Issue 31: an EDP of `−∞` was kept as a non-collapsing point (garbage on the curve and
+/// in the fractiles); now it is a failed analysis, as NaN is. `+∞` stays a collapse by the
+/// EDP rule, with no error.
+#[test]
+fn negative_infinite_edp_is_a_failed_analysis() {
+    let neg = |_: &Toy, im: f64| -> Result<f64, Error> {
+        Ok(if im > 1.0 { f64::NEG_INFINITY } else { im })
+    };
+    let c = ida::trace(&Toy { c: 0.0 }, &DYADIC, neg).unwrap();
+    assert!(c.points.iter().all(|p| p.edp > f64::NEG_INFINITY));
+    let p = c.points.iter().find(|p| p.collapsed).unwrap();
+    assert_eq!(
+        (p.edp, p.error),
+        (f64::INFINITY, Some(Error::NonFiniteState))
+    );
+    let abort = HuntFill {
+        collapse: Collapse {
+            edp: f64::INFINITY,
+            on_failure: OnFailure::Abort,
+        },
+        ..DYADIC
+    };
+    assert_eq!(
+        ida::trace(&Toy { c: 0.0 }, &abort, neg),
+        Err(Error::NonFiniteState)
+    );
+    let pos =
+        |_: &Toy, im: f64| -> Result<f64, Error> { Ok(if im > 1.0 { f64::INFINITY } else { im }) };
+    let c = ida::trace(&Toy { c: 0.0 }, &abort, pos).unwrap();
+    let p = c.points.iter().find(|p| p.collapsed).unwrap();
+    assert_eq!((p.edp, p.error), (f64::INFINITY, None));
+}
+
 #[test]
 fn bad_settings_are_typed_errors() {
     let bad = |s: HuntFill| {
@@ -476,15 +509,21 @@ fn fractiles_by_hand() {
         [0.0, 0.5, 1.5, 5.0 / 3.0, 2.0],
         [0.0, 0.84, 1.5, 5.0 / 3.0 + 0.68 / 3.0, f64::NAN],
     ];
-    for k in 0..3 {
-        for j in 0..5 {
-            let (g, w) = (f[k][j], want[k][j]);
+    for (k, row) in want.iter().enumerate() {
+        for (j, &w) in row.iter().enumerate() {
+            let g = f.at(k, j).unwrap();
             assert!(
                 close(g, w) || (g.is_nan() && w.is_nan()),
                 "q {k}, level {j}: {g} vs {w}"
             );
         }
     }
+    // the named axes: as given, and out of range is None, not a panic
+    assert_eq!(f.quantiles(), &[0.16, 0.5, 0.84]);
+    assert_eq!(f.edp(), &[0.0, 0.01, 0.02, 0.04, 0.06]);
+    assert_eq!((f.at(3, 0), f.at(0, 5), f.curve(3)), (None, None, None));
+    assert_eq!(f.curve(1).unwrap().len(), 5);
+    assert_eq!(f.as_slice()[5..10], *f.curve(1).unwrap());
 }
 
 /// `Sa(T₁)`: linear in the record, typed errors for bad input.

@@ -160,6 +160,70 @@ fn one_column() {
     assert_eq!(records::column_into("1\n2\n", &mut out), Ok(2));
 }
 
+/// Issue 31: the one-column reader ignored a `# dt` header (a record whose header says
+/// 0.02 s was read at the caller's 0.01 s without a word). Every accepted spelling, and the
+/// malformed ones with their line.
+#[cfg(feature = "std")]
+#[test]
+fn one_column_dt_header_is_read_and_checked() {
+    for (text, dt) in [
+        ("# dt = 0.01\n1\n", 0.01),
+        ("#DT=0.005\n1\n", 0.005),
+        ("  # dt: 0.02 s\n1\n", 0.02),
+        ("# Dt 2e-3 SEC\n1\n", 0.002),
+        ("# dt = 0.01s\n1\n", 0.01),
+        ("# dt=0.01sec\n1\n", 0.01),
+        ("\u{feff}# title\n# dt = 0.01\n1\n", 0.01),
+        ("1\n2\n# dt = 0.01\n", 0.01), // anywhere, as a whole-line comment
+        ("# dt = 0.02 s, 3995 samples\n1\n", 0.02), // the El Centro file's header
+        ("# dt=0.02; from quakeio\n1\n", 0.02),
+    ] {
+        assert_eq!(records::column_dt(text), Ok(Some(dt)), "{text:?}");
+        let mut buf = [0.0f64; 4];
+        assert!(records::column_into(text, &mut buf).is_ok(), "{text:?}");
+    }
+    for text in [
+        "1\n",
+        "# station 12, 5 % damped\n1\n",
+        "1 # dt = 0.01\n", // a trailing comment is not a header
+        "# dtx = 0.01\n1\n",
+    ] {
+        assert_eq!(records::column_dt(text), Ok(None), "{text:?}");
+    }
+    for (text, line) in [
+        ("# dt\n1\n", 1),
+        ("# dt = \n1\n", 1),
+        ("# x\n# dt = 0\n1\n", 2),
+        ("# dt = -0.01\n1\n", 1),
+        ("# dt = nan\n1\n", 1),
+        ("# dt = inf\n1\n", 1),
+        ("# dt = 1e999\n1\n", 1),
+        ("# dt = 0.01 ms\n1\n", 1),
+        ("# dt = 0.01 s extra\n1\n", 1),
+        ("# dt = 0.01 0.02\n1\n", 1),
+        ("# dt = 0.01\n1\n# dt = 0.01\n", 3),
+    ] {
+        assert_eq!(records::column_dt(text), Err(bad(line)), "{text:?}");
+    }
+    // The std reader: the header's interval, or the caller's if it agrees.
+    use aemstep::records::Record;
+    let r = Record::from_column_with_header("# dt = 0.02\n0.5\n-0.5\n").unwrap();
+    assert_eq!((r.dt, r.samples.as_slice()), (0.02, &[0.5, -0.5][..]));
+    assert_eq!(
+        Record::from_column("# dt = 0.02\n0.5\n", 0.02).unwrap().dt,
+        0.02
+    );
+    assert_eq!(
+        Record::from_column("# dt = 0.02\n0.5\n", 0.01),
+        Err(Error::InvalidTimeStep)
+    );
+    assert_eq!(Record::from_column_with_header("0.5\n"), Err(bad(1)));
+    assert_eq!(
+        Record::from_column_with_header("# dt = x\n0.5\n"),
+        Err(bad(1))
+    );
+}
+
 #[cfg(feature = "std")]
 #[test]
 fn std_records_from_text_and_files() {
@@ -168,7 +232,9 @@ fn std_records_from_text_and_files() {
     assert!(r.title.starts_with("PEER-format"));
     let c = records::Record::from_column(TXT, 0.02).unwrap();
     assert_eq!(c.samples, r.samples);
-    assert_eq!(r.scaled(records::G)[0], -6.4031800e-3 * 9.80665);
+    assert_eq!(records::column_dt(TXT), Ok(Some(0.02)));
+    assert_eq!(records::Record::from_column_with_header(TXT).unwrap(), c);
+    assert_eq!(r.scaled(records::G).unwrap()[0], -6.4031800e-3 * 9.80665);
     for dt in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert_eq!(
             records::Record::from_column(TXT, dt),
@@ -217,6 +283,7 @@ fn parse_anything(text: &str) {
         assert!(n >= 1 && buf[..n].iter().all(|v| v.is_finite()));
     }
     let _ = records::column(text).count();
+    let _ = records::column_dt(text);
 }
 
 fn check_at2(h: &At2<'_>) {
@@ -310,4 +377,164 @@ fn random_text_never_panics() {
         headers > cases / 50 && complete > 0,
         "{headers} headers, {complete} complete"
     );
+}
+
+/// `sin(2π f t)` at `t = k·dt`, `k = 0..n`.
+fn sine_at(f: f64, dt: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|k| (std::f64::consts::TAU * f * k as f64 * dt).sin())
+        .collect()
+}
+
+/// Resampled with the library, the length checked against `resampled_len`.
+fn resampled(x: &[f64], dt: f64, h: f64) -> Vec<f64> {
+    let n = records::resampled_len(x.len(), dt, h).unwrap();
+    let mut y = vec![f64::NAN; n + 3];
+    assert_eq!(records::resample_into(x, dt, h, &mut y), Ok(n));
+    assert!(y[n..].iter().all(|v| v.is_nan()), "wrote past its length");
+    y.truncate(n);
+    y
+}
+
+/// Upsampling is linear interpolation: exact (to rounding) against the interpolant written
+/// here, at a ratio that is not a power of two; and the output length covers the record.
+#[test]
+fn resample_upsampling_is_linear_interpolation() {
+    let dt = 0.02;
+    let x: Vec<f64> = (0..50).map(|k| ((k * 37) % 11) as f64 - 5.0).collect();
+    let h = dt / 3.0;
+    let y = resampled(&x, dt, h);
+    assert_eq!(y.len(), 49 * 3 + 1); // t from 0 to the end, 0.98 s
+    let mut worst = 0.0f64;
+    for (k, &yk) in y.iter().enumerate() {
+        let t = k as f64 * h;
+        let j = ((t / dt).floor() as usize).min(x.len() - 2);
+        let th = t / dt - j as f64;
+        let exact = x[j] + th * (x[j + 1] - x[j]);
+        worst = worst.max((yk - exact).abs());
+    }
+    // Both sides round the position t/dt = k·h/dt (two roundings each, ≤ 4ε·49 apart at
+    // the end) and the slope is at most 10: ≤ 4·49ε·10 + a few ulps of 5 (measured 5.0e-14).
+    println!("upsampling vs the linear interpolant: {worst:.1e}");
+    assert!(
+        worst <= (4.0 * 49.0 * 10.0 + 8.0 * 5.0) * f64::EPSILON,
+        "{worst:e}"
+    );
+    // A sine: linear interpolation's error ≤ ω² dt²/8 (amplitude 1).
+    let (f, dt) = (1.3, 0.01);
+    let x = sine_at(f, dt, 400);
+    let h = 0.0037;
+    let y = resampled(&x, dt, h);
+    let w = std::f64::consts::TAU * f;
+    let err = y
+        .iter()
+        .enumerate()
+        .map(|(k, v)| (v - (w * k as f64 * h).sin()).abs())
+        .fold(0.0, f64::max);
+    let bound = w * w * dt * dt / 8.0;
+    println!("upsampled 1.3 Hz sine: error {err:.3e}, bound ω²dt²/8 = {bound:.3e}");
+    assert!(err <= bound && err >= 0.5 * bound, "{err:e} vs {bound:e}");
+    // h = dt: a copy.
+    assert_eq!(resampled(&x, dt, dt), x);
+}
+
+/// Downsampling filters first: a sine above the new Nyquist frequency (which plain
+/// decimation would alias, at full amplitude, onto a lower frequency) comes out attenuated
+/// by the Blackman window's stop band (about 74 dB: ≤ 2e-4 of the amplitude); one in the
+/// pass band (below 0.6 of the new Nyquist frequency) comes out as itself.
+#[test]
+fn resample_downsampling_filters_before_it_decimates() {
+    let (dt, h) = (0.002, 0.01); // 500 Hz to 100 Hz: new Nyquist 50 Hz
+    let n = 2500; // 5 s
+    // the filter's half-length M = ⌈13.75 h/dt⌉ = 69 input samples: skip its edges
+    let edge = (70.0f64 * dt / h).ceil() as usize + 1;
+    let interior = |y: &[f64]| edge..y.len() - edge;
+    let mut worst_stop = 0.0f64;
+    for f in [50.0, 55.0, 60.0, 80.0, 120.0, 249.0] {
+        let x = sine_at(f, dt, n);
+        // plain decimation aliases it at (nearly) full amplitude
+        let alias = (0..n / 5).map(|k| x[5 * k].abs()).fold(0.0, f64::max);
+        let y = resampled(&x, dt, h);
+        let peak = y[interior(&y)].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        println!("{f} Hz: decimated {alias:.3}, resampled peak {peak:.2e}");
+        worst_stop = worst_stop.max(peak);
+        if f != 50.0 {
+            assert!(alias > 0.5, "{f} Hz aliases (test premise)");
+        }
+    }
+    // Blackman: about −74 dB (2e-4); measured 1.56e-4 at 55 Hz, 1.1 of the new Nyquist.
+    assert!(worst_stop <= 2e-4, "stop band {worst_stop:e}");
+    // Pass band at an integer ratio (outputs on input samples, no interpolation): the
+    // filter's own gain error, up to 0.6 of the new Nyquist frequency (where the
+    // transition band, 0.6 to 1.0 of it, begins).
+    let mut ripple = 0.0f64;
+    for f in [0.5, 5.0, 15.0, 25.0, 30.0] {
+        let x = sine_at(f, dt, n);
+        let y = resampled(&x, dt, h);
+        let w = std::f64::consts::TAU * f;
+        let err = interior(&y)
+            .map(|k| (y[k] - (w * k as f64 * h).sin()).abs())
+            .fold(0.0, f64::max);
+        println!("{f} Hz pass band, ratio 5: error {err:.2e}");
+        ripple = ripple.max(err);
+    }
+    // the window's ripple, of the order of its stop band (measured 1.85e-4 at 25 Hz)
+    assert!(ripple <= 2e-4, "pass band {ripple:e}");
+    // At a ratio 2.5 (outputs between input samples): that ripple plus linear
+    // interpolation's ω² dt²/8.
+    let (dt, h) = (0.004, 0.01);
+    for f in [0.5, 2.0, 10.0, 25.0] {
+        let x = sine_at(f, dt, 1250);
+        let y = resampled(&x, dt, h);
+        let w = std::f64::consts::TAU * f;
+        let err = interior(&y)
+            .map(|k| (y[k] - (w * k as f64 * h).sin()).abs())
+            .fold(0.0, f64::max);
+        let bound = 2e-4 + w * w * dt * dt / 8.0;
+        println!("{f} Hz pass band: error {err:.2e} (bound {bound:.2e})");
+        assert!(err <= bound, "{f} Hz: {err:e}");
+    }
+}
+
+#[test]
+fn resample_bad_input_is_typed() {
+    let mut out = [0.0f64; 8];
+    let x = [0.0, 1.0, 2.0];
+    for (dt, h) in [
+        (0.0, 0.01),
+        (0.01, -1.0),
+        (f64::NAN, 0.01),
+        (0.01, f64::INFINITY),
+    ] {
+        assert_eq!(
+            records::resample_into(&x, dt, h, &mut out),
+            Err(Error::InvalidTimeStep)
+        );
+    }
+    assert_eq!(
+        records::resample_into(&[0.0, f64::NAN], 0.01, 0.02, &mut out),
+        Err(Error::NonFiniteInput)
+    );
+    assert_eq!(
+        records::resample_into(&x, 0.01, 0.001, &mut out),
+        Err(Error::InvalidParameter(Param::OutputBuffer))
+    );
+    assert_eq!(
+        records::resample_into::<f64>(&[], 0.01, 0.02, &mut out),
+        Ok(0)
+    );
+    // f32 out of an f64 computation: rounded once; an overflow is typed
+    let mut o32 = [0.0f32; 8];
+    assert_eq!(
+        records::resample_into(&[1.0f32, 3.0], 0.02, 0.01, &mut o32),
+        Ok(3)
+    );
+    assert_eq!(&o32[..3], &[1.0, 2.0, 3.0]);
+    let big = [f32::MAX, f32::MAX];
+    assert!(records::resample_into(&big, 0.01, 0.0101, &mut o32).is_ok());
+    #[cfg(feature = "std")]
+    {
+        let r = aemstep::records::Record::from_column("1\n2\n", 0.01).unwrap();
+        assert_eq!(r.resampled(0.0).map(|_| ()), Err(Error::InvalidTimeStep));
+    }
 }

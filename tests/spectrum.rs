@@ -640,6 +640,7 @@ fn batch_equals_one_record_at_a_time() {
         let out = batch::spectra(&b, &slices, 50, threads);
         assert_eq!(out.len(), 7);
         for (i, o) in out.iter().enumerate() {
+            let o = o.as_ref().unwrap();
             let (sd, sv, sa) = run(&b, &recs[i], 50);
             assert_eq!((o.sd(), o.sv(), o.sa()), (&sd, &sv, &sa));
         }

@@ -540,7 +540,8 @@ fn ida_fractiles<'py>(
     let curves = build().map_err(|f| f.raise(py))?;
     let (levels, q) = (read1(&drifts), read1(&q));
     let out = ida::fractiles(&curves, &levels, &q).map_err(|e| Fail::from(e).raise(py))?;
-    Ok(out2(py, out.into_iter().flatten().collect(), levels.len()))
+    // quantile-major, `len(q) × len(drifts)`: the array the Python API has always returned
+    Ok(out2(py, out.as_slice().to_vec(), levels.len()))
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -775,10 +775,20 @@ fn spectra<'py>(
             }
             bank.free_vibration(&mut resp, fv);
             let sd = *resp.sd();
-            (sd, *resp.sv(), *resp.sa(), bank.psv(&sd), bank.psa(&sd))
+            let part = (sd, *resp.sv(), *resp.sa(), bank.psv(&sd), bank.psa(&sd));
+            // A finite sample that overflowed the response stays non-finite to the end
+            // (`Bank::response`); a pseudo-spectral value that overflows is refused too.
+            if !resp.is_finite() {
+                Err(Error::NonFiniteState)
+            } else if part.3.iter().chain(&part.4).all(|x| x.is_finite()) {
+                Ok(part)
+            } else {
+                Err(Error::OperatorOverflow)
+            }
         });
         let mut out: Vec<Spectrum> = (0..records.len()).map(|_| Default::default()).collect();
         for (&(r, _), part) in jobs.iter().zip(parts) {
+            let part = part?;
             let o = &mut out[r];
             o[0].extend_from_slice(&part.0);
             o[1].extend_from_slice(&part.1);
@@ -854,10 +864,18 @@ fn rotd<'py>(
             }
             angles.free_vibration(bank, &mut r, fv);
             let (d50, d100) = (r.rotd50(), r.rotd100());
-            (d50, d100, bank.psa(&d50), bank.psa(&d100))
+            let part = (d50, d100, bank.psa(&d50), bank.psa(&d100));
+            if !r.is_finite() {
+                Err(Error::NonFiniteState)
+            } else if part.2.iter().chain(&part.3).all(|x| x.is_finite()) {
+                Ok(part)
+            } else {
+                Err(Error::OperatorOverflow)
+            }
         });
         let mut out: [Vec<f64>; 4] = Default::default();
         for p in parts {
+            let p = p?;
             out[0].extend_from_slice(&p.0);
             out[1].extend_from_slice(&p.1);
             out[2].extend_from_slice(&p.2);

@@ -3,7 +3,7 @@
 use nalgebra::SVector;
 
 use super::{Law, ShearBuilding};
-use crate::{Real, State};
+use crate::{Error, Real, State};
 
 /// The energy balance of a [`ShearBuilding`] run, kept step by step beside it (fixed size,
 /// no allocation):
@@ -56,7 +56,7 @@ use crate::{Real, State};
 ///     account.input, account.kinetic, account.recoverable, account.viscous, account.hysteretic
 /// );
 /// assert!(account.hysteretic > 0.0); // it yielded
-/// assert!(account.max_balance_error() <= 1e-6 * account.max_input());
+/// assert!(account.max_balance_error()? <= 1e-6 * account.max_input());
 /// # Ok::<(), aemstep::Error>(())
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -148,7 +148,13 @@ impl<T: Real, const N: usize> EnergyAccount<T, N> {
         self.damping_force = damping_force;
         self.storey_force = storey_force;
         self.max_input = self.max_input.max(self.input.abs());
-        self.max_error = self.max_error.max(self.balance_error().abs());
+        // Not `max`, which drops a NaN: a non-finite balance sticks (`max_balance_error`).
+        let e = self.balance_error().abs();
+        #[allow(clippy::eq_op)]
+        let nan = e != e;
+        if e > self.max_error || nan {
+            self.max_error = e;
+        }
     }
 
     /// `E₀ + E_in − (E_k + E_s + E_v + E_h)` now (J). Cost: 5 flops.
@@ -157,9 +163,17 @@ impl<T: Real, const N: usize> EnergyAccount<T, N> {
             - (self.kinetic + self.recoverable + self.viscous + self.hysteretic)
     }
 
-    /// The largest `|balance_error|` over the steps accounted so far (J). Cost: O(1).
-    pub fn max_balance_error(&self) -> T {
-        self.max_error
+    /// The largest `|balance_error|` over the steps accounted so far (J).
+    ///
+    /// Errors: [`Error::NonFiniteState`] if the balance of a step accounted was NaN or
+    /// infinite (an energy overflowed, or a NaN reached the account): the largest error is
+    /// then unknown, not the largest of the finite ones. Cost: O(1).
+    pub fn max_balance_error(&self) -> Result<T, Error> {
+        if self.max_error.is_finite() {
+            Ok(self.max_error)
+        } else {
+            Err(Error::NonFiniteState)
+        }
     }
 
     /// The largest `|E_in|` over the steps accounted so far (J): the scale to judge the

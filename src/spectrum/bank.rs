@@ -486,6 +486,31 @@ impl<T: Real, const P: usize> Response<T, P> {
     pub fn walks(&self) -> u64 {
         self.walks
     }
+    /// Every state and peak is finite (`u`, `v`, `Sd`, `Sv`, `Sa`): what
+    /// [`Bank::try_step`] checks. Cost: a scan of `5P` values.
+    pub fn is_finite(&self) -> bool {
+        use super::all_finite;
+        all_finite(&self.u)
+            & all_finite(&self.v)
+            & all_finite(&self.sd)
+            & all_finite(&self.sv)
+            & all_finite(&self.sa)
+    }
+    /// A response at rest for any `T` (the `const` [`Bank::at_rest`] is per type).
+    pub(super) fn rest() -> Self {
+        let z = T::from_f64_rounded(0.0);
+        Response {
+            u: [z; P],
+            v: [z; P],
+            sd: [z; P],
+            sv: [z; P],
+            sa: [z; P],
+            last: z,
+            samples: 0,
+            skipped: 0,
+            walks: 0,
+        }
+    }
 }
 
 #[inline(always)]
@@ -547,6 +572,61 @@ impl<T: Real, const P: usize> Bank<T, P> {
         }
     }
 
+    /// [`Bank::step`], checked: the sample is taken on a copy of `r`, committed only if
+    /// every state and peak of the copy is finite ([`Response::is_finite`]). A non-finite
+    /// sample is still skipped and counted (`Ok`), as in [`Bank::step`]; a *finite* sample
+    /// so large that the response overflows (e.g. `1.5e308` then `−1.5e308`, whose
+    /// difference is `−∞`) is the error.
+    ///
+    /// Errors: [`Error::NonFiniteState`], `r` unchanged. Cost: one [`Bank::step`], a copy
+    /// of `r` and a scan of `5P` values.
+    pub fn try_step(&self, r: &mut Response<T, P>, ag: T) -> Result<(), Error> {
+        let mut next = *r;
+        self.step(&mut next, ag);
+        if next.is_finite() {
+            *r = next;
+            Ok(())
+        } else {
+            Err(Error::NonFiniteState)
+        }
+    }
+
+    /// The response to a whole record: from rest, every sample of `record` (sample
+    /// interval [`Bank::time_step`]; non-finite samples skipped and counted, as in
+    /// [`Bank::step`]) then [`Bank::free_vibration_samples`] of free vibration.
+    ///
+    /// The samples are stepped unchecked and the response checked once at the end: a
+    /// non-finite state or peak never turns finite again under these linear maps (`∞` and
+    /// NaN propagate, peaks are running maxima), so the end check sees every overflow.
+    ///
+    /// Errors: [`Error::NonFiniteState`] if the response overflowed;
+    /// [`Error::InvalidTimeStep`] if the tail exceeds
+    /// [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES). Cost:
+    /// `N + ⌈T_max/h⌉` steps, one scan.
+    ///
+    /// ```
+    /// use aemstep::{Error, spectrum::Bank};
+    /// let bank = Bank::<f64, 2>::new([0.2, 1.0], [0.05; 2], 0.01)?;
+    /// let r = bank.response(&[0.0, 1.0, -1.0, 0.5])?; // m/s²
+    /// assert!(r.sd()[1] > 0.0);
+    /// // finite samples whose difference overflows: an error, not ±∞ in the spectrum
+    /// assert_eq!(bank.response(&[0.0, 1.5e308, -1.5e308]), Err(Error::NonFiniteState));
+    /// # Ok::<(), Error>(())
+    /// ```
+    pub fn response(&self, record: &[T]) -> Result<Response<T, P>, Error> {
+        let tail = super::checked_tail(&self.period, self.time_step)?;
+        let mut r = Response::rest();
+        for &a in record {
+            self.step(&mut r, a);
+        }
+        self.free_vibration(&mut r, tail);
+        if r.is_finite() {
+            Ok(r)
+        } else {
+            Err(Error::NonFiniteState)
+        }
+    }
+
     /// Continue after the record in free vibration: the ground acceleration returns
     /// linearly to zero over one `h` and stays zero for `samples − 1` more intervals;
     /// peaks keep updating ([`Response::samples`] does not count these).
@@ -571,9 +651,11 @@ impl<T: Real, const P: usize> Bank<T, P> {
         }
     }
 
-    /// One period of the longest oscillator, in samples (`⌈T_max/h⌉`): after the record,
-    /// a damped oscillator's free vibration decays, so its peak (displacement, velocity and
-    /// absolute acceleration) comes within one period; stepping this long catches it.
+    /// One period of the longest oscillator, in samples (`⌈T_max/h⌉`, saturating at
+    /// `u32::MAX`): after the record, a damped oscillator's free vibration decays, so its
+    /// peak (displacement, velocity and absolute acceleration) comes within one period;
+    /// stepping this long catches it. The record-level calls refuse a tail longer than
+    /// [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES).
     /// Cost: a scan of the periods.
     pub fn free_vibration_samples(&self) -> u32 {
         super::longest_period_samples(&self.period, self.time_step)

@@ -4,7 +4,7 @@
 use std::vec::Vec;
 
 use super::bank::{Bank, Response};
-use crate::Real;
+use crate::{Error, Real};
 
 /// The spectra of many records (each a slice of ground-acceleration samples, m/s² or any
 /// unit, at the bank's time step [`Bank::time_step`]), on `threads` threads (`0`: as many as
@@ -13,8 +13,11 @@ use crate::Real;
 /// then continued `free_vibration` samples in free vibration ([`Bank::free_vibration`];
 /// pass [`Bank::free_vibration_samples`] for every peak, `0` for none).
 ///
-/// Returns one [`Response`] per record, in the order of `records`, bit for bit those of
-/// stepping each record alone, on any thread count. Cost: that of [`Bank::step`] per
+/// Returns one result per record, in the order of `records`: its [`Response`], bit for
+/// bit that of stepping the record alone on any thread count, or
+/// [`Error::NonFiniteState`] if a finite sample made a state or a peak overflow (the
+/// response is checked once at the end, as in [`Bank::response`]; non-finite samples are
+/// skipped and counted, not errors). Cost: that of [`Bank::step`] per
 /// sample, divided among the threads, plus the pool's creation (one OS thread per pool
 /// thread); allocates the result and the pool. Stepping does not panic, so neither does
 /// this (a pool that cannot be built runs the records serially).
@@ -23,34 +26,23 @@ pub fn spectra<T, const P: usize>(
     records: &[&[T]],
     free_vibration: u32,
     threads: usize,
-) -> Vec<Response<T, P>>
+) -> Vec<Result<Response<T, P>, Error>>
 where
     T: Real + Send + Sync,
     Response<T, P>: Send,
     Bank<T, P>: Sync,
 {
     crate::batch::map(records, threads, |record| {
-        let mut r = zero_response(bank);
+        let mut r = Response::rest();
         for &a in *record {
             bank.step(&mut r, a);
         }
         bank.free_vibration(&mut r, free_vibration);
-        r
+        // Checked once at the end (see `Bank::response`: an overflow stays non-finite).
+        if r.is_finite() {
+            Ok(r)
+        } else {
+            Err(Error::NonFiniteState)
+        }
     })
-}
-
-/// A response at rest for a generic `T` (the `const` constructors are per type).
-fn zero_response<T: Real, const P: usize>(_bank: &Bank<T, P>) -> Response<T, P> {
-    let z = T::from_f64_rounded(0.0);
-    Response {
-        u: [z; P],
-        v: [z; P],
-        sd: [z; P],
-        sv: [z; P],
-        sa: [z; P],
-        last: z,
-        samples: 0,
-        skipped: 0,
-        walks: 0,
-    }
 }

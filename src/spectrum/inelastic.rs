@@ -83,6 +83,17 @@
 //! a strength-reduction factor, target ductility or search setting out of range is
 //! [`Error::InvalidParameter`]. A non-finite sample is skipped and counted, as in
 //! [`Bank::step`](super::Bank::step).
+//!
+//! **Extreme records**: every field of a record-level result is finite, or the call is a
+//! typed error: a finite sample that makes the response overflow (one sample of `5e307`
+//! m/s²) is [`Error::NonFiniteState`] ([`Yielding::try_step`] leaves the response
+//! unchanged; [`Yielding::response`] and the spectra check it once per pass), a ductility
+//! or elastic strength that overflows is [`Error::OperatorOverflow`], a strength whose
+//! yield displacement is subnormal is [`Error::InvalidMaterial`] from
+//! [`Yielding::at_rest`] and [`Error::OperatorUnderflow`] from the spectra (`R = 1e308`),
+//! and a free-vibration tail over
+//! [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES) is
+//! [`Error::InvalidTimeStep`].
 
 use super::bank::substeps_for;
 use super::{MAX_SUBSTEPS, Substeps};
@@ -367,6 +378,17 @@ impl<T: Real, const P: usize> YieldResponse<T, P> {
     pub fn skipped(&self) -> u64 {
         self.skipped
     }
+    /// Every state, peak and energy is finite (`u`, `v`, `f`, `Sd`, the plastic work and
+    /// deformation): what [`Yielding::try_step`] checks. Cost: a scan of `6P` values.
+    pub fn is_finite(&self) -> bool {
+        use super::all_finite;
+        all_finite(&self.u)
+            & all_finite(&self.v)
+            & all_finite(&self.f)
+            & all_finite(&self.sd)
+            & all_finite(&self.work)
+            & all_finite(&self.plastic)
+    }
 }
 
 impl<T: Real, const P: usize> Yielding<T, P> {
@@ -429,21 +451,15 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// `+∞` is allowed: that oscillator never yields (its ductility reads `0`).
     ///
     /// Errors: [`Error::InvalidMaterial`] if a strength is NaN or not `> 0`, or so small
-    /// that its yield displacement `a_y/ω²` or band `(1 − α) a_y` rounds to zero in `T`.
+    /// that it, its yield displacement `a_y/ω²` or its band `(1 − α) a_y` is subnormal
+    /// or zero in `T` (below `MIN_POSITIVE`: the ductility `max|u|/u_y` of a subnormal
+    /// `u_y` overflows for any motion, and has lost its precision).
     /// Cost: `2P` multiplications.
     pub fn at_rest(&self, yield_acceleration: &[T; P]) -> Result<YieldResponse<T, P>, Error> {
         let zero = T::from_f64_rounded(0.0);
-        let mut lim = [zero; P];
-        let mut uy = [zero; P];
-        for p in 0..P {
-            let a = yield_acceleration[p];
-            lim[p] = self.one_minus_alpha * a;
-            uy[p] = a * self.inv_w2[p];
-            // `!(x > 0)` is true for NaN too
-            if !(a > zero && lim[p] > zero && uy[p] > zero) {
-                return Err(Error::InvalidMaterial(Param::YieldForce));
-            }
-        }
+        let (lim, uy) = self
+            .bands(yield_acceleration)
+            .ok_or(Error::InvalidMaterial(Param::YieldForce))?;
         Ok(YieldResponse {
             u: [zero; P],
             v: [zero; P],
@@ -459,6 +475,26 @@ impl<T: Real, const P: usize> Yielding<T, P> {
             samples: 0,
             skipped: 0,
         })
+    }
+
+    /// The bands `(1 − α) a_y` and yield displacements `a_y/ω²` of the strengths `ay`, or
+    /// `None` if a strength, band or yield displacement is NaN or below `MIN_POSITIVE` of
+    /// `T` (`+∞` passes: that oscillator never yields).
+    fn bands(&self, ay: &[T; P]) -> Option<([T; P], [T; P])> {
+        let zero = T::from_f64_rounded(0.0);
+        let tiny = T::from_f64_rounded(super::min_normal::<T>());
+        let mut lim = [zero; P];
+        let mut uy = [zero; P];
+        for p in 0..P {
+            let a = ay[p];
+            lim[p] = self.one_minus_alpha * a;
+            uy[p] = a * self.inv_w2[p];
+            // `!(x >= tiny)` is true for NaN too
+            if !(a >= tiny && lim[p] >= tiny && uy[p] >= tiny) {
+                return None;
+            }
+        }
+        Some((lim, uy))
     }
 
     /// Feed the next ground-acceleration sample `ag` (m/s²). Sample 0 is the ground
@@ -479,6 +515,25 @@ impl<T: Real, const P: usize> Yielding<T, P> {
         }
     }
 
+    /// [`Yielding::step`], checked: the sample is taken on a copy of `r`, committed only if
+    /// every state, peak and energy of the copy is finite ([`YieldResponse::is_finite`]).
+    /// A non-finite sample is still skipped and counted (`Ok`); a *finite* sample so large
+    /// that the response overflows (one sample of `5e307` m/s² turns the state to NaN) is
+    /// the error.
+    ///
+    /// Errors: [`Error::NonFiniteState`], `r` unchanged. Cost: one [`Yielding::step`], a
+    /// copy of `r` and a scan of `6P` values.
+    pub fn try_step(&self, r: &mut YieldResponse<T, P>, ag: T) -> Result<(), Error> {
+        let mut next = *r;
+        self.step(&mut next, ag);
+        if next.is_finite() {
+            *r = next;
+            Ok(())
+        } else {
+            Err(Error::NonFiniteState)
+        }
+    }
+
     /// Continue after the record in free vibration: the ground acceleration returns
     /// linearly to zero over one `h` and stays zero for `samples − 1` more intervals
     /// (as [`Bank::free_vibration`](super::Bank::free_vibration)).
@@ -496,9 +551,11 @@ impl<T: Real, const P: usize> Yielding<T, P> {
         }
     }
 
-    /// One initial period of the longest oscillator, in samples (`⌈T_max/h⌉`): the free
-    /// vibration the record-level functions append to the record. Cost: a scan of the
-    /// periods.
+    /// One initial period of the longest oscillator, in samples (`⌈T_max/h⌉`, saturating
+    /// at `u32::MAX`): the free vibration the record-level functions append to the record
+    /// (they refuse more than
+    /// [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES)). Cost: a scan of
+    /// the periods.
     pub fn free_vibration_samples(&self) -> u32 {
         super::longest_period_samples(&self.period, self.time_step)
     }
@@ -562,17 +619,33 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// vibration, from rest, with strengths `yield_acceleration` (m/s², as
     /// [`Yielding::at_rest`]). One *record pass*.
     ///
-    /// Errors: as [`Yielding::at_rest`]. Cost: `N + ⌈T_max/h⌉` steps.
+    /// Every field of the result is finite, its [ductility](YieldResponse::ductility)
+    /// included, or the call is an error. The samples are stepped unchecked and the
+    /// response checked once at the end: a NaN or `±∞` state never turns finite again (it
+    /// propagates through the step, and the peak, work and deformation are running
+    /// maxima and sums), so the end check sees every overflow.
+    ///
+    /// Errors: as [`Yielding::at_rest`]; [`Error::InvalidTimeStep`] if the free-vibration
+    /// tail exceeds [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES);
+    /// [`Error::NonFiniteState`] if a finite sample made the response overflow;
+    /// [`Error::OperatorOverflow`] if a ductility overflows. Cost: `N + ⌈T_max/h⌉` steps.
     pub fn response(
         &self,
         record: &[T],
         yield_acceleration: &[T; P],
     ) -> Result<YieldResponse<T, P>, Error> {
         let mut r = self.at_rest(yield_acceleration)?;
+        let tail = super::checked_tail(&self.period, self.time_step)?;
         for &a in record {
             self.step(&mut r, a);
         }
-        self.free_vibration(&mut r, self.free_vibration_samples());
+        self.free_vibration(&mut r, tail);
+        if !r.is_finite() {
+            return Err(Error::NonFiniteState);
+        }
+        if !super::all_finite(&r.ductility()) {
+            return Err(Error::OperatorOverflow);
+        }
         Ok(r)
     }
 
@@ -581,19 +654,20 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// yields, stepped the same way (one record pass, as [`Yielding::response`], with
     /// `a_y = +∞`). `f_o = m a_y0` is Chopra's elastic strength.
     ///
-    /// Cost: one record pass.
-    pub fn elastic_strength(&self, record: &[T]) -> [T; P] {
+    /// Errors: as [`Yielding::response`]; [`Error::OperatorOverflow`] if `ω² u_o`
+    /// overflows. Cost: one record pass.
+    pub fn elastic_strength(&self, record: &[T]) -> Result<[T; P], Error> {
         let inf = [T::from_f64_rounded(f64::INFINITY); P];
         // `+∞` passes `at_rest`'s checks (it is `> 0`, and so are `(1 − α)∞` and `∞/ω²`).
-        match self.response(record, &inf) {
-            Ok(r) => {
-                let mut out = r.sd;
-                for (o, &w2) in out.iter_mut().zip(self.w2.iter()) {
-                    *o *= w2;
-                }
-                out
-            }
-            Err(_) => [T::from_f64_rounded(0.0); P],
+        let r = self.response(record, &inf)?;
+        let mut out = r.sd;
+        for (o, &w2) in out.iter_mut().zip(self.w2.iter()) {
+            *o *= w2;
+        }
+        if super::all_finite(&out) {
+            Ok(out)
+        } else {
+            Err(Error::OperatorOverflow)
         }
     }
 
@@ -604,7 +678,12 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// vibration.
     ///
     /// Errors: [`Error::InvalidParameter`] if a factor is not finite and `> 0`, or if the
-    /// record leaves an oscillator at rest (elastic strength `0`: no ductility to speak of).
+    /// record leaves an oscillator at rest (elastic strength `0`: no ductility to speak of);
+    /// [`Error::OperatorUnderflow`] if a strength `a_y0/R` (or its yield displacement) is
+    /// subnormal in `T` (e.g. `R = 1e308`; see [`Yielding::at_rest`]); otherwise as
+    /// [`Yielding::response`] (a record so large that the response or the ductility
+    /// overflows: [`Error::NonFiniteState`], [`Error::OperatorOverflow`]). Every field of
+    /// the result is finite.
     /// Cost: two record passes ([`Yielding::response`]).
     pub fn constant_strength(
         &self,
@@ -615,13 +694,16 @@ impl<T: Real, const P: usize> Yielding<T, P> {
         if reduction.iter().any(|&x| !(super::finite(x) && x > zero)) {
             return Err(Error::InvalidParameter(Param::StrengthReduction));
         }
-        let elastic = self.elastic_strength(record);
+        let elastic = self.elastic_strength(record)?;
         let mut ay = elastic;
         for p in 0..P {
             ay[p] /= reduction[p];
             if !(elastic[p] > zero && super::finite(elastic[p])) {
                 return Err(Error::InvalidParameter(Param::ElasticStrength));
             }
+        }
+        if self.bands(&ay).is_none() {
+            return Err(Error::OperatorUnderflow);
         }
         let r = self.response(record, &ay)?;
         Ok(ConstantStrength {
@@ -663,7 +745,9 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     ///
     /// Errors: [`Error::InvalidParameter`] if `target` is not finite and `> 1`, a setting of
     /// `search` is out of range ([`Search`]; its `tol` below `4 ε` of `T`), or the record
-    /// leaves an oscillator at rest. Cost: `1 + (k_max) + refinement` record passes,
+    /// leaves an oscillator at rest; [`Error::OperatorUnderflow`] if a strength of the
+    /// grid, `a_y0 · lowest`, is subnormal in `T` (see [`Yielding::at_rest`]); otherwise as
+    /// [`Yielding::response`] (a pass whose response or ductility overflows). Cost: `1 + (k_max) + refinement` record passes,
     /// `k_max ≤ points − 1` the grid index of the slowest bracket; refinement at most
     /// `2 ⌈log₂((1 − ρ)/tol)⌉ + 2`, typically 5 to 10 ([`ConstantDuctility::passes`];
     /// measured with [`Search::DEFAULT`] on El Centro, 10 periods 0.1–3 s, `μ_t = 2, 4`:
@@ -682,10 +766,15 @@ impl<T: Real, const P: usize> Yielding<T, P> {
         if !(search.valid() && search.tol >= 4.0 * eps) {
             return Err(Error::InvalidParameter(Param::Search));
         }
-        let elastic = self.elastic_strength(record);
+        let elastic = self.elastic_strength(record)?;
         let zero = T::from_f64_rounded(0.0);
         if elastic.iter().any(|&x| !(x > zero && super::finite(x))) {
             return Err(Error::InvalidParameter(Param::ElasticStrength));
+        }
+        // The weakest strength the search can try (the refinement stays above it).
+        let weakest = elastic.map(|x| T::from_f64_rounded(x.as_f64() * search.lowest));
+        if self.bands(&weakest).is_none() {
+            return Err(Error::OperatorUnderflow);
         }
         let a0 = elastic.map(|x| x.as_f64());
         let ratio = libm_pow(search.lowest, 1.0 / (search.points - 1) as f64);

@@ -53,6 +53,21 @@
 //! [`Error::InvalidDamping`]); a non-finite sample is skipped and counted, the peaks kept
 //! ([`Bank::step`]).
 //!
+//! **Extreme records**: a *finite* sample so large that a state or a peak overflows
+//! (`±1e308`, or a record times `1e290`) is an error, never a response with `±∞`/NaN in
+//! it: the checked steps ([`Bank::try_step`], [`RotD::try_step`],
+//! [`inelastic::Yielding::try_step`]) leave the response unchanged and return
+//! [`Error::NonFiniteState`]; the record-level calls ([`Bank::response`],
+//! [`inelastic::Yielding::response`] and the spectra built on it, `batch::spectra`) return
+//! it too, and [`Error::OperatorOverflow`] for a derived result that overflows (a
+//! ductility, a pseudo-acceleration). The unchecked [`Bank::step`] keeps its cost and does
+//! not check. A time step so small that the free-vibration tail would exceed
+//! [`MAX_FREE_VIBRATION_SAMPLES`] is [`Error::InvalidTimeStep`] in the record-level calls.
+//!
+//! [`Error::NonFiniteState`]: crate::Error::NonFiniteState
+//! [`Error::InvalidTimeStep`]: crate::Error::InvalidTimeStep
+//! [`Error::OperatorOverflow`]: crate::Error::OperatorOverflow
+//!
 //! [`Error::InvalidPeriod`]: crate::Error::InvalidPeriod
 //! [`Error::InvalidDamping`]: crate::Error::InvalidDamping
 
@@ -113,6 +128,47 @@ pub(crate) fn longest_period_samples(periods: &[f64], h: f64) -> u32 {
         f.saturating_add(1)
     } else {
         f
+    }
+}
+
+/// The longest free-vibration tail (samples of `h`) the record-level calls append
+/// ([`inelastic::Yielding::response`], [`Bank::response`],
+/// `ida::spectral_acceleration` with `std`): `2²⁰ = 1 048 576`, one period of
+/// `T_max = 10 s` down to `h ≈ 1e-5 s`. A tail of one longest period
+/// (`⌈T_max/h⌉`, [`Bank::free_vibration_samples`]) longer than this is refused with
+/// [`Error::InvalidTimeStep`](crate::Error::InvalidTimeStep) rather than stepped: at
+/// `h = 1e-9 s` it would be `10⁹` samples (minutes of stepping per pass, hours for a
+/// constant-ductility search). Resample the record to a coarser step
+/// ([`records::resample_into`](crate::records::resample_into)) instead.
+pub const MAX_FREE_VIBRATION_SAMPLES: u32 = 1 << 20;
+
+/// The free-vibration tail of a record-level call: one longest period in samples of `h`,
+/// refused above [`MAX_FREE_VIBRATION_SAMPLES`]. Cost: a scan of the periods.
+pub(crate) fn checked_tail(periods: &[f64], h: f64) -> Result<u32, crate::Error> {
+    let n = longest_period_samples(periods, h);
+    if n > MAX_FREE_VIBRATION_SAMPLES {
+        Err(crate::Error::InvalidTimeStep)
+    } else {
+        Ok(n)
+    }
+}
+
+/// Every value of `xs` is finite. Cost: a scan.
+#[inline]
+pub(crate) fn all_finite<T: crate::Real>(xs: &[T]) -> bool {
+    let mut ok = true;
+    for &x in xs {
+        ok &= finite(x);
+    }
+    ok
+}
+
+/// The smallest positive normal value of `T` (`MIN_POSITIVE`), as `f64`.
+pub(crate) fn min_normal<T: crate::Real>() -> f64 {
+    if T::MAX > f32::MAX as f64 {
+        f64::MIN_POSITIVE
+    } else {
+        f32::MIN_POSITIVE as f64
     }
 }
 

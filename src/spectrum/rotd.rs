@@ -3,7 +3,7 @@
 use super::bank::{Bank, Response};
 use super::finite;
 use super::operators::cos_sin;
-use crate::Real;
+use crate::{Error, Real};
 
 /// The rotation angles of a RotD computation: `K` angles `θ_j = jπ/K`, `j = 0 … K−1`
 /// (`K = 180` is the usual 1° increment). Build with [`RotD::new`] (run time, generic)
@@ -122,6 +122,30 @@ impl<T: Real, const K: usize> RotD<T, K> {
         r.y.samples += 1;
     }
 
+    /// [`RotD::step`], checked: the samples are taken on a copy of `r`, committed only if
+    /// both components' states and peaks and every rotated peak are finite
+    /// ([`RotDResponse::is_finite`]). Non-finite samples are still skipped and counted
+    /// (`Ok`); finite samples that make the response overflow are the error.
+    ///
+    /// Errors: [`Error::NonFiniteState`], `r` unchanged. Cost: one [`RotD::step`], a copy of
+    /// `r` and a scan of it.
+    pub fn try_step<const P: usize>(
+        &self,
+        bank: &Bank<T, P>,
+        r: &mut RotDResponse<T, P, K>,
+        ax: T,
+        ay: T,
+    ) -> Result<(), Error> {
+        let mut next = *r;
+        self.step(bank, &mut next, ax, ay);
+        if next.is_finite() {
+            *r = next;
+            Ok(())
+        } else {
+            Err(Error::NonFiniteState)
+        }
+    }
+
     /// Continue both components in free vibration for `samples` sample intervals (as
     /// [`Bank::free_vibration`]). Cost: `samples` times that of [`RotD::step`].
     pub fn free_vibration<const P: usize>(
@@ -210,6 +234,17 @@ impl<T: Real, const K: usize> RotD<T, K> {
 }
 
 impl<T: Real, const P: usize, const K: usize> RotDResponse<T, P, K> {
+    /// Both components' states and peaks ([`Response::is_finite`]) and every rotated peak
+    /// are finite. A non-finite value never turns finite again under the linear maps, so
+    /// this at the end of a record (after [`RotD::free_vibration`]) also tells whether any
+    /// step overflowed. Cost: a scan of `10P + K·P` values.
+    pub fn is_finite(&self) -> bool {
+        let mut ok = self.x.is_finite() & self.y.is_finite();
+        for pk in &self.peak {
+            ok &= super::all_finite(pk);
+        }
+        ok
+    }
     /// The first component's own response (its `Sd`, `Sv`, `Sa`). Cost: none.
     pub fn x(&self) -> &Response<T, P> {
         &self.x

@@ -165,8 +165,24 @@ where
         let (x, y) = (T::from_f64_rounded(ax), T::from_f64_rounded(ay));
         record.push(x);
         let before = r;
+        // The checked step: the unchecked one's result when finite, else `r` unchanged.
+        let mut tried = r;
+        let t = bank.try_step(&mut tried, x);
         bank.step(&mut r, x);
         count(SP, "samples");
+        match t {
+            Ok(()) => check!(
+                tried == r && r.is_finite(),
+                "{SP}: Bank::try_step Ok differs from step or is not finite"
+            ),
+            Err(e) => {
+                count(SP, "checked steps refused");
+                check!(
+                    e == Error::NonFiniteState && bits(&tried) == bits(&before) && !r.is_finite(),
+                    "{SP}: Bank::try_step gave {e:?} or changed the response"
+                );
+            }
+        }
         if !x.is_finite() {
             count(SP, "samples skipped");
             // A skipped sample: counted, and the same as the last finite sample held.
@@ -205,7 +221,20 @@ where
                 "{SP}: a peak fell"
             );
         }
+        let (rr_before, mut rr_tried) = (rr, rr);
+        let t = rot.try_step(&bank, &mut rr_tried, x, y);
         rot.step(&bank, &mut rr, x, y);
+        check!(
+            match t {
+                Ok(()) => rr_tried == rr && rr.is_finite(),
+                Err(e) => {
+                    e == Error::NonFiniteState
+                        && bits(&rr_tried) == bits(&rr_before)
+                        && !rr.is_finite()
+                }
+            },
+            "{SP}: RotD::try_step differs from step, or changed the response"
+        );
     }
     // Ordinary samples: each at most 10 (m/s²) in size, or skipped (not finite).
     let ordinary = samples
@@ -245,7 +274,11 @@ where
     if batch {
         let out = aemstep::spectrum::batch::spectra(&bank, &[&record[..]], 0, 1);
         check!(
-            out.len() == 1 && bits(&out[0]) == bits(&r),
+            out.len() == 1
+                && match &out[0] {
+                    Ok(o) => bits(o) == bits(&r) && r.is_finite(),
+                    Err(e) => *e == Error::NonFiniteState && !r.is_finite(),
+                },
             "{SP}: batch differs from stepping"
         );
         count(SP, "batch compared");
@@ -356,8 +389,20 @@ fn inelastic_typed<T: Real>(
     if let Ok(mut r) = rest {
         for &x in &record {
             let before = r;
+            let mut tried = r;
+            let t = bank.try_step(&mut tried, x);
             bank.step(&mut r, x);
             count(SP, "yielding samples");
+            check!(
+                match t {
+                    Ok(()) => tried == r && r.is_finite(),
+                    Err(e) =>
+                        e == Error::NonFiniteState
+                            && bits(&tried) == bits(&before)
+                            && !r.is_finite(),
+                },
+                "{SP}: Yielding::try_step differs from step, or changed the response"
+            );
             check!(
                 r.samples() == before.samples() + 1
                     && r.skipped() == before.skipped() + u64::from(!x.is_finite()),
@@ -382,11 +427,30 @@ fn inelastic_typed<T: Real>(
     let reduction = y.reduction.map(T::from_f64_rounded);
     let cs = bank.constant_strength(&record, &reduction);
     outcome(SP, &cs);
-    if let Err(e) = cs {
-        check!(
-            matches!(e, Error::InvalidParameter(_) | Error::InvalidMaterial(_)),
-            "{SP}: constant_strength gave {e:?}"
-        );
+    // The record-level errors: bad data, an underflowing strength, an overflowing response.
+    let typed_pass = |e: &Error| {
+        matches!(
+            e,
+            Error::InvalidParameter(_)
+                | Error::InvalidMaterial(_)
+                | Error::OperatorUnderflow
+                | Error::OperatorOverflow
+                | Error::NonFiniteState
+        )
+    };
+    match &cs {
+        Err(e) => check!(typed_pass(e), "{SP}: constant_strength gave {e:?}"),
+        // Every field finite, or an error.
+        Ok(c) => check!(
+            c.response.is_finite()
+                && c.elastic
+                    .iter()
+                    .chain(&c.yield_acceleration)
+                    .chain(&c.ductility)
+                    .chain(&c.plastic_work)
+                    .all(|x| x.is_finite()),
+            "{SP}: constant_strength Ok with a non-finite field: {c:?}"
+        ),
     }
     if reduction.iter().any(|&x| !(x > T::zero() && x.is_finite())) {
         check!(
@@ -398,10 +462,7 @@ fn inelastic_typed<T: Real>(
     let cd = bank.constant_ductility(&record, T::from_f64_rounded(y.target), &y.search);
     outcome(SP, &cd);
     match cd {
-        Err(e) => check!(
-            matches!(e, Error::InvalidParameter(_) | Error::InvalidMaterial(_)),
-            "{SP}: constant_ductility gave {e:?}"
-        ),
+        Err(e) => check!(typed_pass(&e), "{SP}: constant_ductility gave {e:?}"),
         Ok(c) => {
             count(SP, "constant-ductility searches");
             for p in 0..3 {
@@ -636,8 +697,13 @@ fn ida_checks(b: &mut Bytes) {
             let q = [b.value(), b.param(0.0, 1.0)];
             match ida::fractiles(core::slice::from_ref(&c), &edp, &q) {
                 Ok(f) => check!(
-                    f.len() == 2 && f.iter().all(|r| r.len() == 2),
-                    "ida: fractile shape"
+                    f.quantiles() == q
+                        && f.edp() == edp
+                        && f.as_slice().len() == 4
+                        && f.at(1, 1) == f.curve(1).map(|c| c[1])
+                        && f.at(2, 0).is_none()
+                        && f.at(0, 2).is_none(),
+                    "ida: fractile axes"
                 ),
                 Err(e) => check!(
                     e == Error::InvalidParameter(Param::Fractiles),

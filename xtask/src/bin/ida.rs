@@ -21,7 +21,7 @@ mod plot;
 
 use std::fmt::Write as _;
 
-use aemstep::ida::{self, Collapse, Curve, HuntFill, OnFailure};
+use aemstep::ida::{self, Collapse, Curve, Fractiles, HuntFill, OnFailure};
 use aemstep::models;
 use aemstep::records::{self, G};
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
@@ -94,7 +94,7 @@ for (r, c) in suite.iter().zip(&curves) {
 }
 // The 16, 50 and 84 % intensities at drifts of 1, 2 and 3 cm.
 let f = ida::fractiles(&curves, &[0.01, 0.02, 0.03], &[0.16, 0.5, 0.84])?;
-println!("median scale at 2 cm: {}", f[1][1]);
+println!("median scale at 2 cm: {:?}", f.at(1, 1));
 # Ok::<(), Box<dyn std::error::Error>>(())
 ```"#;
 
@@ -169,7 +169,7 @@ fn first_period() -> f64 {
 fn suite(t1: f64) -> Result<Vec<Rec>, aemstep::Error> {
     // The real record through the AT2 reader (the same samples as the `.txt` the scenes use).
     let at2 = records::Record::from_at2(include_str!("../../../data/elcentro-ns-1940.AT2"))?;
-    let el: Vec<f64> = at2.scaled(G);
+    let el: Vec<f64> = at2.scaled(G)?;
     assert_eq!(el.as_slice(), &elcentro::AG_F64[..]);
     let mut list = vec![
         (
@@ -247,7 +247,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         std::array::from_fn(|i| 0.05 * (3.0f64 / 0.05).powf(i as f64 / (P - 1) as f64));
     let bank = Yielding::<f64, P>::new(periods, [ZETA; P], 0.0, elcentro::DT)?;
     let el = &recs[0].ag;
-    let elastic = bank.elastic_strength(el);
+    let elastic = bank.elastic_strength(el)?;
     let mut spectra: Vec<[f64; P]> = vec![elastic.map(|a| a / G)];
     let mut passes = Vec::new();
     let mut unconverged = 0;
@@ -287,7 +287,7 @@ fn page(
     s: &HuntFill,
     t1: f64,
     same_bits: bool,
-    table: &[Vec<f64>],
+    table: &Fractiles,
     periods: &[f64; P],
     spectra: &[[f64; P]],
     passes: &[u32],
@@ -417,9 +417,9 @@ Fractiles of Sa(T₁) (g) given the peak storey drift:\n\n\
         let _ = writeln!(
             md,
             "| {e:.3} | {} | {} | {} |",
-            cell(table[0][j]),
-            cell(table[1][j]),
-            cell(table[2][j])
+            cell(table.at(0, j).unwrap_or(f64::NAN)),
+            cell(table.at(1, j).unwrap_or(f64::NAN)),
+            cell(table.at(2, j).unwrap_or(f64::NAN))
         );
     }
     let _ = write!(
@@ -461,7 +461,7 @@ fn plot_ida(
     recs: &[Rec],
     curves: &[Curve],
     levels: &[f64],
-    fr: &[Vec<f64>],
+    fr: &Fractiles,
 ) -> plot::Res<()> {
     let root = SVGBackend::new(path, (1000, 600)).into_drawing_area();
     root.fill(&WHITE)?;
@@ -510,7 +510,7 @@ fn plot_ida(
     for (k, (q, w)) in QS.iter().zip([1, 3, 1]).enumerate() {
         let pts: Vec<(f64, f64)> = levels
             .iter()
-            .zip(&fr[k])
+            .zip(fr.curve(k).unwrap_or(&[]))
             .filter(|(_, y)| y.is_finite())
             .map(|(&e, &y)| (100.0 * e, y))
             .collect();

@@ -168,7 +168,9 @@ fn main() -> Res<()> {
             .collect();
         let slices: Vec<&[f64]> = idx.iter().map(|&i| records[i].ag.as_slice()).collect();
         let t0 = std::time::Instant::now();
-        let out = batch::spectra(&bank, &slices, bank.free_vibration_samples(), 0);
+        let out = batch::spectra(&bank, &slices, bank.free_vibration_samples(), 0)
+            .into_iter()
+            .collect::<Result<Vec<_>, _>>()?;
         eprintln!(
             "dt = {dt} s: {} record(s) in {:.2?} (host)",
             idx.len(),
