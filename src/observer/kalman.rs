@@ -4,8 +4,8 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::fixed::{Estimate, initial_estimate};
+use super::kalman_core::is_covariance;
 use super::kalman_core::{cross_is_valid, gain_t, innovation_t, is_zero, joseph_t};
-use super::riccati::is_covariance;
 use super::state_space::{Measurement, StateSpace};
 use crate::linalg::{Mat, all_finite, finite_as, matrix_t, rows_f64, sym};
 use crate::{Error, Real};

@@ -89,7 +89,8 @@ pub use kalman::{Kalman, KalmanState};
 pub(crate) use kalman_core::{
     cross_is_valid, cross_riccati_start, gain_t, innovation_parts, innovation_t, is_zero,
 };
-pub(crate) use riccati::{A_SMALL, balance, doubling, inf_norm, is_covariance, symmetrize};
+pub(crate) use kalman_core::{is_covariance, symmetrize};
+pub(crate) use riccati::{A_SMALL, balance, doubling, inf_norm};
 pub use riccati::{RICCATI_MAX_ITERATIONS, RICCATI_RESIDUAL_UNITS, SteadyState};
 pub(crate) use state_space::lu_of;
 pub use state_space::{Measurement, Outputs, StateSpace};

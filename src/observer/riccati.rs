@@ -24,13 +24,14 @@
 
 use nalgebra::SMatrix;
 
-use super::kalman_core::{cross_is_valid, cross_riccati_start, innovation_parts, is_zero};
+use super::kalman_core::{
+    cross_is_valid, cross_riccati_start, definite_lu, innovation_parts, is_covariance, is_zero,
+    symmetrize,
+};
 use super::state_space::{Measurement, StateSpace, lu_of};
 use crate::Error;
-use crate::linalg::cholesky::cholesky;
-use crate::linalg::lu::Lu;
 use crate::linalg::{
-    Mat, add_scaled, all_finite, identity, is_symmetric, max_abs, mul, rows_f64, sqrt, transpose,
+    Mat, add_scaled, all_finite, identity, max_abs, mul, rows_f64, sqrt, transpose,
 };
 
 /// Iteration budget of the doubling algorithm: iterate `k` covers `2^k` steps of the
@@ -68,61 +69,6 @@ pub struct SteadyState<const S: usize, const O: usize> {
     /// [`innovation_covariance`](crate::detection::innovation_covariance) and the
     /// [smoother](crate::estimation::smoother) use the same noise model.
     pub cross: [[f64; O]; S],
-}
-
-/// `a` symmetric to `64 ε max|a|` and all finite.
-const fn symmetric<const N: usize>(a: &Mat<N, N>) -> bool {
-    all_finite(a) && is_symmetric(a, 64.0 * f64::EPSILON)
-}
-
-/// `(a + aᵀ)/2`.
-pub(crate) const fn symmetrize<const N: usize>(a: &Mat<N, N>) -> Mat<N, N> {
-    let mut s = *a;
-    let mut i = 0;
-    while i < N {
-        let mut j = 0;
-        while j < i {
-            let m = 0.5 * (a[i][j] + a[j][i]);
-            s[i][j] = m;
-            s[j][i] = m;
-            j += 1;
-        }
-        i += 1;
-    }
-    s
-}
-
-/// The LU (with row scales) of `a` if `a` is a positive definite covariance: finite,
-/// symmetric, with a Cholesky factorization and that LU, which [`SteadyState`] solves
-/// with. Both: at the edge of singularity the two judge rounding differently (an `R` with
-/// relative determinant `−3e-21` passed the Cholesky and failed the LU, so `Kalman` took
-/// what `SteadyState` refused; found by fuzzing). Cost: `N³/6 + N³/3` multiply-adds.
-pub(crate) const fn definite_lu<const N: usize>(a: &Mat<N, N>) -> Option<Lu<N>> {
-    if !symmetric(a) || cholesky(a).is_none() {
-        return None;
-    }
-    lu_of(a)
-}
-
-/// `a` is a valid covariance: finite, symmetric and positive semidefinite (`definite`:
-/// positive definite, as [`definite_lu`] judges it). Semidefiniteness is tested by a
-/// Cholesky factorization of `a + δI`, `δ = 16 N ε max|a|`: a rank-deficient `a` passes,
-/// an eigenvalue below `−δ` fails. Cost: `N³/6` flops (`N³/3` more for `definite`).
-pub(crate) const fn is_covariance<const N: usize>(a: &Mat<N, N>, definite: bool) -> bool {
-    if definite {
-        return definite_lu(a).is_some();
-    }
-    if !symmetric(a) {
-        return false;
-    }
-    let delta = 16.0 * N as f64 * f64::EPSILON * max_abs(a) + f64::MIN_POSITIVE;
-    let mut b = *a;
-    let mut i = 0;
-    while i < N {
-        b[i][i] += delta;
-        i += 1;
-    }
-    cholesky(&b).is_some()
 }
 
 /// `L = P Hᵀ (H P Hᵀ + R)⁻¹` for a covariance `P` (a solve with the `O×O` innovation
