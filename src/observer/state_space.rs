@@ -46,11 +46,11 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::kernel::{checked_rows, newmark_operators, start_operators};
 use crate::kinematics::check_time_step_as;
-use crate::linalg::expm::{Blk, blk_expm, norm1};
 use crate::linalg::lu::{Lu, row_scales};
-use crate::linalg::{Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled, sqrt};
+use crate::linalg::{Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled};
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
+use crate::schemes::exponential_blocks;
 use crate::{AlphaParameters, Error, Exact};
 
 /// The discrete state-space model of a linear scheme with `N` degrees of freedom, state
@@ -673,9 +673,8 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     ///
     /// exactly (no truncation error, only rounding) — so in the two-ended form
     /// `Γ₀ = Γ`, `Γ₁ = 0` (for the filters of [`estimation`](crate::estimation):
-    /// `B = Γ`, `D̃ = D`). `Φ` and `Γ` are blocks of one matrix exponential (Van Loan)
-    /// of `h [[0, I, 0], [−M⁻¹K, −M⁻¹C, M⁻¹], [0, 0, 0]]`, balanced and computed as for
-    /// [`Exact`] (same `Φ`). The outputs are those of every full-state builder:
+    /// `B = Γ`, `D̃ = D`). `Φ` and `Γ` are blocks of the one matrix exponential (Van
+    /// Loan) that [`Exact`] reads, so `Φ` is its `Φ` bit for bit and `Γ` its `Γ₁ᵉ B`. The outputs are those of every full-state builder:
     /// `u = U x`, `v = V x`, `a = M⁻¹ (B w − C v − K u)` — the acceleration at `t_n` with
     /// the sample `w_n` that is held from `t_n` on (the right limit at a switch of the
     /// input), so an acceleration output has the direct feedthrough `D = Y_a M⁻¹ B`, the
@@ -720,31 +719,16 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         let hf = check_time_step_as(h, f64::MAX)?;
         let (lu_m, st) = start_operators(&mm, &cc, &kk, f64::MAX)?.ok_or(Error::SingularMass)?;
         let (mi, mic, mik) = (&st.minv, &st.minv_c, &st.minv_k);
-        // The balancing of `Exact::new`, D = diag(1, σ, τ, 1): block (i, j) scaled by
-        // d_j / d_i, which leaves the exponential's blocks scaled the same way.
-        let kn = norm1(mik);
-        let sigma = if kn > 0.0 { sqrt(kn) } else { 1.0 / hf };
-        let theta = (sigma * hf).max(norm1(mic) * hf);
-        let tau = sigma * theta / (norm1(mi) * hf);
-        let d = [1.0, sigma, tau, 1.0];
-        let z = [[0.0; N]; N];
-        let id: Mat<N, N> = identity();
-        let mut x: Blk<N> = [[z; 4]; 4];
-        x[0][1] = scaled(hf * d[1] / d[0], &id);
-        x[1][0] = scaled(-hf * d[0] / d[1], mik);
-        x[1][1] = scaled(-hf, mic);
-        x[1][2] = scaled(hf * d[2] / d[1], mi);
-        let mut work: Blk<N> = [[z; 4]; 4];
-        let mut e: Blk<N> = [[z; 4]; 4];
-        blk_expm(&mut x, &mut work, &mut e);
-        let blk = |i: usize, j: usize| scaled(d[i] / d[j], &e[i][j]);
+        // Φ and Γ₁ᵉ = ∫₀ʰ e^{F s} ds [0; M⁻¹] of the exponential `Exact` reads.
+        let [[phi_uu, phi_uv, gu, _], [phi_vu, phi_vv, gv, _]] =
+            exponential_blocks(mi, mic, mik, hf);
         let mut ss = Self::zero(hf);
-        put(&mut ss.phi, &blk(0, 0), 0, 0);
-        put(&mut ss.phi, &blk(0, 1), 0, N);
-        put(&mut ss.phi, &blk(1, 0), N, 0);
-        put(&mut ss.phi, &blk(1, 1), N, N);
-        put(&mut ss.gamma0, &mul(&blk(0, 2), &bb), 0, 0);
-        put(&mut ss.gamma0, &mul(&blk(1, 2), &bb), N, 0);
+        put(&mut ss.phi, &phi_uu, 0, 0);
+        put(&mut ss.phi, &phi_uv, 0, N);
+        put(&mut ss.phi, &phi_vu, N, 0);
+        put(&mut ss.phi, &phi_vv, N, N);
+        put(&mut ss.gamma0, &mul(&gu, &bb), 0, 0);
+        put(&mut ss.gamma0, &mul(&gv, &bb), N, 0);
         let (au, av) = (scaled(-1.0, mik), scaled(-1.0, mic));
         ss.full_outputs(&au, &av, lu_m.solve(&bb))
     }
