@@ -213,11 +213,17 @@ for i in 0..5 {
     b[i][i] = 1.0;
     qw[i][i] = 5e4 * 5e4; // N²
 }
-let q = StateSpace::<5, 10, 5>::from_rows_aem(m, c, k, b, h)?.input_noise(&qw);
-// Measurement noise R: each accelerometer's variance ((m/s²)²).
-let r = [[0.18 * 0.18, 0.0], [0.0, 0.26 * 0.26]];
+let forces = StateSpace::<5, 10, 5>::from_rows_aem(m, c, k, b, h)?;
+let q = forces.input_noise(&qw);
+// The same forces reach the accelerometers (a = M⁻¹(f − C v − K u)): their share D Q_w Dᵀ
+// of the measurement noise, and its cross covariance N with the process noise.
+let at_sensors = forces.outputs(&Outputs::accelerations(Outputs::<5, 5, 2>::select([1, 4])))?;
+let n = forces.input_cross_noise(&at_sensors, &qw);
+let f = forces.feedthrough_noise(&at_sensors, &qw);
+// Measurement noise R: each accelerometer's own variance ((m/s²)²) plus the forces' share.
+let r = [[0.18 * 0.18 + f[0][0], f[0][1]], [f[1][0], 0.26 * 0.26 + f[1][1]]];
 
-let gain = SteadyState::from_parts(&model, &meas, &q, &r)?; // `const fn`: also in a `static`
+let gain = SteadyState::from_parts_cross(&model, &meas, &q, &r, &n)?; // `const fn` too
 let observer = Observer::<f32, 10, 1, 2>::new(&model, &meas, &gain.gain_matrix())?;
 let readout = Readout::<f32, 10, 1, 5>::new(&drifts)?;
 
