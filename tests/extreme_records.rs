@@ -44,6 +44,18 @@ fn constant_strength_r_1e308_is_an_error_not_infinite_ductility() {
 }
 
 #[test]
+fn constant_strength_tiny_reduction_overflowing_f32_is_an_error() {
+    // Found by fuzzing (fuzz/regressions/spectrum/constant-strength-f32-tiny-reduction-
+    // overflows): in f32, R = 4.2e-44 (subnormal) makes a_y0/R ≈ 2e44 = +∞, which was
+    // taken as "never yields" and returned Ok with an infinite yield acceleration.
+    let y = Yielding::<f32, 3>::new([0.2, 0.5, 1.0], [0.05; 3], 0.0, H).unwrap();
+    let rec: Vec<f32> = sine().iter().map(|&a| a as f32).collect();
+    let cs = y.constant_strength(&rec, &[4.2e-44, 4.0, 4.0]);
+    assert_eq!(cs.map(|_| ()), Err(Error::OperatorOverflow));
+    assert!(y.constant_strength(&rec, &[4.0; 3]).is_ok());
+}
+
+#[test]
 fn constant_strength_record_times_1e290_is_an_error_not_infinite_work() {
     let big: Vec<f64> = sine().iter().map(|a| a * 1e290).collect();
     let cs = yielding().constant_strength(&big, &[4.0; 3]);

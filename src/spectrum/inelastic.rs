@@ -679,8 +679,9 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     ///
     /// Errors: [`Error::InvalidParameter`] if a factor is not finite and `> 0`, or if the
     /// record leaves an oscillator at rest (elastic strength `0`: no ductility to speak of);
-    /// [`Error::OperatorUnderflow`] if a strength `a_y0/R` (or its yield displacement) is
-    /// subnormal in `T` (e.g. `R = 1e308`; see [`Yielding::at_rest`]); otherwise as
+    /// [`Error::OperatorOverflow`] if a strength `a_y0/R` overflows `T` (a tiny `R`, e.g.
+    /// `4e-44` in `f32`), [`Error::OperatorUnderflow`] if it (or its yield displacement)
+    /// is subnormal in `T` (e.g. `R = 1e308`; see [`Yielding::at_rest`]); otherwise as
     /// [`Yielding::response`] (a record so large that the response or the ductility
     /// overflows: [`Error::NonFiniteState`], [`Error::OperatorOverflow`]). Every field of
     /// the result is finite.
@@ -701,6 +702,11 @@ impl<T: Real, const P: usize> Yielding<T, P> {
             if !(elastic[p] > zero && super::finite(elastic[p])) {
                 return Err(Error::InvalidParameter(Param::ElasticStrength));
             }
+        }
+        // `a_y0 / R` beyond the range of `T` (a tiny `R`, found by fuzzing: `f32`, R = 4e-44)
+        // or below its normal range (a huge `R`).
+        if ay.iter().any(|&a| !super::finite(a)) {
+            return Err(Error::OperatorOverflow);
         }
         if self.bands(&ay).is_none() {
             return Err(Error::OperatorUnderflow);
