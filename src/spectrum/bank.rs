@@ -96,6 +96,65 @@ pub(super) const fn substeps_for(rule: Substeps, h: f64, t: f64) -> u16 {
     }
 }
 
+/// The sample interval `h` (s, finite, `> 0`: else [`Error::InvalidTimeStep`]) and the
+/// sub-step rule ([`Error::InvalidParameter`] for `Fixed(0)`, `Fixed(n > MAX_SUBSTEPS)`,
+/// `PointsPerPeriod(0)`), checked in that order: the first checks of both banks (the
+/// elastic [`Bank`] and the yielding [`Yielding`](super::inelastic::Yielding)).
+pub(super) const fn check_interval(h: f64, rule: Substeps) -> Result<(), Error> {
+    if !(h.is_finite() && h > 0.0) {
+        return Err(Error::InvalidTimeStep);
+    }
+    match rule {
+        Substeps::Fixed(n) if n == 0 || n > MAX_SUBSTEPS => {
+            Err(Error::InvalidParameter(Param::Substeps))
+        }
+        Substeps::PointsPerPeriod(0) => Err(Error::InvalidParameter(Param::Substeps)),
+        _ => Ok(()),
+    }
+}
+
+/// One oscillator of a bank, set up from its period and damping ratio.
+pub(super) struct Oscillator {
+    /// `ω = 2π/T` (1/s).
+    pub w: f64,
+    /// Damping ratio `ζ`, as given.
+    pub z: f64,
+    /// Sub-steps per sample `n`.
+    pub n: u16,
+    /// Sub-step `h/n` (s).
+    pub hs: f64,
+}
+
+/// Oscillator `p`'s set-up, shared by both banks: its period checked (finite, at least
+/// `1e-150` — periods so short that `ω²` overflows are rejected with the non-positive
+/// ones — and not below the previous one: else [`Error::InvalidPeriod`]), then its damping
+/// ratio (in `[0, 1)`: else [`Error::InvalidDamping`]); `ω = 2π/T`, `n` by
+/// [`substeps_for`], `h/n`. `h` and `rule` checked by [`check_interval`]. Cost: a few
+/// flops.
+pub(super) const fn oscillator<const P: usize>(
+    period: &[f64; P],
+    damping: &[f64; P],
+    p: usize,
+    h: f64,
+    rule: Substeps,
+) -> Result<Oscillator, Error> {
+    let t = period[p];
+    let z = damping[p];
+    if !(t.is_finite() && t >= 1e-150) || (p > 0 && t < period[p - 1]) {
+        return Err(Error::InvalidPeriod);
+    }
+    if !(z >= 0.0 && z < 1.0) {
+        return Err(Error::InvalidDamping);
+    }
+    let n = substeps_for(rule, h, t);
+    Ok(Oscillator {
+        w: TAU / t,
+        z,
+        n,
+        hs: h / n as f64,
+    })
+}
+
 /// The homogeneous part of a map is bounded as a damped oscillator's must be: the energy
 /// `(ω²u² + v²)/2` never grows, so `|uu|, |vv|, ω|uv|, |vu|/ω ≤ 1` (exactly for both
 /// schemes; here within `1e-6`). The exact scheme's matrix exponential loses that, and all
@@ -151,16 +210,8 @@ pub(super) const fn build_f64<const P: usize>(
     rule: Substeps,
     max: f64,
 ) -> Result<OpsF64<P>, Error> {
-    if !(h.is_finite() && h > 0.0) {
-        return Err(Error::InvalidTimeStep);
-    }
-    if let Substeps::Fixed(n) = rule
-        && (n == 0 || n > MAX_SUBSTEPS)
-    {
-        return Err(Error::InvalidParameter(Param::Substeps));
-    }
-    if let Substeps::PointsPerPeriod(0) = rule {
-        return Err(Error::InvalidParameter(Param::Substeps));
+    if let Err(e) = check_interval(h, rule) {
+        return Err(e);
     }
     let zero = SdofOps {
         uu: 0.0,
@@ -183,18 +234,10 @@ pub(super) const fn build_f64<const P: usize>(
     let mut fits_all = true;
     let mut p = 0;
     while p < P {
-        let t = period[p];
-        let z = damping[p];
-        // Periods so short that ω² overflows are rejected with the non-positive ones.
-        if !(t.is_finite() && t >= 1e-150) || (p > 0 && t < period[p - 1]) {
-            return Err(Error::InvalidPeriod);
-        }
-        if !(z >= 0.0 && z < 1.0) {
-            return Err(Error::InvalidDamping);
-        }
-        let w = TAU / t;
-        let n = substeps_for(rule, h, t);
-        let hs = h / n as f64;
+        let Oscillator { w, z, n, hs } = match oscillator(period, damping, p, h, rule) {
+            Ok(o) => o,
+            Err(e) => return Err(e),
+        };
         out.w2[p] = w * w;
         out.c2[p] = 2.0 * z * w;
         out.n[p] = n;

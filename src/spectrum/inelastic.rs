@@ -95,11 +95,10 @@
 //! [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES) is
 //! [`Error::InvalidTimeStep`].
 
-use super::bank::substeps_for;
-use super::{MAX_SUBSTEPS, Substeps};
+use super::Substeps;
+use super::bank::{Oscillator, check_interval, oscillator};
 use crate::linalg::all_fit;
 use crate::{Error, Param, Real};
-use core::f64::consts::TAU;
 
 /// A bank of `P` yielding single-degree-of-freedom oscillators (bilinear, kinematic
 /// hardening, post-yield ratio `α` shared by the bank; see the [module](self)), fed one
@@ -160,15 +159,8 @@ const fn coeffs<const P: usize>(
     rule: Substeps,
     max: f64,
 ) -> Result<Coeffs<P>, Error> {
-    if !(h.is_finite() && h > 0.0) {
-        return Err(Error::InvalidTimeStep);
-    }
-    match rule {
-        Substeps::Fixed(n) if n == 0 || n > MAX_SUBSTEPS => {
-            return Err(Error::InvalidParameter(Param::Substeps));
-        }
-        Substeps::PointsPerPeriod(0) => return Err(Error::InvalidParameter(Param::Substeps)),
-        _ => {}
+    if let Err(e) = check_interval(h, rule) {
+        return Err(e);
     }
     let mut out = Coeffs {
         c: [[0.0; P]; 9],
@@ -178,18 +170,11 @@ const fn coeffs<const P: usize>(
     let mut fits = true;
     let mut p = 0;
     while p < P {
-        let t = period[p];
-        let z = damping[p];
-        if !(t.is_finite() && t >= 1e-150) || (p > 0 && t < period[p - 1]) {
-            return Err(Error::InvalidPeriod);
-        }
-        if !(z >= 0.0 && z < 1.0) {
-            return Err(Error::InvalidDamping);
-        }
-        let w = TAU / t;
+        let Oscillator { w, z, n, hs } = match oscillator(period, damping, p, h, rule) {
+            Ok(o) => o,
+            Err(e) => return Err(e),
+        };
         let w2 = w * w;
-        let n = substeps_for(rule, h, t);
-        let hs = h / n as f64;
         let kappa = 4.0 / (hs * hs) + 4.0 * z * w / hs;
         let aw2 = alpha * w2;
         let row = [
