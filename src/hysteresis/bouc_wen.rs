@@ -165,17 +165,7 @@ impl<T: Real> BoucWen<T> {
         } else {
             0.5
         };
-        let [
-            ak,
-            cz,
-            ck,
-            inv_uy,
-            half_inv_uy,
-            kappa,
-            sigma_load,
-            sigma_unload,
-            n_t,
-        ] = rounded::<T, 9>([
+        let c = rounded::<T, 9>([
             alpha * k,
             (1.0 - alpha) * fy,
             (1.0 - alpha) * k,
@@ -210,15 +200,15 @@ impl<T: Real> BoucWen<T> {
         };
         let z_scale = T::from_f64_rounded(z_max.min(1.0).max(floor));
         Ok(Self {
-            ak,
-            cz,
-            ck,
-            inv_uy,
-            half_inv_uy,
-            kappa,
-            sigma_load,
-            sigma_unload,
-            n: n_t,
+            ak: c[0],
+            cz: c[1],
+            ck: c[2],
+            inv_uy: c[3],
+            half_inv_uy: c[4],
+            kappa: c[5],
+            sigma_load: c[6],
+            sigma_unload: c[7],
+            n: c[8],
             split_at_zero: gamma < beta,
             n_kind: if n == 1.0 {
                 1

@@ -658,6 +658,15 @@ impl<T: Real, const P: usize> Bank<T, P> {
     /// ```
     pub fn response(&self, record: &[T]) -> Result<Response<T, P>, Error> {
         let tail = super::checked_tail(&self.period, self.time_step)?;
+        self.record_pass(record, tail)
+    }
+
+    /// From rest, every sample of `record` stepped unchecked, then `tail` samples of free
+    /// vibration, the response checked once at the end (see [`Bank::response`]): the pass
+    /// of [`Bank::response`] and of the host batch.
+    ///
+    /// Errors: [`Error::NonFiniteState`]. Cost: `N + tail` steps, one scan.
+    pub(super) fn record_pass(&self, record: &[T], tail: u32) -> Result<Response<T, P>, Error> {
         let mut r = Response::rest();
         for &a in record {
             self.step(&mut r, a);
