@@ -3,6 +3,7 @@
 use super::operators::{self, SdofOps};
 use super::{MAX_SUBSTEPS, Scheme, Substeps};
 use crate::linalg::{all_fit, fits_value};
+use crate::macros::const_try;
 use crate::{Error, Param, Real};
 use core::f64::consts::TAU;
 
@@ -210,9 +211,7 @@ pub(super) const fn build_f64<const P: usize>(
     rule: Substeps,
     max: f64,
 ) -> Result<OpsF64<P>, Error> {
-    if let Err(e) = check_interval(h, rule) {
-        return Err(e);
-    }
+    const_try!(check_interval(h, rule));
     let zero = SdofOps {
         uu: 0.0,
         uv: 0.0,
@@ -234,10 +233,7 @@ pub(super) const fn build_f64<const P: usize>(
     let mut fits_all = true;
     let mut p = 0;
     while p < P {
-        let Oscillator { w, z, n, hs } = match oscillator(period, damping, p, h, rule) {
-            Ok(o) => o,
-            Err(e) => return Err(e),
-        };
+        let Oscillator { w, z, n, hs } = const_try!(oscillator(period, damping, p, h, rule));
         out.w2[p] = w * w;
         out.c2[p] = 2.0 * z * w;
         out.n[p] = n;
@@ -383,10 +379,7 @@ macro_rules! bank_ctor {
                 substeps: Substeps,
                 max: f64,
             ) -> Result<Self, Error> {
-                let o = match build_f64(&period, &damping, h, scheme, substeps, max) {
-                    Ok(o) => o,
-                    Err(e) => return Err(e),
-                };
+                let o = const_try!(build_f64(&period, &damping, h, scheme, substeps, max));
                 let mut b = Bank {
                     su: [[0.0; P]; 4],
                     sv: [[0.0; P]; 4],

@@ -98,6 +98,7 @@
 use super::Substeps;
 use super::bank::{Oscillator, check_interval, oscillator};
 use crate::linalg::all_fit;
+use crate::macros::const_try;
 use crate::{Error, Param, Real};
 
 /// A bank of `P` yielding single-degree-of-freedom oscillators (bilinear, kinematic
@@ -159,9 +160,7 @@ const fn coeffs<const P: usize>(
     rule: Substeps,
     max: f64,
 ) -> Result<Coeffs<P>, Error> {
-    if let Err(e) = check_interval(h, rule) {
-        return Err(e);
-    }
+    const_try!(check_interval(h, rule));
     let mut out = Coeffs {
         c: [[0.0; P]; 9],
         n: [1; P],
@@ -170,10 +169,7 @@ const fn coeffs<const P: usize>(
     let mut fits = true;
     let mut p = 0;
     while p < P {
-        let Oscillator { w, z, n, hs } = match oscillator(period, damping, p, h, rule) {
-            Ok(o) => o,
-            Err(e) => return Err(e),
-        };
+        let Oscillator { w, z, n, hs } = const_try!(oscillator(period, damping, p, h, rule));
         let w2 = w * w;
         let kappa = 4.0 / (hs * hs) + 4.0 * z * w / hs;
         let aw2 = alpha * w2;
@@ -233,10 +229,14 @@ macro_rules! yielding_ctor {
                 h: f64,
                 substeps: Substeps,
             ) -> Result<Self, Error> {
-                let o = match coeffs(&period, &damping, alpha, h, substeps, $t::MAX as f64) {
-                    Ok(o) => o,
-                    Err(e) => return Err(e),
-                };
+                let o = const_try!(coeffs(
+                    &period,
+                    &damping,
+                    alpha,
+                    h,
+                    substeps,
+                    $t::MAX as f64
+                ));
                 let mut c = [[0.0 as $t; P]; 9];
                 let mut k = 0;
                 while k < 9 {
