@@ -11,6 +11,8 @@ Usage (from anywhere; paths are relative to the repository root):
   python3 scripts/check_docs.py --quotes   only check the quotes (scripts/qemu.sh, after it
                                            rewrote docs/cortex-m4-cost.md)
   python3 scripts/check_docs.py --self-test  show that a perturbed number fails the check
+  python3 scripts/check_docs.py --page docs/layout.md   only regenerate and compare that
+                                           generated page (with --write: only write it)
 
 Three kinds of page:
 
@@ -124,6 +126,8 @@ GENERATED = {
     # 72 yielding-building runs of the whole record (about 670 000 steps) and 3
     # constant-ductility spectra of 60 periods: about 2 s (release).
     "docs/ida.md": dict(cmd=example("ida", "{dir}"), out="file"),
+    # The families, their files and the cores they stand on, read from src/ (under a second).
+    "docs/layout.md": dict(cmd=["python3", "scripts/layout.py"], out="stdout"),
 }
 # Generated in place by a slower stage of the test command: compared with the git index.
 IN_PLACE = {
@@ -460,9 +464,11 @@ def refresh_quotes(old_pages):
             print(f"  {page}: {changed} quoted line(s) updated")
 
 
-def write():
+def write(only=None):
     old = {p: committed(p) for p in list(GENERATED) + list(IN_PLACE)}
     for path, spec in GENERATED.items():
+        if only is not None and path not in only:
+            continue
         outdir = os.path.join(ROOT, os.path.dirname(path))
         text = run_generator(path, spec, outdir)
         with open(os.path.join(ROOT, path), "w", encoding="utf-8") as f:
@@ -578,8 +584,21 @@ def main(argv):
     if "--self-test" in argv:
         self_test()
         return
+    only = None
+    if "--page" in argv:
+        i = argv.index("--page")
+        if i + 1 >= len(argv) or argv[i + 1] not in GENERATED:
+            raise SystemExit(f"--page needs one of: {', '.join(GENERATED)}")
+        only = [argv[i + 1]]
     if "--write" in argv:
-        write()
+        write(only)
+        return
+    if only is not None:
+        errs = check_generated(only=only)
+        if errs:
+            print("\n".join(errs), file=sys.stderr)
+            raise SystemExit(f"FAILED: {len(errs)} docs check(s) ({only[0]})")
+        print(f"docs: {only[0]} matches its generator")
         return
     if "--refresh-quotes" in argv:
         refresh_quotes({p: committed(p) for p in list(GENERATED) + list(IN_PLACE)})

@@ -389,7 +389,15 @@ struct Progress<'a> {
     report: Option<&'a (dyn Fn(usize, usize) + Sync)>,
 }
 
-impl Progress<'_> {
+impl<'a> Progress<'a> {
+    /// No run done yet, of `total`; `report(done, total)` is called by [`Progress::add`].
+    fn new(total: usize, report: Option<&'a (dyn Fn(usize, usize) + Sync)>) -> Self {
+        Progress {
+            done: AtomicUsize::new(0),
+            total,
+            report,
+        }
+    }
     fn add(&self, k: usize) {
         if let (Some(f), true) = (self.report, k > 0) {
             f(self.done.fetch_add(k, Ordering::Relaxed) + k, self.total);
@@ -422,11 +430,7 @@ where
     F: Fn(&R, f64) -> Result<f64, Error> + Sync + Send,
 {
     settings.check()?;
-    let p = Progress {
-        done: AtomicUsize::new(0),
-        total: records.len().saturating_mul(settings.runs),
-        report: progress,
-    };
+    let p = Progress::new(records.len().saturating_mul(settings.runs), progress);
     let out = crate::batch::map(records, threads, |r| {
         let used = AtomicUsize::new(0);
         let curve = trace_with(r, settings, &analysis, &|| {
@@ -472,11 +476,7 @@ where
     let jobs: Vec<(usize, f64)> = (0..records.len())
         .flat_map(|r| intensities.iter().map(move |&im| (r, im)))
         .collect();
-    let p = Progress {
-        done: AtomicUsize::new(0),
-        total: jobs.len(),
-        report: progress,
-    };
+    let p = Progress::new(jobs.len(), progress);
     let runs = crate::batch::map(&jobs, threads, |&(r, im)| {
         let out = run(&records[r], im, collapse, &analysis);
         p.add(1);

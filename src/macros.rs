@@ -1,4 +1,5 @@
-//! `matrix!` and `vector!`: nalgebra's literal syntax, through `aemstep` alone.
+//! `matrix!` and `vector!`: nalgebra's literal syntax, through `aemstep` alone; and the
+//! crate-private `const_try!`, `?` for the `const fn` constructors.
 //!
 //! nalgebra's own `matrix!`/`vector!` (re-exported as `aemstep::nalgebra::{matrix, vector}`)
 //! expand to paths that start with `nalgebra::`, so they compile only in a crate that also
@@ -52,6 +53,20 @@ macro_rules! vector {
         ))
     };
 }
+
+/// `?` for a `const fn`: the value of an `Ok`, or `return Err(e)` from the enclosing
+/// function (`?` itself calls a trait method, not allowed in a `const fn`). The one
+/// spelling of the `match … { Ok(v) => v, Err(e) => return Err(e) }` that the `const`
+/// constructors (`_f32`/`_f64` twins) write around every fallible call. Cost: none.
+macro_rules! const_try {
+    ($result:expr) => {
+        match $result {
+            Ok(value) => value,
+            Err(e) => return Err(e),
+        }
+    };
+}
+pub(crate) use const_try;
 
 /// The columns of a matrix given by its rows (`out[j][i] = rows[i][j]`): nalgebra stores
 /// matrices column by column. Used by [`matrix!`]; not part of the API.

@@ -1,6 +1,6 @@
 //! Bilinear elastic–plastic law with linear kinematic hardening, by return mapping.
 
-use super::{Law, LawTrial, check_elastic_plastic, fits};
+use super::{Law, LawTrial, check_elastic_plastic, rounded};
 use crate::{Error, Real};
 
 /// Bilinear hysteresis with linear kinematic hardening: elastic stiffness `k`, yield force
@@ -76,23 +76,21 @@ impl<T: Real> Bilinear<T> {
     /// `k > f32::MAX` in `f32`). Cost: O(1).
     pub fn new(k: f64, fy: f64, alpha: f64) -> Result<Self, Error> {
         check_elastic_plastic(k, fy, alpha)?;
-        let c = [
+        let [k, fy, hard, one_minus_alpha, compliance_p, kt] = rounded::<T, 6>([
             k,
             fy,
             alpha * k / (1.0 - alpha),
             1.0 - alpha,
             (1.0 - alpha) / k,
             alpha * k,
-        ];
-        fits::<T>(&c)?;
-        let r = T::from_f64_rounded;
+        ])?;
         Ok(Self {
-            k: r(c[0]),
-            fy: r(c[1]),
-            hard: r(c[2]),
-            one_minus_alpha: r(c[3]),
-            compliance_p: r(c[4]),
-            kt: r(c[5]),
+            k,
+            fy,
+            hard,
+            one_minus_alpha,
+            compliance_p,
+            kt,
         })
     }
 

@@ -3,7 +3,7 @@
 
 use nalgebra::ComplexField;
 
-use super::{Law, LawTrial, check_elastic_plastic, fits, positive};
+use super::{Law, LawTrial, check_elastic_plastic, fits, positive, rounded};
 use crate::{Error, Param, Real};
 
 /// Iterations allowed for the internal variable of one trial: Newton, with bisection steps
@@ -165,7 +165,7 @@ impl<T: Real> BoucWen<T> {
         } else {
             0.5
         };
-        let c = [
+        let c = rounded::<T, 9>([
             alpha * k,
             (1.0 - alpha) * fy,
             (1.0 - alpha) * k,
@@ -175,8 +175,7 @@ impl<T: Real> BoucWen<T> {
             (half * beta + half * gamma) / m,
             (half * gamma - half * beta) / m,
             n,
-        ];
-        fits::<T>(&c)?;
+        ])?;
         // The largest hysteretic force the law can produce, `(1 − α) f_y |z|` with `|z|`
         // within `2^{1/n} z_max` (β + γ > 0; for γ = −β, `z` does not saturate and the
         // stepper reports the force that leaves `T`): it must fit `T` too, else a step
@@ -200,17 +199,16 @@ impl<T: Real> BoucWen<T> {
             f64::MIN_POSITIVE
         };
         let z_scale = T::from_f64_rounded(z_max.min(1.0).max(floor));
-        let r = T::from_f64_rounded;
         Ok(Self {
-            ak: r(c[0]),
-            cz: r(c[1]),
-            ck: r(c[2]),
-            inv_uy: r(c[3]),
-            half_inv_uy: r(c[4]),
-            kappa: r(c[5]),
-            sigma_load: r(c[6]),
-            sigma_unload: r(c[7]),
-            n: r(c[8]),
+            ak: c[0],
+            cz: c[1],
+            ck: c[2],
+            inv_uy: c[3],
+            half_inv_uy: c[4],
+            kappa: c[5],
+            sigma_load: c[6],
+            sigma_unload: c[7],
+            n: c[8],
             split_at_zero: gamma < beta,
             n_kind: if n == 1.0 {
                 1

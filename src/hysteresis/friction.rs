@@ -1,6 +1,6 @@
 //! Coulomb friction regularized in the velocity.
 
-use super::{Law, LawTrial, fits, positive};
+use super::{Law, LawTrial, positive, rounded};
 use crate::{Error, Param, Real};
 
 /// A friction device: Coulomb friction of slip force `f_s`, regularized in the velocity,
@@ -42,12 +42,8 @@ impl<T: Real> Friction<T> {
         }
         // `f_s / v_r` too: the trial's damping `(f_s / v_r)(1 − tanh²)` was `∞ · 0 = NaN`
         // with `v_r = 1.25e-308` (found by fuzzing).
-        fits::<T>(&[fs, 1.0 / vr, vr, fs / vr])?;
-        Ok(Self {
-            fs: T::from_f64_rounded(fs),
-            inv_vr: T::from_f64_rounded(1.0 / vr),
-            vr: T::from_f64_rounded(vr),
-        })
+        let [fs, inv_vr, vr, _] = rounded::<T, 4>([fs, 1.0 / vr, vr, fs / vr])?;
+        Ok(Self { fs, inv_vr, vr })
     }
 
     /// The slip force `f_s` (force). Cost: O(1).

@@ -213,3 +213,13 @@ pub(crate) fn fits<T: Real>(xs: &[f64]) -> Result<(), crate::Error> {
         Err(crate::Error::OperatorOverflow)
     }
 }
+
+/// The coefficients `c` of a law, computed in `f64`, checked to fit `T` ([`fits`]) and each
+/// rounded once to `T`: the laws' constructors store these. Cost: `K` comparisons and
+/// roundings.
+///
+/// Errors: [`Error::OperatorOverflow`](crate::Error::OperatorOverflow).
+pub(crate) fn rounded<T: Real, const K: usize>(c: [f64; K]) -> Result<[T; K], crate::Error> {
+    fits::<T>(&c)?;
+    Ok(c.map(T::from_f64_rounded))
+}

@@ -3,6 +3,7 @@
 use super::operators::{self, SdofOps};
 use super::{MAX_SUBSTEPS, Scheme, Substeps};
 use crate::linalg::{all_fit, fits_value};
+use crate::macros::const_try;
 use crate::{Error, Param, Real};
 use core::f64::consts::TAU;
 
@@ -96,6 +97,65 @@ pub(super) const fn substeps_for(rule: Substeps, h: f64, t: f64) -> u16 {
     }
 }
 
+/// The sample interval `h` (s, finite, `> 0`: else [`Error::InvalidTimeStep`]) and the
+/// sub-step rule ([`Error::InvalidParameter`] for `Fixed(0)`, `Fixed(n > MAX_SUBSTEPS)`,
+/// `PointsPerPeriod(0)`), checked in that order: the first checks of both banks (the
+/// elastic [`Bank`] and the yielding [`Yielding`](super::inelastic::Yielding)).
+pub(super) const fn check_interval(h: f64, rule: Substeps) -> Result<(), Error> {
+    if !(h.is_finite() && h > 0.0) {
+        return Err(Error::InvalidTimeStep);
+    }
+    match rule {
+        Substeps::Fixed(n) if n == 0 || n > MAX_SUBSTEPS => {
+            Err(Error::InvalidParameter(Param::Substeps))
+        }
+        Substeps::PointsPerPeriod(0) => Err(Error::InvalidParameter(Param::Substeps)),
+        _ => Ok(()),
+    }
+}
+
+/// One oscillator of a bank, set up from its period and damping ratio.
+pub(super) struct Oscillator {
+    /// `ω = 2π/T` (1/s).
+    pub w: f64,
+    /// Damping ratio `ζ`, as given.
+    pub z: f64,
+    /// Sub-steps per sample `n`.
+    pub n: u16,
+    /// Sub-step `h/n` (s).
+    pub hs: f64,
+}
+
+/// Oscillator `p`'s set-up, shared by both banks: its period checked (finite, at least
+/// `1e-150` — periods so short that `ω²` overflows are rejected with the non-positive
+/// ones — and not below the previous one: else [`Error::InvalidPeriod`]), then its damping
+/// ratio (in `[0, 1)`: else [`Error::InvalidDamping`]); `ω = 2π/T`, `n` by
+/// [`substeps_for`], `h/n`. `h` and `rule` checked by [`check_interval`]. Cost: a few
+/// flops.
+pub(super) const fn oscillator<const P: usize>(
+    period: &[f64; P],
+    damping: &[f64; P],
+    p: usize,
+    h: f64,
+    rule: Substeps,
+) -> Result<Oscillator, Error> {
+    let t = period[p];
+    let z = damping[p];
+    if !(t.is_finite() && t >= 1e-150) || (p > 0 && t < period[p - 1]) {
+        return Err(Error::InvalidPeriod);
+    }
+    if !(z >= 0.0 && z < 1.0) {
+        return Err(Error::InvalidDamping);
+    }
+    let n = substeps_for(rule, h, t);
+    Ok(Oscillator {
+        w: TAU / t,
+        z,
+        n,
+        hs: h / n as f64,
+    })
+}
+
 /// The homogeneous part of a map is bounded as a damped oscillator's must be: the energy
 /// `(ω²u² + v²)/2` never grows, so `|uu|, |vv|, ω|uv|, |vu|/ω ≤ 1` (exactly for both
 /// schemes; here within `1e-6`). The exact scheme's matrix exponential loses that, and all
@@ -151,17 +211,7 @@ pub(super) const fn build_f64<const P: usize>(
     rule: Substeps,
     max: f64,
 ) -> Result<OpsF64<P>, Error> {
-    if !(h.is_finite() && h > 0.0) {
-        return Err(Error::InvalidTimeStep);
-    }
-    if let Substeps::Fixed(n) = rule
-        && (n == 0 || n > MAX_SUBSTEPS)
-    {
-        return Err(Error::InvalidParameter(Param::Substeps));
-    }
-    if let Substeps::PointsPerPeriod(0) = rule {
-        return Err(Error::InvalidParameter(Param::Substeps));
-    }
+    const_try!(check_interval(h, rule));
     let zero = SdofOps {
         uu: 0.0,
         uv: 0.0,
@@ -183,18 +233,7 @@ pub(super) const fn build_f64<const P: usize>(
     let mut fits_all = true;
     let mut p = 0;
     while p < P {
-        let t = period[p];
-        let z = damping[p];
-        // Periods so short that ω² overflows are rejected with the non-positive ones.
-        if !(t.is_finite() && t >= 1e-150) || (p > 0 && t < period[p - 1]) {
-            return Err(Error::InvalidPeriod);
-        }
-        if !(z >= 0.0 && z < 1.0) {
-            return Err(Error::InvalidDamping);
-        }
-        let w = TAU / t;
-        let n = substeps_for(rule, h, t);
-        let hs = h / n as f64;
+        let Oscillator { w, z, n, hs } = const_try!(oscillator(period, damping, p, h, rule));
         out.w2[p] = w * w;
         out.c2[p] = 2.0 * z * w;
         out.n[p] = n;
@@ -340,10 +379,7 @@ macro_rules! bank_ctor {
                 substeps: Substeps,
                 max: f64,
             ) -> Result<Self, Error> {
-                let o = match build_f64(&period, &damping, h, scheme, substeps, max) {
-                    Ok(o) => o,
-                    Err(e) => return Err(e),
-                };
+                let o = const_try!(build_f64(&period, &damping, h, scheme, substeps, max));
                 let mut b = Bank {
                     su: [[0.0; P]; 4],
                     sv: [[0.0; P]; 4],
@@ -615,6 +651,15 @@ impl<T: Real, const P: usize> Bank<T, P> {
     /// ```
     pub fn response(&self, record: &[T]) -> Result<Response<T, P>, Error> {
         let tail = super::checked_tail(&self.period, self.time_step)?;
+        self.record_pass(record, tail)
+    }
+
+    /// From rest, every sample of `record` stepped unchecked, then `tail` samples of free
+    /// vibration, the response checked once at the end (see [`Bank::response`]): the pass
+    /// of [`Bank::response`] and of the host batch.
+    ///
+    /// Errors: [`Error::NonFiniteState`]. Cost: `N + tail` steps, one scan.
+    pub(super) fn record_pass(&self, record: &[T], tail: u32) -> Result<Response<T, P>, Error> {
         let mut r = Response::rest();
         for &a in record {
             self.step(&mut r, a);

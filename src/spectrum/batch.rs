@@ -32,17 +32,8 @@ where
     Response<T, P>: Send,
     Bank<T, P>: Sync,
 {
+    // Checked once at the end (see `Bank::response`: an overflow stays non-finite).
     crate::batch::map(records, threads, |record| {
-        let mut r = Response::rest();
-        for &a in *record {
-            bank.step(&mut r, a);
-        }
-        bank.free_vibration(&mut r, free_vibration);
-        // Checked once at the end (see `Bank::response`: an overflow stays non-finite).
-        if r.is_finite() {
-            Ok(r)
-        } else {
-            Err(Error::NonFiniteState)
-        }
+        bank.record_pass(record, free_vibration)
     })
 }

@@ -95,11 +95,11 @@
 //! [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES) is
 //! [`Error::InvalidTimeStep`].
 
-use super::bank::substeps_for;
-use super::{MAX_SUBSTEPS, Substeps};
+use super::Substeps;
+use super::bank::{Oscillator, check_interval, oscillator};
 use crate::linalg::all_fit;
+use crate::macros::const_try;
 use crate::{Error, Param, Real};
-use core::f64::consts::TAU;
 
 /// A bank of `P` yielding single-degree-of-freedom oscillators (bilinear, kinematic
 /// hardening, post-yield ratio `α` shared by the bank; see the [module](self)), fed one
@@ -160,16 +160,7 @@ const fn coeffs<const P: usize>(
     rule: Substeps,
     max: f64,
 ) -> Result<Coeffs<P>, Error> {
-    if !(h.is_finite() && h > 0.0) {
-        return Err(Error::InvalidTimeStep);
-    }
-    match rule {
-        Substeps::Fixed(n) if n == 0 || n > MAX_SUBSTEPS => {
-            return Err(Error::InvalidParameter(Param::Substeps));
-        }
-        Substeps::PointsPerPeriod(0) => return Err(Error::InvalidParameter(Param::Substeps)),
-        _ => {}
-    }
+    const_try!(check_interval(h, rule));
     let mut out = Coeffs {
         c: [[0.0; P]; 9],
         n: [1; P],
@@ -178,18 +169,8 @@ const fn coeffs<const P: usize>(
     let mut fits = true;
     let mut p = 0;
     while p < P {
-        let t = period[p];
-        let z = damping[p];
-        if !(t.is_finite() && t >= 1e-150) || (p > 0 && t < period[p - 1]) {
-            return Err(Error::InvalidPeriod);
-        }
-        if !(z >= 0.0 && z < 1.0) {
-            return Err(Error::InvalidDamping);
-        }
-        let w = TAU / t;
+        let Oscillator { w, z, n, hs } = const_try!(oscillator(period, damping, p, h, rule));
         let w2 = w * w;
-        let n = substeps_for(rule, h, t);
-        let hs = h / n as f64;
         let kappa = 4.0 / (hs * hs) + 4.0 * z * w / hs;
         let aw2 = alpha * w2;
         let row = [
@@ -248,10 +229,14 @@ macro_rules! yielding_ctor {
                 h: f64,
                 substeps: Substeps,
             ) -> Result<Self, Error> {
-                let o = match coeffs(&period, &damping, alpha, h, substeps, $t::MAX as f64) {
-                    Ok(o) => o,
-                    Err(e) => return Err(e),
-                };
+                let o = const_try!(coeffs(
+                    &period,
+                    &damping,
+                    alpha,
+                    h,
+                    substeps,
+                    $t::MAX as f64
+                ));
                 let mut c = [[0.0 as $t; P]; 9];
                 let mut k = 0;
                 while k < 9 {
