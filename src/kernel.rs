@@ -139,6 +139,43 @@ macro_rules! const_kernel {
 const_kernel!(f32);
 const_kernel!(f64);
 
+/// The `const fn` twins `from_rows_f32` / `from_rows_f64` and the `const` `time_step` of a
+/// scheme stored as `{ kernel: Kernel<T, N, AemKinematics<T>> }`
+/// ([`Linear`](crate::Linear), [`CompensatedLinear`](crate::CompensatedLinear)): one
+/// build, [`Kernel::from_rows_aem`], behind both scalars and both schemes; each scheme
+/// passes the docs of its `from_rows_*`.
+macro_rules! aem_const_ctors {
+    ($scheme:ident, $(#[$doc:meta])*) => {
+        $crate::kernel::aem_const_ctors!(@one $scheme, f32, from_rows_f32, $(#[$doc])*);
+        $crate::kernel::aem_const_ctors!(@one $scheme, f64, from_rows_f64, $(#[$doc])*);
+    };
+    (@one $scheme:ident, $t:ident, $from_rows:ident, $(#[$doc:meta])*) => {
+        impl<const N: usize> $scheme<$t, N> {
+            $(#[$doc])*
+            pub const fn $from_rows(
+                m: $crate::linalg::Rows<N>,
+                c: $crate::linalg::Rows<N>,
+                k: $crate::linalg::Rows<N>,
+                h: f64,
+            ) -> Result<Self, $crate::Error> {
+                type K<T> = $crate::kinematics::AemKinematics<T>;
+                match $crate::kernel::Kernel::<$t, N, K<$t>>::from_rows_aem(&m, &c, &k, h) {
+                    Ok(kernel) => Ok(Self { kernel }),
+                    Err(e) => Err(e),
+                }
+            }
+
+            /// The time step `h` (s), usable in `const` contexts: the same value as
+            /// [`Stepper::time_step`](crate::Stepper::time_step), which generic code (`S:
+            /// Stepper<T, N>`) still calls. Cost: none.
+            pub const fn time_step(&self) -> $t {
+                self.kernel.kin.h
+            }
+        }
+    };
+}
+pub(crate) use aem_const_ctors;
+
 /// `impl Stepper` for a scheme stored as `{ kernel: Kernel<T, N, K> }`
 /// ([`Linear`](crate::Linear), [`Newmark`](crate::Newmark)).
 macro_rules! kernel_stepper {
