@@ -82,7 +82,9 @@ impl<T: Real, const N: usize, K> Kernel<T, N, K> {
 }
 
 /// `Kernel::<f32, N, AemKinematics<f32>>::from_ops` (and `f64`): the `const` twin of
-/// [`KernelOps::round_aem`], for the `const fn` constructors (bit-identical to it).
+/// [`KernelOps::round_aem`], for the `const fn` constructors (bit-identical to it); and
+/// the `const` twin, per scalar, of the start-up rounding every scheme's `const fn` shares
+/// (`StartOps::rounded`).
 macro_rules! const_kernel {
     ($t:ident) => {
         impl<const N: usize> Kernel<$t, N, AemKinematics<$t>> {
@@ -123,14 +125,22 @@ macro_rules! const_kernel {
                     ops: OpRows::new(ops),
                     kin: crate::linalg::const_round!($t, kin op.aem),
                     start: match &op.start {
-                        Some((_, s)) => Some(StartOps {
-                            minv: crate::linalg::const_round!($t, rows s.minv),
-                            minv_c: crate::linalg::const_round!($t, rows s.minv_c),
-                            minv_k: crate::linalg::const_round!($t, rows s.minv_k),
-                        }),
+                        Some((_, s)) => Some(StartOps::<$t, N>::rounded(s)),
                         None => None,
                     },
                     condition: op.condition,
+                }
+            }
+        }
+
+        impl<const N: usize> StartOps<$t, N> {
+            /// The `const` twin of [`StartOps::round`]: each operator rounded once to the
+            /// scalar (bit-identical to it). Cost: `3N²` conversions.
+            pub(crate) const fn rounded(s: &StartOps<f64, N>) -> Self {
+                Self {
+                    minv: crate::linalg::const_round!($t, rows s.minv),
+                    minv_c: crate::linalg::const_round!($t, rows s.minv_c),
+                    minv_k: crate::linalg::const_round!($t, rows s.minv_k),
                 }
             }
         }

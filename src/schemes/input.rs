@@ -219,11 +219,7 @@ macro_rules! const_ctor {
                     start: match op.start {
                         Some((mb, s)) => Some(InputStart {
                             minv_b: linalg::const_round!($t, rows mb),
-                            ops: StartOps {
-                                minv: linalg::const_round!($t, rows s.minv),
-                                minv_c: linalg::const_round!($t, rows s.minv_c),
-                                minv_k: linalg::const_round!($t, rows s.minv_k),
-                            },
+                            ops: StartOps::<$t, N>::rounded(&s),
                         }),
                         None => None,
                     },

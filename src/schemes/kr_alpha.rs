@@ -494,11 +494,7 @@ macro_rules! const_ctor {
                     gc: crate::linalg::const_round!($t, rows op.gc),
                     gk: crate::linalg::const_round!($t, rows op.gk),
                     gma3: crate::linalg::const_round!($t, rows op.gma3),
-                    start: Some(StartOps {
-                        minv: crate::linalg::const_round!($t, rows s.minv),
-                        minv_c: crate::linalg::const_round!($t, rows s.minv_c),
-                        minv_k: crate::linalg::const_round!($t, rows s.minv_k),
-                    }),
+                    start: Some(StartOps::<$t, N>::rounded(s)),
                 })
             }
 
