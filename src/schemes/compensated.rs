@@ -108,9 +108,7 @@ impl<T: Real, const N: usize> CompensatedLinear<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        Ok(Self {
-            kernel: Kernel::aem(m, c, k, h)?,
-        })
+        Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
     }
 
     /// `κ₁` of the row-equilibrated effective matrix, as

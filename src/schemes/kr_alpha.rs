@@ -305,7 +305,7 @@ impl<T: Real, const N: usize> KrAlpha<T, N> {
         h: f64,
         rho_inf: f64,
     ) -> Result<Self, Error> {
-        Self::build(m, c, k, h, AlphaParameters::chung_hulbert(rho_inf)?)
+        Self::with_rest(m, c, k, k, h, AlphaParameters::chung_hulbert(rho_inf)?)
     }
 
     /// The Chen–Ricles algorithm (`α_m = α_f = 0`, `γ = 1/2`, `β = 1/4`: the equation of
@@ -318,25 +318,30 @@ impl<T: Real, const N: usize> KrAlpha<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        Self::build(m, c, k, h, CHEN_RICLES)
+        Self::with_rest(m, c, k, k, h, CHEN_RICLES)
     }
 
-    fn build(
+    /// The operators of `p` with `k_rest` for the computed restoring force
+    /// ([`kr_operators`]; `k` for [`KrAlpha`], the numerical part for
+    /// [`Split`](crate::hybrid::Split)), rounded once to `T`: the run-time twin of
+    /// `from_params`.
+    pub(crate) fn with_rest(
         m: &SMatrix<f64, N, N>,
         c: &SMatrix<f64, N, N>,
         k: &SMatrix<f64, N, N>,
+        k_rest: &SMatrix<f64, N, N>,
         h: f64,
         p: AlphaParameters,
     ) -> Result<Self, Error> {
-        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+        let (m, c, k, kr) = (rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(k_rest));
         Ok(Self::from_ops(
-            &kr_operators(&m, &c, &k, &k, h, &p, T::MAX)?,
+            &kr_operators(&m, &c, &k, &kr, h, &p, T::MAX)?,
             p,
         ))
     }
 
     /// Round the `f64` operators once to `T` (run time).
-    pub(crate) fn from_ops(op: &KrOps<N>, p: AlphaParameters) -> Self {
+    fn from_ops(op: &KrOps<N>, p: AlphaParameters) -> Self {
         Self {
             params: p,
             h: T::from_f64_rounded(op.h),

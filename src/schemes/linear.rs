@@ -73,9 +73,7 @@ impl<T: Real, const N: usize> Linear<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        Ok(Self {
-            kernel: Kernel::aem(m, c, k, h)?,
-        })
+        Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
     }
 
     /// `G = (M + (h/2) C + (h²/4) K)⁻¹`.
