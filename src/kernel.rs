@@ -534,6 +534,37 @@ pub(crate) const fn newmark_operators<const N: usize>(
     })
 }
 
+/// [`newmark_operators`] for a load `p = B w` entering through `B` (`N×I`): `B` checked
+/// first ([`Error::NonFiniteInput`]), then the kernel's operators, with `G B` (a solve
+/// with `M_eff`) and, when `M` is regular, `M⁻¹ B` (a solve with `M`). The one build
+/// behind [`LinearInput`](crate::LinearInput) and the Newmark state-space form. Errors:
+/// those of [`newmark_operators`], after `B`'s.
+#[allow(clippy::too_many_arguments)] // newmark_operators' arguments, plus B
+pub(crate) const fn input_kernel_operators<const N: usize, const I: usize>(
+    m: &Mat<N, N>,
+    c: &Mat<N, N>,
+    k: &Mat<N, N>,
+    b: &Mat<N, I>,
+    h: f64,
+    beta: f64,
+    gamma: f64,
+    max: f64,
+) -> Result<(KernelOps<N>, Mat<N, I>, Option<Mat<N, I>>), Error> {
+    if !all_finite(b) {
+        return Err(Error::NonFiniteInput);
+    }
+    let op = match newmark_operators(m, c, k, h, beta, gamma, max) {
+        Ok(op) => op,
+        Err(e) => return Err(e),
+    };
+    let gb = op.lu.solve(b);
+    let minv_b = match &op.start {
+        Some((lu, _)) => Some(lu.solve(b)),
+        None => None,
+    };
+    Ok((op, gb, minv_b))
+}
+
 /// `M, C, K` as row-major `f64`, checked finite ([`Error::NonFiniteInput`]): the data
 /// check of the schemes built outside [`newmark_operators`].
 pub(crate) fn checked_rows<const N: usize>(

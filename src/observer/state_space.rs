@@ -44,7 +44,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, checked_rows, newmark_operators, start_operators};
+use crate::kernel::{StartOps, checked_rows, input_kernel_operators, start_operators};
 use crate::kinematics::check_time_step_as;
 use crate::linalg::lu::{Lu, row_scales};
 use crate::linalg::{
@@ -231,8 +231,9 @@ const fn axpy<const R: usize, const C: usize>(a: &Mat<R, C>, s: f64, b: &Mat<R, 
 }
 
 /// The Newmark step (β, γ) as blocks (see the module docs): factorizations of `M` and
-/// `M_eff = M + γh C + βh² K`, solves. The checks of [`newmark_operators`] (the
-/// steppers'), after `B`'s.
+/// `M_eff = M + γh C + βh² K`, solves. The checks of
+/// [`newmark_operators`](crate::kernel::newmark_operators) (the steppers'), after `B`'s
+/// ([`input_kernel_operators`], as [`LinearInput`](crate::LinearInput)'s).
 const fn newmark_blocks<const N: usize, const I: usize>(
     m: &Rows<N>,
     c: &Rows<N>,
@@ -242,16 +243,13 @@ const fn newmark_blocks<const N: usize, const I: usize>(
     beta: f64,
     gamma: f64,
 ) -> Result<NewmarkBlocks<N, I>, Error> {
-    if !all_finite(b) {
-        return Err(Error::NonFiniteInput);
-    }
-    let op = match newmark_operators(m, c, k, h, beta, gamma, f64::MAX) {
-        Ok(op) => op,
+    let (op, gb, minv_b) = match input_kernel_operators(m, c, k, b, h, beta, gamma, f64::MAX) {
+        Ok(ops) => ops,
         Err(e) => return Err(e),
     };
-    let (lu_m, st) = match op.start {
-        Some(s) => s,
-        None => return Err(Error::SingularMass),
+    let (aw, st) = match (minv_b, op.start) {
+        (Some(aw), Some((_, st))) => (aw, st),
+        _ => return Err(Error::SingularMass),
     };
     let kin = op.kin;
     let zero_i = [[0.0; I]; N];
@@ -259,7 +257,6 @@ const fn newmark_blocks<const N: usize, const I: usize>(
     // The equation of motion: a = −M⁻¹K u − M⁻¹C v + M⁻¹B w.
     let au = scaled(-1.0, &st.minv_k);
     let av = scaled(-1.0, &st.minv_c);
-    let aw = lu_m.solve(b);
     // Predictor: v̂ = v + c_v a, û = u + h v̂ − c_u a.
     let vh_u = scaled(kin.c_v, &au);
     let vh_v = axpy(&id, kin.c_v, &av);
@@ -275,7 +272,7 @@ const fn newmark_blocks<const N: usize, const I: usize>(
         op.lu.solve(&rhs_u),
         op.lu.solve(&rhs_v),
         op.lu.solve(&rhs_w),
-        op.lu.solve(b),
+        gb,
     );
     // Corrector: u_n = û + β h² q, v_n = v̂ + γ h q.
     let (bh2, gh) = (kin.beta_h2, kin.gamma_h);
