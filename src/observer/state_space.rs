@@ -44,15 +44,14 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, checked_rows, input_kernel_operators, start_operators};
-use crate::kinematics::check_time_step_as;
+use crate::kernel::{StartOps, input_kernel_operators, start_operators};
 use crate::linalg::lu::{Lu, row_scales};
 use crate::linalg::{
     Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled, transpose,
 };
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
-use crate::schemes::exponential_blocks;
+use crate::schemes::{Exponential, exponential};
 use crate::{AlphaParameters, Error, Exact};
 
 /// The discrete state-space model of a linear scheme with `N` degrees of freedom, state
@@ -686,13 +685,14 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     ) -> Result<Self, Error> {
         let bb = rows_f64(b);
         Self::check_input(2 * N, &bb)?;
-        let (mm, cc, kk) = checked_rows(m, c, k)?;
-        let hf = check_time_step_as(h, f64::MAX)?;
-        let (lu_m, st) = start_operators(&mm, &cc, &kk, f64::MAX)?.ok_or(Error::SingularMass)?;
-        let (mi, mic, mik) = (&st.minv, &st.minv_c, &st.minv_k);
         // Φ and Γ₁ᵉ = ∫₀ʰ e^{F s} ds [0; M⁻¹] of the exponential `Exact` reads.
-        let [[phi_uu, phi_uv, gu, _], [phi_vu, phi_vv, gv, _]] =
-            exponential_blocks(mi, mic, mik, hf);
+        let Exponential {
+            h: hf,
+            lu_m,
+            start: st,
+            blocks: [[phi_uu, phi_uv, gu, _], [phi_vu, phi_vv, gv, _]],
+            ..
+        } = exponential(m, c, k, h, f64::MAX)?;
         let phi = [[&phi_uu, &phi_uv], [&phi_vu, &phi_vv]];
         let gamma0 = [&mul(&gu, &bb), &mul(&gv, &bb)];
         let zero = [[0.0; I]; N];
