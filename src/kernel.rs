@@ -464,6 +464,32 @@ pub(crate) const fn terms_scales<const N: usize>(
     s
 }
 
+/// The effective matrix `M_eff = M + wc C + wk K` of an implicit scheme (`m` already
+/// weighted where the scheme weights it), checked finite, with the row scales of its terms
+/// ([`terms_scales`]) and its factorization: the one effective-matrix build of the Newmark
+/// family, generalized-α and KR-α (`const fn`).
+///
+/// Errors: [`Error::OperatorOverflow`] (`M_eff` not finite),
+/// [`Error::SingularEffectiveMatrix`] (singular to working precision against its terms).
+/// Cost: `N³/3` flops for the LU and `O(N²)`.
+pub(crate) const fn effective_lu<const N: usize>(
+    m: &Mat<N, N>,
+    c: &Mat<N, N>,
+    k: &Mat<N, N>,
+    wc: f64,
+    wk: f64,
+) -> Result<(Mat<N, N>, [f64; N], Lu<N>), Error> {
+    let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
+    if !all_finite(&meff) {
+        return Err(Error::OperatorOverflow);
+    }
+    let scales = terms_scales(m, c, k, wc, wk);
+    match Lu::new(&meff, &scales) {
+        Some(lu) => Ok((meff, scales, lu)),
+        None => Err(Error::SingularEffectiveMatrix),
+    }
+}
+
 /// Check `M, C, K, h, β, γ` and build the kernel's operators by factorizing `M_eff` and
 /// solving (paper eqs. 19–23 in eliminated form for β = 1/4, γ = 1/2). `max`: the
 /// largest finite value of the scalar type the operators will be rounded to.
@@ -499,15 +525,9 @@ pub(crate) const fn newmark_operators<const N: usize>(
     if let Err(e) = check_time_step_as(h, max) {
         return Err(e);
     }
-    let (wc, wk) = (kin.gamma_h, kin.beta_h2);
-    let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
-    if !all_finite(&meff) {
-        return Err(Error::OperatorOverflow);
-    }
-    let scales = terms_scales(m, c, k, wc, wk);
-    let lu = match Lu::new(&meff, &scales) {
-        Some(lu) => lu,
-        None => return Err(Error::SingularEffectiveMatrix),
+    let (meff, scales, lu) = match effective_lu(m, c, k, kin.gamma_h, kin.beta_h2) {
+        Ok(e) => e,
+        Err(e) => return Err(e),
     };
     let (g, gc, gk) = (lu.inverse(), lu.solve(c), lu.solve(k));
     let fit = [fits(&g, &meff, max), fits(&gc, c, max), fits(&gk, k, max)];

@@ -24,7 +24,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, start_operators, terms_scales};
+use crate::kernel::{StartOps, effective_lu, start_operators};
 use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition};
 use crate::linalg::{
@@ -146,15 +146,9 @@ pub(crate) const fn alpha_operators<const N: usize>(
     let hf = kin.h;
     let f1 = 1.0 - alpha_f;
     let (wm, wc, wk) = (1.0 - alpha_m, f1 * gamma * hf, f1 * beta * hf * hf);
-    let mm = scaled(wm, m);
-    let meff = add_scaled(&add_scaled(&mm, wc, c), wk, k);
-    let scales = terms_scales(&mm, c, k, wc, wk);
-    if !all_finite(&meff) {
-        return Err(Error::OperatorOverflow);
-    }
-    let lu = match Lu::new(&meff, &scales) {
-        Some(lu) => lu,
-        None => return Err(Error::SingularEffectiveMatrix),
+    let (meff, scales, lu) = match effective_lu(&scaled(wm, m), c, k, wc, wk) {
+        Ok(e) => e,
+        Err(e) => return Err(e),
     };
     let (g, gc, gk, gm) = (lu.inverse(), lu.solve(c), lu.solve(k), lu.solve(m));
     // a_n = G p̄ − α_m GM a − (1−α_f) GC v̂ − (1−α_f) GK û − α_f (GC v + GK u), with

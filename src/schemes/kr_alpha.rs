@@ -78,7 +78,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, start_operators, terms_scales};
+use crate::kernel::{StartOps, effective_lu, start_operators, terms_scales};
 use crate::kinematics::check_time_step_as;
 use crate::linalg::lu::Lu;
 use crate::linalg::{Mat, Rows, add_scaled, all_finite, all_fit, first_error, fits, mul};
@@ -146,13 +146,9 @@ pub(crate) const fn kr_operators<const N: usize>(
     } = *p;
     let (wc, wk) = (gamma * h, beta * h * h);
     // α1 = M_eff⁻¹ M, α3 = M_eff⁻¹ (α_m M + α_f γh C + α_f βh² K).
-    let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
-    if !all_finite(&meff) {
-        return Err(Error::OperatorOverflow);
-    }
-    let lu = match Lu::new(&meff, &terms_scales(m, c, k, wc, wk)) {
-        Some(lu) => lu,
-        None => return Err(Error::SingularEffectiveMatrix),
+    let lu = match effective_lu(m, c, k, wc, wk) {
+        Ok((_, _, lu)) => lu,
+        Err(e) => return Err(e),
     };
     let num3 = add_scaled(
         &add_scaled(&scaled(alpha_m, m), alpha_f * wc, c),
