@@ -464,6 +464,23 @@ pub(crate) const fn terms_scales<const N: usize>(
     s
 }
 
+/// The range verdict of an operator build: the [`fits`] checks of its operators `fit` and
+/// whether its scalar coefficients fit (`coefficients_fit`, e.g. the kinematics'). An
+/// operator's overflow first, then a coefficient's overflow ([`Error::OperatorOverflow`]
+/// both), then an operator's underflow — overflow anywhere before underflow anywhere,
+/// whatever the order of the checks (`const fn`). Cost: `L` comparisons.
+pub(crate) const fn range_verdict<const L: usize>(
+    fit: [Result<(), Error>; L],
+    coefficients_fit: bool,
+) -> Result<(), Error> {
+    match first_error(fit) {
+        Some(Error::OperatorOverflow) => Err(Error::OperatorOverflow),
+        _ if !coefficients_fit => Err(Error::OperatorOverflow),
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
 /// The effective matrix `M_eff = M + wc C + wk K` of an implicit scheme (`m` already
 /// weighted where the scheme weights it), checked finite, with the row scales of its terms
 /// ([`terms_scales`]) and its factorization: the one effective-matrix build of the Newmark
@@ -532,11 +549,8 @@ pub(crate) const fn newmark_operators<const N: usize>(
     let (g, gc, gk) = (lu.inverse(), lu.solve(c), lu.solve(k));
     let fit = [fits(&g, &meff, max), fits(&gc, c, max), fits(&gk, k, max)];
     // Overflow (of an operator or of a kinematic coefficient) before underflow.
-    match first_error(fit) {
-        Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
-        _ if !kin.fits(max) => return Err(Error::OperatorOverflow),
-        Some(e) => return Err(e),
-        None => {}
+    if let Err(e) = range_verdict(fit, kin.fits(max)) {
+        return Err(e);
     }
     let start = match start_operators(m, c, k, max) {
         Ok(s) => s,

@@ -24,12 +24,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, effective_lu, start_operators};
+use crate::kernel::{StartOps, effective_lu, range_verdict, start_operators};
 use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition};
-use crate::linalg::{
-    Mat, add_scaled, all_finite, finite_as, first_error, fits, round_rows, rows_f64, scaled,
-};
+use crate::linalg::{Mat, add_scaled, all_finite, finite_as, fits, round_rows, rows_f64, scaled};
 use crate::{Error, Param, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
@@ -164,11 +162,8 @@ pub(crate) const fn alpha_operators<const N: usize>(
     // before underflow anywhere.
     let fit = [fits(&g, &meff, max), fits(&gc, c, max), fits(&gk, k, max)];
     let combined = finite_as(&av, max) && finite_as(&aa, max) && kin.fits(max);
-    match first_error(fit) {
-        Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
-        _ if !combined => return Err(Error::OperatorOverflow),
-        Some(e) => return Err(e),
-        None => {}
+    if let Err(e) = range_verdict(fit, combined) {
+        return Err(e);
     }
     let start = match start_operators(m, c, k, max) {
         Ok(s) => s,

@@ -78,10 +78,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, effective_lu, start_operators, terms_scales};
+use crate::kernel::{StartOps, effective_lu, range_verdict, start_operators, terms_scales};
 use crate::kinematics::check_time_step_as;
 use crate::linalg::lu::Lu;
-use crate::linalg::{Mat, Rows, add_scaled, all_finite, all_fit, first_error, fits, mul};
+use crate::linalg::{Mat, Rows, add_scaled, all_finite, all_fit, fits, mul};
 use crate::linalg::{round_rows, rows_f64, scaled};
 use crate::{AlphaParameters, Error, Real, State, Stepper};
 
@@ -190,13 +190,8 @@ pub(crate) const fn kr_operators<const N: usize>(
         start_fit,
     ];
     // Overflow (of an operator or of a coefficient) anywhere before underflow anywhere.
-    match first_error(fit) {
-        Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
-        _ if !all_fit(&[c2, wc, alpha_f, 1.0 - alpha_f], max) => {
-            return Err(Error::OperatorOverflow);
-        }
-        Some(e) => return Err(e),
-        None => {}
+    if let Err(e) = range_verdict(fit, all_fit(&[c2, wc, alpha_f, 1.0 - alpha_f], max)) {
+        return Err(e);
     }
     let start = match start {
         Some(s) => s,
