@@ -630,3 +630,51 @@ pub(crate) fn initial_state<T: Real, const N: usize>(
     let a0 = mat_vec(&ops.minv, p0) - mat_vec(&ops.minv_c, v0) - mat_vec(&ops.minv_k, u0);
     State::initial_computed(u0, v0, a0)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The verdict the three operator builds share, as its docs state it: an operator's
+    /// overflow, then a coefficient's overflow, then an operator's underflow, whatever the
+    /// order of the checks.
+    #[test]
+    fn range_verdict_overflow_before_underflow() {
+        let (o, u) = (Err(Error::OperatorOverflow), Err(Error::OperatorUnderflow));
+        assert_eq!(range_verdict([u, Ok(()), o], true), o);
+        assert_eq!(range_verdict([o, u], false), o);
+        assert_eq!(range_verdict([u, Ok(())], false), o);
+        assert_eq!(range_verdict([Ok(()), u], true), u);
+        assert_eq!(range_verdict([Ok(()); 3], false), o);
+        assert_eq!(range_verdict([Ok(()); 3], true), Ok(()));
+    }
+
+    /// `effective_lu` forms `M + wc C + wk K` entry by entry in that order, refuses a
+    /// non-finite sum before factorizing, and a matrix whose rows cancel to rounding.
+    #[test]
+    fn effective_lu_sum_and_refusals() {
+        let (m, c, k) = (
+            [[2.0, 0.0], [0.0, 1.0]],
+            [[0.5, 0.1], [0.1, 0.5]],
+            [[4.0, -1.0], [-1.0, 3.0]],
+        );
+        let (wc, wk) = (0.005, 2.5e-5);
+        let (meff, _, _) = effective_lu(&m, &c, &k, wc, wk).unwrap();
+        for i in 0..2 {
+            for j in 0..2 {
+                assert_eq!(meff[i][j], m[i][j] + wc * c[i][j] + wk * k[i][j]);
+            }
+        }
+        let big = [[f64::MAX, 0.0], [0.0, f64::MAX]];
+        assert_eq!(
+            effective_lu(&big, &big, &k, 1.0, 0.0).err(),
+            Some(Error::OperatorOverflow)
+        );
+        // M + 1·(−M): every row cancels exactly.
+        let neg = [[-2.0, 0.0], [0.0, -1.0]];
+        assert_eq!(
+            effective_lu(&m, &neg, &k, 1.0, 0.0).err(),
+            Some(Error::SingularEffectiveMatrix)
+        );
+    }
+}
