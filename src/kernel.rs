@@ -82,7 +82,9 @@ impl<T: Real, const N: usize, K> Kernel<T, N, K> {
 }
 
 /// `Kernel::<f32, N, AemKinematics<f32>>::from_ops` (and `f64`): the `const` twin of
-/// [`KernelOps::round_aem`], for the `const fn` constructors (bit-identical to it).
+/// [`KernelOps::round_aem`], for the `const fn` constructors (bit-identical to it); and
+/// the `const` twin, per scalar, of the start-up rounding every scheme's `const fn` shares
+/// (`StartOps::rounded`).
 macro_rules! const_kernel {
     ($t:ident) => {
         impl<const N: usize> Kernel<$t, N, AemKinematics<$t>> {
@@ -123,14 +125,22 @@ macro_rules! const_kernel {
                     ops: OpRows::new(ops),
                     kin: crate::linalg::const_round!($t, kin op.aem),
                     start: match &op.start {
-                        Some((_, s)) => Some(StartOps {
-                            minv: crate::linalg::const_round!($t, rows s.minv),
-                            minv_c: crate::linalg::const_round!($t, rows s.minv_c),
-                            minv_k: crate::linalg::const_round!($t, rows s.minv_k),
-                        }),
+                        Some((_, s)) => Some(StartOps::<$t, N>::rounded(s)),
                         None => None,
                     },
                     condition: op.condition,
+                }
+            }
+        }
+
+        impl<const N: usize> StartOps<$t, N> {
+            /// The `const` twin of [`StartOps::round`]: each operator rounded once to the
+            /// scalar (bit-identical to it). Cost: `3N²` conversions.
+            pub(crate) const fn rounded(s: &StartOps<f64, N>) -> Self {
+                Self {
+                    minv: crate::linalg::const_round!($t, rows s.minv),
+                    minv_c: crate::linalg::const_round!($t, rows s.minv_c),
+                    minv_k: crate::linalg::const_round!($t, rows s.minv_k),
                 }
             }
         }
@@ -138,6 +148,43 @@ macro_rules! const_kernel {
 }
 const_kernel!(f32);
 const_kernel!(f64);
+
+/// The `const fn` twins `from_rows_f32` / `from_rows_f64` and the `const` `time_step` of a
+/// scheme stored as `{ kernel: Kernel<T, N, AemKinematics<T>> }`
+/// ([`Linear`](crate::Linear), [`CompensatedLinear`](crate::CompensatedLinear)): one
+/// build, [`Kernel::from_rows_aem`], behind both scalars and both schemes; each scheme
+/// passes the docs of its `from_rows_*`.
+macro_rules! aem_const_ctors {
+    ($scheme:ident, $(#[$doc:meta])*) => {
+        $crate::kernel::aem_const_ctors!(@one $scheme, f32, from_rows_f32, $(#[$doc])*);
+        $crate::kernel::aem_const_ctors!(@one $scheme, f64, from_rows_f64, $(#[$doc])*);
+    };
+    (@one $scheme:ident, $t:ident, $from_rows:ident, $(#[$doc:meta])*) => {
+        impl<const N: usize> $scheme<$t, N> {
+            $(#[$doc])*
+            pub const fn $from_rows(
+                m: $crate::linalg::Rows<N>,
+                c: $crate::linalg::Rows<N>,
+                k: $crate::linalg::Rows<N>,
+                h: f64,
+            ) -> Result<Self, $crate::Error> {
+                type K<T> = $crate::kinematics::AemKinematics<T>;
+                match $crate::kernel::Kernel::<$t, N, K<$t>>::from_rows_aem(&m, &c, &k, h) {
+                    Ok(kernel) => Ok(Self { kernel }),
+                    Err(e) => Err(e),
+                }
+            }
+
+            /// The time step `h` (s), usable in `const` contexts: the same value as
+            /// [`Stepper::time_step`](crate::Stepper::time_step), which generic code (`S:
+            /// Stepper<T, N>`) still calls. Cost: none.
+            pub const fn time_step(&self) -> $t {
+                self.kernel.kin.h
+            }
+        }
+    };
+}
+pub(crate) use aem_const_ctors;
 
 /// `impl Stepper` for a scheme stored as `{ kernel: Kernel<T, N, K> }`
 /// ([`Linear`](crate::Linear), [`Newmark`](crate::Newmark)).
@@ -417,6 +464,49 @@ pub(crate) const fn terms_scales<const N: usize>(
     s
 }
 
+/// The range verdict of an operator build: the [`fits`] checks of its operators `fit` and
+/// whether its scalar coefficients fit (`coefficients_fit`, e.g. the kinematics'). An
+/// operator's overflow first, then a coefficient's overflow ([`Error::OperatorOverflow`]
+/// both), then an operator's underflow — overflow anywhere before underflow anywhere,
+/// whatever the order of the checks (`const fn`). Cost: `L` comparisons.
+pub(crate) const fn range_verdict<const L: usize>(
+    fit: [Result<(), Error>; L],
+    coefficients_fit: bool,
+) -> Result<(), Error> {
+    match first_error(fit) {
+        Some(Error::OperatorOverflow) => Err(Error::OperatorOverflow),
+        _ if !coefficients_fit => Err(Error::OperatorOverflow),
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// The effective matrix `M_eff = M + wc C + wk K` of an implicit scheme (`m` already
+/// weighted where the scheme weights it), checked finite, with the row scales of its terms
+/// ([`terms_scales`]) and its factorization: the one effective-matrix build of the Newmark
+/// family, generalized-α and KR-α (`const fn`).
+///
+/// Errors: [`Error::OperatorOverflow`] (`M_eff` not finite),
+/// [`Error::SingularEffectiveMatrix`] (singular to working precision against its terms).
+/// Cost: `N³/3` flops for the LU and `O(N²)`.
+pub(crate) const fn effective_lu<const N: usize>(
+    m: &Mat<N, N>,
+    c: &Mat<N, N>,
+    k: &Mat<N, N>,
+    wc: f64,
+    wk: f64,
+) -> Result<(Mat<N, N>, [f64; N], Lu<N>), Error> {
+    let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
+    if !all_finite(&meff) {
+        return Err(Error::OperatorOverflow);
+    }
+    let scales = terms_scales(m, c, k, wc, wk);
+    match Lu::new(&meff, &scales) {
+        Some(lu) => Ok((meff, scales, lu)),
+        None => Err(Error::SingularEffectiveMatrix),
+    }
+}
+
 /// Check `M, C, K, h, β, γ` and build the kernel's operators by factorizing `M_eff` and
 /// solving (paper eqs. 19–23 in eliminated form for β = 1/4, γ = 1/2). `max`: the
 /// largest finite value of the scalar type the operators will be rounded to.
@@ -452,24 +542,15 @@ pub(crate) const fn newmark_operators<const N: usize>(
     if let Err(e) = check_time_step_as(h, max) {
         return Err(e);
     }
-    let (wc, wk) = (kin.gamma_h, kin.beta_h2);
-    let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
-    if !all_finite(&meff) {
-        return Err(Error::OperatorOverflow);
-    }
-    let scales = terms_scales(m, c, k, wc, wk);
-    let lu = match Lu::new(&meff, &scales) {
-        Some(lu) => lu,
-        None => return Err(Error::SingularEffectiveMatrix),
+    let (meff, scales, lu) = match effective_lu(m, c, k, kin.gamma_h, kin.beta_h2) {
+        Ok(e) => e,
+        Err(e) => return Err(e),
     };
     let (g, gc, gk) = (lu.inverse(), lu.solve(c), lu.solve(k));
     let fit = [fits(&g, &meff, max), fits(&gc, c, max), fits(&gk, k, max)];
     // Overflow (of an operator or of a kinematic coefficient) before underflow.
-    match first_error(fit) {
-        Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
-        _ if !kin.fits(max) => return Err(Error::OperatorOverflow),
-        Some(e) => return Err(e),
-        None => {}
+    if let Err(e) = range_verdict(fit, kin.fits(max)) {
+        return Err(e);
     }
     let start = match start_operators(m, c, k, max) {
         Ok(s) => s,
@@ -485,6 +566,37 @@ pub(crate) const fn newmark_operators<const N: usize>(
         condition: condition(&meff, &g, &scales),
         start,
     })
+}
+
+/// [`newmark_operators`] for a load `p = B w` entering through `B` (`N×I`): `B` checked
+/// first ([`Error::NonFiniteInput`]), then the kernel's operators, with `G B` (a solve
+/// with `M_eff`) and, when `M` is regular, `M⁻¹ B` (a solve with `M`). The one build
+/// behind [`LinearInput`](crate::LinearInput) and the Newmark state-space form. Errors:
+/// those of [`newmark_operators`], after `B`'s.
+#[allow(clippy::too_many_arguments)] // newmark_operators' arguments, plus B
+pub(crate) const fn input_kernel_operators<const N: usize, const I: usize>(
+    m: &Mat<N, N>,
+    c: &Mat<N, N>,
+    k: &Mat<N, N>,
+    b: &Mat<N, I>,
+    h: f64,
+    beta: f64,
+    gamma: f64,
+    max: f64,
+) -> Result<(KernelOps<N>, Mat<N, I>, Option<Mat<N, I>>), Error> {
+    if !all_finite(b) {
+        return Err(Error::NonFiniteInput);
+    }
+    let op = match newmark_operators(m, c, k, h, beta, gamma, max) {
+        Ok(op) => op,
+        Err(e) => return Err(e),
+    };
+    let gb = op.lu.solve(b);
+    let minv_b = match &op.start {
+        Some((lu, _)) => Some(lu.solve(b)),
+        None => None,
+    };
+    Ok((op, gb, minv_b))
 }
 
 /// `M, C, K` as row-major `f64`, checked finite ([`Error::NonFiniteInput`]): the data
@@ -517,4 +629,52 @@ pub(crate) fn initial_state<T: Real, const N: usize>(
     let ops = ops.ok_or(Error::SingularMass)?;
     let a0 = mat_vec(&ops.minv, p0) - mat_vec(&ops.minv_c, v0) - mat_vec(&ops.minv_k, u0);
     State::initial_computed(u0, v0, a0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The verdict the three operator builds share, as its docs state it: an operator's
+    /// overflow, then a coefficient's overflow, then an operator's underflow, whatever the
+    /// order of the checks.
+    #[test]
+    fn range_verdict_overflow_before_underflow() {
+        let (o, u) = (Err(Error::OperatorOverflow), Err(Error::OperatorUnderflow));
+        assert_eq!(range_verdict([u, Ok(()), o], true), o);
+        assert_eq!(range_verdict([o, u], false), o);
+        assert_eq!(range_verdict([u, Ok(())], false), o);
+        assert_eq!(range_verdict([Ok(()), u], true), u);
+        assert_eq!(range_verdict([Ok(()); 3], false), o);
+        assert_eq!(range_verdict([Ok(()); 3], true), Ok(()));
+    }
+
+    /// `effective_lu` forms `M + wc C + wk K` entry by entry in that order, refuses a
+    /// non-finite sum before factorizing, and a matrix whose rows cancel to rounding.
+    #[test]
+    fn effective_lu_sum_and_refusals() {
+        let (m, c, k) = (
+            [[2.0, 0.0], [0.0, 1.0]],
+            [[0.5, 0.1], [0.1, 0.5]],
+            [[4.0, -1.0], [-1.0, 3.0]],
+        );
+        let (wc, wk) = (0.005, 2.5e-5);
+        let (meff, _, _) = effective_lu(&m, &c, &k, wc, wk).unwrap();
+        for i in 0..2 {
+            for j in 0..2 {
+                assert_eq!(meff[i][j], m[i][j] + wc * c[i][j] + wk * k[i][j]);
+            }
+        }
+        let big = [[f64::MAX, 0.0], [0.0, f64::MAX]];
+        assert_eq!(
+            effective_lu(&big, &big, &k, 1.0, 0.0).err(),
+            Some(Error::OperatorOverflow)
+        );
+        // M + 1·(−M): every row cancels exactly.
+        let neg = [[-2.0, 0.0], [0.0, -1.0]];
+        assert_eq!(
+            effective_lu(&m, &neg, &k, 1.0, 0.0).err(),
+            Some(Error::SingularEffectiveMatrix)
+        );
+    }
 }

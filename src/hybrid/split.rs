@@ -3,8 +3,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::linalg::rows_f64;
-use crate::schemes::kr_alpha::{CHEN_RICLES, kr_operators};
+use crate::schemes::kr_alpha::CHEN_RICLES;
 use crate::{AlphaParameters, Error, KrAlpha, Param, Real, State, StepInput, Stepper};
 
 /// A KR-α step split in two for real-time hybrid simulation: the displacement command of
@@ -141,7 +140,8 @@ impl<T: Real, const N: usize> Split<T, N> {
         h: f64,
         rho_inf: f64,
     ) -> Result<Self, Error> {
-        Self::build(m, c, k, k_num, h, AlphaParameters::chung_hulbert(rho_inf)?)
+        let p = AlphaParameters::chung_hulbert(rho_inf)?;
+        KrAlpha::with_rest(m, c, k, k_num, h, p).map(|kr| Self { kr })
     }
 
     /// The split Chen–Ricles step (`α_m = α_f = 0`, `γ = 1/2`, `β = 1/4`). Arguments,
@@ -153,22 +153,7 @@ impl<T: Real, const N: usize> Split<T, N> {
         k_num: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        Self::build(m, c, k, k_num, h, CHEN_RICLES)
-    }
-
-    fn build(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        k_num: &SMatrix<f64, N, N>,
-        h: f64,
-        p: AlphaParameters,
-    ) -> Result<Self, Error> {
-        let (m, c, k, kn) = (rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(k_num));
-        let op = kr_operators(&m, &c, &k, &kn, h, &p, T::MAX)?;
-        Ok(Self {
-            kr: KrAlpha::from_ops(&op, p),
-        })
+        KrAlpha::with_rest(m, c, k, k_num, h, CHEN_RICLES).map(|kr| Self { kr })
     }
 
     /// The scheme's parameters `(α_m, α_f, β, γ)`. Cost: O(1).

@@ -44,13 +44,14 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{checked_rows, newmark_operators, start_operators};
-use crate::kinematics::check_time_step_as;
+use crate::kernel::{StartOps, input_kernel_operators, start_operators};
 use crate::linalg::lu::{Lu, row_scales};
-use crate::linalg::{Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled};
+use crate::linalg::{
+    Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled, transpose,
+};
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
-use crate::schemes::exponential_blocks;
+use crate::schemes::{Exponential, exponential};
 use crate::{AlphaParameters, Error, Exact};
 
 /// The discrete state-space model of a linear scheme with `N` degrees of freedom, state
@@ -229,8 +230,9 @@ const fn axpy<const R: usize, const C: usize>(a: &Mat<R, C>, s: f64, b: &Mat<R, 
 }
 
 /// The Newmark step (β, γ) as blocks (see the module docs): factorizations of `M` and
-/// `M_eff = M + γh C + βh² K`, solves. The checks of [`newmark_operators`] (the
-/// steppers'), after `B`'s.
+/// `M_eff = M + γh C + βh² K`, solves. The checks of
+/// [`newmark_operators`](crate::kernel::newmark_operators) (the steppers'), after `B`'s
+/// ([`input_kernel_operators`], as [`LinearInput`](crate::LinearInput)'s).
 const fn newmark_blocks<const N: usize, const I: usize>(
     m: &Rows<N>,
     c: &Rows<N>,
@@ -240,16 +242,13 @@ const fn newmark_blocks<const N: usize, const I: usize>(
     beta: f64,
     gamma: f64,
 ) -> Result<NewmarkBlocks<N, I>, Error> {
-    if !all_finite(b) {
-        return Err(Error::NonFiniteInput);
-    }
-    let op = match newmark_operators(m, c, k, h, beta, gamma, f64::MAX) {
-        Ok(op) => op,
+    let (op, gb, minv_b) = match input_kernel_operators(m, c, k, b, h, beta, gamma, f64::MAX) {
+        Ok(ops) => ops,
         Err(e) => return Err(e),
     };
-    let (lu_m, st) = match op.start {
-        Some(s) => s,
-        None => return Err(Error::SingularMass),
+    let (aw, st) = match (minv_b, op.start) {
+        (Some(aw), Some((_, st))) => (aw, st),
+        _ => return Err(Error::SingularMass),
     };
     let kin = op.kin;
     let zero_i = [[0.0; I]; N];
@@ -257,7 +256,6 @@ const fn newmark_blocks<const N: usize, const I: usize>(
     // The equation of motion: a = −M⁻¹K u − M⁻¹C v + M⁻¹B w.
     let au = scaled(-1.0, &st.minv_k);
     let av = scaled(-1.0, &st.minv_c);
-    let aw = lu_m.solve(b);
     // Predictor: v̂ = v + c_v a, û = u + h v̂ − c_u a.
     let vh_u = scaled(kin.c_v, &au);
     let vh_v = axpy(&id, kin.c_v, &av);
@@ -273,7 +271,7 @@ const fn newmark_blocks<const N: usize, const I: usize>(
         op.lu.solve(&rhs_u),
         op.lu.solve(&rhs_v),
         op.lu.solve(&rhs_w),
-        op.lu.solve(b),
+        gb,
     );
     // Corrector: u_n = û + β h² q, v_n = v̂ + γ h q.
     let (bh2, gh) = (kin.beta_h2, kin.gamma_h);
@@ -404,15 +402,8 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
             Ok(bl) => bl,
             Err(e) => return Err(e),
         };
-        let mut ss = Self::zero(h);
-        put(&mut ss.phi, &bl.uu, 0, 0);
-        put(&mut ss.phi, &bl.uv, 0, N);
-        put(&mut ss.phi, &bl.vu, N, 0);
-        put(&mut ss.phi, &bl.vv, N, N);
-        put(&mut ss.gamma0, &bl.u0, 0, 0);
-        put(&mut ss.gamma0, &bl.v0, N, 0);
-        put(&mut ss.gamma1, &bl.u1, 0, 0);
-        put(&mut ss.gamma1, &bl.v1, N, 0);
+        let phi = [[&bl.uu, &bl.uv], [&bl.vu, &bl.vv]];
+        let ss = Self::from_uv_blocks(h, phi, [&bl.u0, &bl.v0], [&bl.u1, &bl.v1]);
         ss.full_outputs(&bl.au, &bl.av, bl.aw)
     }
 
@@ -478,11 +469,8 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         h: f64,
         params: AlphaParameters,
     ) -> Result<Self, Error> {
-        if S != 3 * N {
-            return Err(Error::StateSizeMismatch);
-        }
-        if !all_finite(&b) {
-            return Err(Error::NonFiniteInput);
+        if let Err(e) = Self::check_input(3 * N, &b) {
+            return Err(e);
         }
         let op = match alpha_operators(&m, &c, &k, h, &params, f64::MAX) {
             Ok(op) => op,
@@ -522,9 +510,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         put(&mut ss.gamma1, &scaled(bh2, &a1), 0, 0);
         put(&mut ss.gamma1, &scaled(gh, &a1), N, 0);
         put(&mut ss.gamma1, &a1, 2 * N, 0);
-        // The physical acceleration M⁻¹ (B w − C v − K u).
-        let (au, av) = (scaled(-1.0, &st.minv_k), scaled(-1.0, &st.minv_c));
-        ss.full_outputs(&au, &av, lu_m.solve(&b))
+        ss.physical_outputs(&lu_m, &st, &b)
     }
 
     /// [`StateSpace::from_rows_generalized_alpha`] from `nalgebra` matrices (run time; same
@@ -639,27 +625,16 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         b: &SMatrix<f64, N, I>,
         h: f64,
     ) -> Result<Self, Error> {
-        if S != 2 * N {
-            return Err(Error::StateSizeMismatch);
-        }
         let bb = rows_f64(b);
-        if !all_finite(&bb) {
-            return Err(Error::NonFiniteInput);
-        }
+        Self::check_input(2 * N, &bb)?;
         let ex = Exact::<f64, N>::new(m, c, k, h)?;
         let (mm, cc, kk) = (rows_f64(m), rows_f64(c), rows_f64(k));
         let (lu_m, st) = start_operators(&mm, &cc, &kk, f64::MAX)?.ok_or(Error::SingularMass)?;
-        let mut ss = Self::zero(h);
-        put(&mut ss.phi, &ex.au[0], 0, 0);
-        put(&mut ss.phi, &ex.au[1], 0, N);
-        put(&mut ss.phi, &ex.av[0], N, 0);
-        put(&mut ss.phi, &ex.av[1], N, N);
-        put(&mut ss.gamma0, &mul(&ex.au[2], &bb), 0, 0);
-        put(&mut ss.gamma0, &mul(&ex.av[2], &bb), N, 0);
-        put(&mut ss.gamma1, &mul(&ex.au[3], &bb), 0, 0);
-        put(&mut ss.gamma1, &mul(&ex.av[3], &bb), N, 0);
-        let (au, av) = (scaled(-1.0, &st.minv_k), scaled(-1.0, &st.minv_c));
-        ss.full_outputs(&au, &av, lu_m.solve(&bb))
+        let phi = [[&ex.au[0], &ex.au[1]], [&ex.av[0], &ex.av[1]]];
+        let gamma0 = [&mul(&ex.au[2], &bb), &mul(&ex.av[2], &bb)];
+        let gamma1 = [&mul(&ex.au[3], &bb), &mul(&ex.av[3], &bb)];
+        let ss = Self::from_uv_blocks(h, phi, gamma0, gamma1);
+        ss.physical_outputs(&lu_m, &st, &bb)
     }
 
     /// The zero-order-hold discretization (`x = [u; v]`, `S = 2N`): the input held
@@ -708,29 +683,21 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         b: &SMatrix<f64, N, I>,
         h: f64,
     ) -> Result<Self, Error> {
-        if S != 2 * N {
-            return Err(Error::StateSizeMismatch);
-        }
         let bb = rows_f64(b);
-        if !all_finite(&bb) {
-            return Err(Error::NonFiniteInput);
-        }
-        let (mm, cc, kk) = checked_rows(m, c, k)?;
-        let hf = check_time_step_as(h, f64::MAX)?;
-        let (lu_m, st) = start_operators(&mm, &cc, &kk, f64::MAX)?.ok_or(Error::SingularMass)?;
-        let (mi, mic, mik) = (&st.minv, &st.minv_c, &st.minv_k);
+        Self::check_input(2 * N, &bb)?;
         // Φ and Γ₁ᵉ = ∫₀ʰ e^{F s} ds [0; M⁻¹] of the exponential `Exact` reads.
-        let [[phi_uu, phi_uv, gu, _], [phi_vu, phi_vv, gv, _]] =
-            exponential_blocks(mi, mic, mik, hf);
-        let mut ss = Self::zero(hf);
-        put(&mut ss.phi, &phi_uu, 0, 0);
-        put(&mut ss.phi, &phi_uv, 0, N);
-        put(&mut ss.phi, &phi_vu, N, 0);
-        put(&mut ss.phi, &phi_vv, N, N);
-        put(&mut ss.gamma0, &mul(&gu, &bb), 0, 0);
-        put(&mut ss.gamma0, &mul(&gv, &bb), N, 0);
-        let (au, av) = (scaled(-1.0, mik), scaled(-1.0, mic));
-        ss.full_outputs(&au, &av, lu_m.solve(&bb))
+        let Exponential {
+            h: hf,
+            lu_m,
+            start: st,
+            blocks: [[phi_uu, phi_uv, gu, _], [phi_vu, phi_vv, gv, _]],
+            ..
+        } = exponential(m, c, k, h, f64::MAX)?;
+        let phi = [[&phi_uu, &phi_uv], [&phi_vu, &phi_vv]];
+        let gamma0 = [&mul(&gu, &bb), &mul(&gv, &bb)];
+        let zero = [[0.0; I]; N];
+        let ss = Self::from_uv_blocks(hf, phi, gamma0, [&zero, &zero]);
+        ss.physical_outputs(&lu_m, &st, &bb)
     }
 
     /// The form of [`Modal`](crate::Modal) keeping the modes `modes` (indices in ascending
@@ -853,6 +820,51 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         })
     }
 
+    /// Check a full-state builder's shape (`S` must be `states`) and its `B`
+    /// ([`Error::StateSizeMismatch`], then [`Error::NonFiniteInput`]). Cost: a scan of `B`.
+    const fn check_input(states: usize, b: &Mat<N, I>) -> Result<(), Error> {
+        if S != states {
+            return Err(Error::StateSizeMismatch);
+        }
+        if !all_finite(b) {
+            return Err(Error::NonFiniteInput);
+        }
+        Ok(())
+    }
+
+    /// A full-state model `x = [u; v]` with step `h` (s) from its `N×N` blocks
+    /// `phi = [[Φ_uu, Φ_uv], [Φ_vu, Φ_vv]]` and the `N×I` blocks `[u; v]` of `Γ₀`, `Γ₁`
+    /// (the outputs still zero). Cost: copies.
+    const fn from_uv_blocks(
+        h: f64,
+        phi: [[&Mat<N, N>; 2]; 2],
+        gamma0: [&Mat<N, I>; 2],
+        gamma1: [&Mat<N, I>; 2],
+    ) -> Self {
+        let mut ss = Self::zero(h);
+        put(&mut ss.phi, phi[0][0], 0, 0);
+        put(&mut ss.phi, phi[0][1], 0, N);
+        put(&mut ss.phi, phi[1][0], N, 0);
+        put(&mut ss.phi, phi[1][1], N, N);
+        put(&mut ss.gamma0, gamma0[0], 0, 0);
+        put(&mut ss.gamma0, gamma0[1], N, 0);
+        put(&mut ss.gamma1, gamma1[0], 0, 0);
+        put(&mut ss.gamma1, gamma1[1], N, 0);
+        ss
+    }
+
+    /// [`Self::full_outputs`] with the physical acceleration `M⁻¹ (B w − C v − K u)` from the
+    /// factorization `lu_m` of `M` and the start-up operators `st` (`M⁻¹K`, `M⁻¹C`).
+    const fn physical_outputs(
+        self,
+        lu_m: &Lu<N>,
+        st: &StartOps<f64, N>,
+        b: &Mat<N, I>,
+    ) -> Result<Self, Error> {
+        let (au, av) = (scaled(-1.0, &st.minv_k), scaled(-1.0, &st.minv_c));
+        self.full_outputs(&au, &av, lu_m.solve(b))
+    }
+
     /// The output maps of a full-state model (`u`, `v` the first `2N` states;
     /// `a = A_u u + A_v v + A_w w`), then the check that every matrix is finite
     /// ([`Error::OperatorOverflow`] if not).
@@ -933,24 +945,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// the sensors", derives it and checks it by simulation).
     pub const fn input_noise(&self, qw: &[[f64; I]; I]) -> [[f64; S]; S] {
         let g = add_scaled(&self.gamma0, 1.0, &self.gamma1);
-        let gq = mul(&g, qw);
-        let mut q = [[0.0; S]; S];
-        let mut i = 0;
-        while i < S {
-            let mut j = 0;
-            while j < S {
-                let mut s = 0.0;
-                let mut l = 0;
-                while l < I {
-                    s += gq[i][l] * g[j][l];
-                    l += 1;
-                }
-                q[i][j] = s;
-                j += 1;
-            }
-            i += 1;
-        }
-        q
+        mul(&mul(&g, qw), &transpose(&g))
     }
 
     /// The feedthrough companion of [`StateSpace::input_noise`]: the cross covariance
@@ -970,23 +965,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         qw: &[[f64; I]; I],
     ) -> [[f64; O]; S] {
         let gq = mul(&add_scaled(&self.gamma0, 1.0, &self.gamma1), qw);
-        let mut n = [[0.0; O]; S];
-        let mut i = 0;
-        while i < S {
-            let mut j = 0;
-            while j < O {
-                let mut s = 0.0;
-                let mut l = 0;
-                while l < I {
-                    s += gq[i][l] * meas.d[j][l];
-                    l += 1;
-                }
-                n[i][j] = s;
-                j += 1;
-            }
-            i += 1;
-        }
-        n
+        mul(&gq, &transpose(&meas.d))
     }
 
     /// The measurement noise `D Q_w Dᵀ` (`O×O`, output units squared) that a white input
@@ -998,24 +977,7 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         meas: &Measurement<S, I, O>,
         qw: &[[f64; I]; I],
     ) -> [[f64; O]; O] {
-        let dq = mul(&meas.d, qw);
-        let mut out = [[0.0; O]; O];
-        let mut i = 0;
-        while i < O {
-            let mut j = 0;
-            while j < O {
-                let mut s = 0.0;
-                let mut l = 0;
-                while l < I {
-                    s += dq[i][l] * meas.d[j][l];
-                    l += 1;
-                }
-                out[i][j] = s;
-                j += 1;
-            }
-            i += 1;
-        }
-        out
+        mul(&mul(&meas.d, qw), &transpose(&meas.d))
     }
 
     /// `Φ` as a `nalgebra` matrix.

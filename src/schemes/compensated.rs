@@ -9,9 +9,8 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{Kernel, Lows, initial_state, newmark_step_compensated};
+use crate::kernel::{Kernel, Lows, aem_const_ctors, initial_state, newmark_step_compensated};
 use crate::kinematics::{AemKinematics, Kinematics};
-use crate::linalg::Rows;
 use crate::{Error, Real, State, StepState, Stepper};
 
 /// The state of a [`CompensatedLinear`]: the working-precision [`State`] and the rounding
@@ -109,9 +108,7 @@ impl<T: Real, const N: usize> CompensatedLinear<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        Ok(Self {
-            kernel: Kernel::aem(m, c, k, h)?,
-        })
+        Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
     }
 
     /// `κ₁` of the row-equilibrated effective matrix, as
@@ -127,42 +124,19 @@ impl<T: Real, const N: usize> CompensatedLinear<T, N> {
     }
 }
 
-/// Const-fn construction, for operators computed at compile time into flash.
-macro_rules! const_ctor {
-    ($t:ident, $from_rows:ident) => {
-        impl<const N: usize> CompensatedLinear<$t, N> {
-            /// `const fn` twin of [`CompensatedLinear::new`] (row-major `f64` arrays, `h`
-            /// in s), bit-identical to it and to
-            /// [`Linear::from_rows_f32`](crate::Linear::from_rows_f32)'s operators. Size limit at
-            /// compile time and errors: as [`Linear::from_rows_f32`](crate::Linear::from_rows_f32).
-            ///
-            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`); convert with
-            /// [`models::matrix_of`](crate::models::matrix_of) /
-            /// [`models::rows_of`](crate::models::rows_of), not `SMatrix::from`, which
-            /// reads columns.
-            pub const fn $from_rows(
-                m: Rows<N>,
-                c: Rows<N>,
-                k: Rows<N>,
-                h: f64,
-            ) -> Result<Self, Error> {
-                match Kernel::<$t, N, AemKinematics<$t>>::from_rows_aem(&m, &c, &k, h) {
-                    Ok(kernel) => Ok(Self { kernel }),
-                    Err(e) => Err(e),
-                }
-            }
-
-            /// The time step `h` (s), usable in `const` contexts: the same value as
-            /// [`Stepper::time_step`](crate::Stepper::time_step), which generic code still
-            /// calls. Cost: none.
-            pub const fn time_step(&self) -> $t {
-                self.kernel.kin.h
-            }
-        }
-    };
-}
-const_ctor!(f32, from_rows_f32);
-const_ctor!(f64, from_rows_f64);
+// Const-fn construction, for operators computed at compile time into flash.
+aem_const_ctors!(
+    CompensatedLinear,
+    /// `const fn` twin of [`CompensatedLinear::new`] (row-major `f64` arrays, `h`
+    /// in s), bit-identical to it and to
+    /// [`Linear::from_rows_f32`](crate::Linear::from_rows_f32)'s operators. Size limit at
+    /// compile time and errors: as [`Linear::from_rows_f32`](crate::Linear::from_rows_f32).
+    ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`); convert with
+    /// [`models::matrix_of`](crate::models::matrix_of) /
+    /// [`models::rows_of`](crate::models::rows_of), not `SMatrix::from`, which
+    /// reads columns.
+);
 
 impl<T: Real, const N: usize> Stepper<T, N> for CompensatedLinear<T, N> {
     type Input = SVector<T, N>;

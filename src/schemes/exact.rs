@@ -38,6 +38,7 @@ use nalgebra::{ComplexField, SMatrix, SVector};
 use crate::kernel::{StartOps, checked_rows, start_operators};
 use crate::kinematics::check_time_step_as;
 use crate::linalg::expm::{Blk, blk_expm, norm1};
+use crate::linalg::lu::Lu;
 use crate::linalg::{
     Mat, add_scaled, finite_as, first_error, fits, fits_alone, identity, round_rows, scaled,
 };
@@ -96,7 +97,7 @@ pub struct Exact<T, const N: usize> {
 /// first-order hold from all four; the zero-order hold
 /// ([`StateSpace::zero_order_hold`](crate::observer::StateSpace::zero_order_hold)) takes
 /// `Φ` and `Γ₁ᵉ`. Cost: about `(4N)³ (19 + s)` flops, three `16N²` `f64` temporaries.
-pub(crate) fn exponential_blocks<const N: usize>(
+fn exponential_blocks<const N: usize>(
     mi: &Mat<N, N>,
     mic: &Mat<N, N>,
     mik: &Mat<N, N>,
@@ -130,6 +131,48 @@ pub(crate) fn exponential_blocks<const N: usize>(
     [0, 1].map(|r| [blk(r, 0), blk(r, 1), blk(r, 2), blk(r, 3)])
 }
 
+/// What every exact (hold) discretization starts from: `M, C, K` (row-major, checked
+/// finite), the time step `h` (s, checked for the scalar type whose largest finite value
+/// is `max`), the factorization of `M` and its start-up operators `M⁻¹, M⁻¹C, M⁻¹K`, and
+/// the blocks of the exponential ([`exponential_blocks`]).
+pub(crate) struct Exponential<const N: usize> {
+    pub m: Mat<N, N>,
+    pub c: Mat<N, N>,
+    pub k: Mat<N, N>,
+    pub h: f64,
+    pub lu_m: Lu<N>,
+    pub start: StartOps<f64, N>,
+    pub blocks: [[Mat<N, N>; 4]; 2],
+}
+
+/// Check `M, C, K, h` and form the [`Exponential`] (shared by [`Exact::new`] and the
+/// zero-order hold of the state-space form).
+///
+/// Errors, in this order: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
+/// [`Error::OperatorOverflow`] (a start-up operator beyond `max`),
+/// [`Error::SingularMass`]. Cost: that of [`exponential_blocks`] plus `M`'s LU.
+pub(crate) fn exponential<const N: usize>(
+    m: &SMatrix<f64, N, N>,
+    c: &SMatrix<f64, N, N>,
+    k: &SMatrix<f64, N, N>,
+    h: f64,
+    max: f64,
+) -> Result<Exponential<N>, Error> {
+    let (m, c, k) = checked_rows(m, c, k)?;
+    let h = check_time_step_as(h, max)?;
+    let (lu_m, st) = start_operators(&m, &c, &k, max)?.ok_or(Error::SingularMass)?;
+    let blocks = exponential_blocks(&st.minv, &st.minv_c, &st.minv_k, h);
+    Ok(Exponential {
+        m,
+        c,
+        k,
+        h,
+        lu_m,
+        start: st,
+        blocks,
+    })
+}
+
 impl<T: Real, const N: usize> Exact<T, N> {
     /// Compute the exact step operators for step `h` (s). Computed in `f64`, rounded
     /// once to `T`.
@@ -148,11 +191,15 @@ impl<T: Real, const N: usize> Exact<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        let (m, c, k) = checked_rows(m, c, k)?;
-        let hf = check_time_step_as(h, T::MAX)?;
-        let (_, st) = start_operators(&m, &c, &k, T::MAX)?.ok_or(Error::SingularMass)?;
-        let (mi, mic, mik) = (&st.minv, &st.minv_c, &st.minv_k);
-        let blocks = exponential_blocks(mi, mic, mik, hf);
+        let Exponential {
+            m,
+            c,
+            k,
+            h: hf,
+            start: st,
+            blocks,
+            ..
+        } = exponential(m, c, k, h, T::MAX)?;
         let mut under = None;
         let mut au = [[[T::zero(); N]; N]; 4];
         let mut av = [[[T::zero(); N]; N]; 4];

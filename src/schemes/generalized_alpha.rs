@@ -24,12 +24,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, start_operators, terms_scales};
+use crate::kernel::{StartOps, effective_lu, range_verdict, start_operators};
 use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition};
-use crate::linalg::{
-    Mat, add_scaled, all_finite, finite_as, first_error, fits, round_rows, rows_f64, scaled,
-};
+use crate::linalg::{Mat, add_scaled, all_finite, finite_as, fits, round_rows, rows_f64, scaled};
 use crate::{Error, Param, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
@@ -146,15 +144,9 @@ pub(crate) const fn alpha_operators<const N: usize>(
     let hf = kin.h;
     let f1 = 1.0 - alpha_f;
     let (wm, wc, wk) = (1.0 - alpha_m, f1 * gamma * hf, f1 * beta * hf * hf);
-    let mm = scaled(wm, m);
-    let meff = add_scaled(&add_scaled(&mm, wc, c), wk, k);
-    let scales = terms_scales(&mm, c, k, wc, wk);
-    if !all_finite(&meff) {
-        return Err(Error::OperatorOverflow);
-    }
-    let lu = match Lu::new(&meff, &scales) {
-        Some(lu) => lu,
-        None => return Err(Error::SingularEffectiveMatrix),
+    let (meff, scales, lu) = match effective_lu(&scaled(wm, m), c, k, wc, wk) {
+        Ok(e) => e,
+        Err(e) => return Err(e),
     };
     let (g, gc, gk, gm) = (lu.inverse(), lu.solve(c), lu.solve(k), lu.solve(m));
     // a_n = G p̄ − α_m GM a − (1−α_f) GC v̂ − (1−α_f) GK û − α_f (GC v + GK u), with
@@ -170,11 +162,8 @@ pub(crate) const fn alpha_operators<const N: usize>(
     // before underflow anywhere.
     let fit = [fits(&g, &meff, max), fits(&gc, c, max), fits(&gk, k, max)];
     let combined = finite_as(&av, max) && finite_as(&aa, max) && kin.fits(max);
-    match first_error(fit) {
-        Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
-        _ if !combined => return Err(Error::OperatorOverflow),
-        Some(e) => return Err(e),
-        None => {}
+    if let Err(e) = range_verdict(fit, combined) {
+        return Err(e);
     }
     let start = match start_operators(m, c, k, max) {
         Ok(s) => s,

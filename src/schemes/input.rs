@@ -15,10 +15,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, input_step, interleave, newmark_operators};
+use crate::kernel::{StartOps, input_kernel_operators, input_step, interleave};
 use crate::kinematics::AemKinematics;
 use crate::linalg::op_rows::OpRows;
-use crate::linalg::{self, Mat, Rows, all_finite, finite_as, rows_f64};
+use crate::linalg::{self, Mat, Rows, finite_as, rows_f64};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Real, State, Stepper};
 
@@ -83,17 +83,13 @@ const fn input_operators<const N: usize, const I: usize>(
     h: f64,
     max: f64,
 ) -> Result<InputOps<N, I>, Error> {
-    if !all_finite(b) {
-        return Err(Error::NonFiniteInput);
-    }
-    let op = match newmark_operators(m, c, k, h, 0.25, 0.5, max) {
-        Ok(op) => op,
+    let (op, gb, minv_b) = match input_kernel_operators(m, c, k, b, h, 0.25, 0.5, max) {
+        Ok(ops) => ops,
         Err(e) => return Err(e),
     };
-    let gb = op.lu.solve(b);
-    let start = match op.start {
-        Some((lu, s)) => Some((lu.solve(b), s)),
-        None => None,
+    let start = match (minv_b, op.start) {
+        (Some(mb), Some((_, s))) => Some((mb, s)),
+        _ => None,
     };
     let start_ok = match &start {
         Some((mb, _)) => finite_as(mb, max),
@@ -219,11 +215,7 @@ macro_rules! const_ctor {
                     start: match op.start {
                         Some((mb, s)) => Some(InputStart {
                             minv_b: linalg::const_round!($t, rows mb),
-                            ops: StartOps {
-                                minv: linalg::const_round!($t, rows s.minv),
-                                minv_c: linalg::const_round!($t, rows s.minv_c),
-                                minv_k: linalg::const_round!($t, rows s.minv_k),
-                            },
+                            ops: StartOps::<$t, N>::rounded(&s),
                         }),
                         None => None,
                     },

@@ -78,10 +78,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, start_operators, terms_scales};
+use crate::kernel::{StartOps, effective_lu, range_verdict, start_operators, terms_scales};
 use crate::kinematics::check_time_step_as;
 use crate::linalg::lu::Lu;
-use crate::linalg::{Mat, Rows, add_scaled, all_finite, all_fit, first_error, fits, mul};
+use crate::linalg::{Mat, Rows, add_scaled, all_finite, all_fit, fits, mul};
 use crate::linalg::{round_rows, rows_f64, scaled};
 use crate::{AlphaParameters, Error, Real, State, Stepper};
 
@@ -146,13 +146,9 @@ pub(crate) const fn kr_operators<const N: usize>(
     } = *p;
     let (wc, wk) = (gamma * h, beta * h * h);
     // α1 = M_eff⁻¹ M, α3 = M_eff⁻¹ (α_m M + α_f γh C + α_f βh² K).
-    let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
-    if !all_finite(&meff) {
-        return Err(Error::OperatorOverflow);
-    }
-    let lu = match Lu::new(&meff, &terms_scales(m, c, k, wc, wk)) {
-        Some(lu) => lu,
-        None => return Err(Error::SingularEffectiveMatrix),
+    let lu = match effective_lu(m, c, k, wc, wk) {
+        Ok((_, _, lu)) => lu,
+        Err(e) => return Err(e),
     };
     let num3 = add_scaled(
         &add_scaled(&scaled(alpha_m, m), alpha_f * wc, c),
@@ -194,13 +190,8 @@ pub(crate) const fn kr_operators<const N: usize>(
         start_fit,
     ];
     // Overflow (of an operator or of a coefficient) anywhere before underflow anywhere.
-    match first_error(fit) {
-        Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
-        _ if !all_fit(&[c2, wc, alpha_f, 1.0 - alpha_f], max) => {
-            return Err(Error::OperatorOverflow);
-        }
-        Some(e) => return Err(e),
-        None => {}
+    if let Err(e) = range_verdict(fit, all_fit(&[c2, wc, alpha_f, 1.0 - alpha_f], max)) {
+        return Err(e);
     }
     let start = match start {
         Some(s) => s,
@@ -305,7 +296,7 @@ impl<T: Real, const N: usize> KrAlpha<T, N> {
         h: f64,
         rho_inf: f64,
     ) -> Result<Self, Error> {
-        Self::build(m, c, k, h, AlphaParameters::chung_hulbert(rho_inf)?)
+        Self::with_rest(m, c, k, k, h, AlphaParameters::chung_hulbert(rho_inf)?)
     }
 
     /// The Chen–Ricles algorithm (`α_m = α_f = 0`, `γ = 1/2`, `β = 1/4`: the equation of
@@ -318,25 +309,30 @@ impl<T: Real, const N: usize> KrAlpha<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        Self::build(m, c, k, h, CHEN_RICLES)
+        Self::with_rest(m, c, k, k, h, CHEN_RICLES)
     }
 
-    fn build(
+    /// The operators of `p` with `k_rest` for the computed restoring force
+    /// ([`kr_operators`]; `k` for [`KrAlpha`], the numerical part for
+    /// [`Split`](crate::hybrid::Split)), rounded once to `T`: the run-time twin of
+    /// `from_params`.
+    pub(crate) fn with_rest(
         m: &SMatrix<f64, N, N>,
         c: &SMatrix<f64, N, N>,
         k: &SMatrix<f64, N, N>,
+        k_rest: &SMatrix<f64, N, N>,
         h: f64,
         p: AlphaParameters,
     ) -> Result<Self, Error> {
-        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+        let (m, c, k, kr) = (rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(k_rest));
         Ok(Self::from_ops(
-            &kr_operators(&m, &c, &k, &k, h, &p, T::MAX)?,
+            &kr_operators(&m, &c, &k, &kr, h, &p, T::MAX)?,
             p,
         ))
     }
 
     /// Round the `f64` operators once to `T` (run time).
-    pub(crate) fn from_ops(op: &KrOps<N>, p: AlphaParameters) -> Self {
+    fn from_ops(op: &KrOps<N>, p: AlphaParameters) -> Self {
         Self {
             params: p,
             h: T::from_f64_rounded(op.h),
@@ -494,11 +490,7 @@ macro_rules! const_ctor {
                     gc: crate::linalg::const_round!($t, rows op.gc),
                     gk: crate::linalg::const_round!($t, rows op.gk),
                     gma3: crate::linalg::const_round!($t, rows op.gma3),
-                    start: Some(StartOps {
-                        minv: crate::linalg::const_round!($t, rows s.minv),
-                        minv_c: crate::linalg::const_round!($t, rows s.minv_c),
-                        minv_k: crate::linalg::const_round!($t, rows s.minv_k),
-                    }),
+                    start: Some(StartOps::<$t, N>::rounded(s)),
                 })
             }
 

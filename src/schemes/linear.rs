@@ -16,9 +16,8 @@
 
 use nalgebra::SMatrix;
 
-use crate::kernel::{Kernel, kernel_stepper};
+use crate::kernel::{Kernel, aem_const_ctors, kernel_stepper};
 use crate::kinematics::AemKinematics;
-use crate::linalg::Rows;
 use crate::{AForm, Error, Real};
 
 /// The linear constant-coefficient AEM stepper (paper Algorithm 1, eliminated form).
@@ -74,9 +73,7 @@ impl<T: Real, const N: usize> Linear<T, N> {
         k: &SMatrix<f64, N, N>,
         h: f64,
     ) -> Result<Self, Error> {
-        Ok(Self {
-            kernel: Kernel::aem(m, c, k, h)?,
-        })
+        Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
     }
 
     /// `G = (M + (h/2) C + (h²/4) K)⁻¹`.
@@ -115,66 +112,43 @@ impl<T: Real, const N: usize> Linear<T, N> {
     }
 }
 
-/// Const-fn construction, for operators computed at compile time into flash.
-macro_rules! const_ctor {
-    ($t:ident, $from_rows:ident) => {
-        impl<const N: usize> Linear<$t, N> {
-            /// `const fn` twin of [`Linear::new`]: `M, C, K` as row-major `f64` arrays
-            /// (`m[i][j]` is row `i`, column `j`), `h` in seconds. Bit-identical to
-            /// [`Linear::new`] given the same values. `from_rows_f32` builds a
-            /// `Linear<f32, N>`, `from_rows_f64` a `Linear<f64, N>`: the scalar in the name
-            /// lets a typed `static` infer `N` with no turbofish.
-            ///
-            /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
-            /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
-            /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
-            /// which reads columns.
-            ///
-            /// In a `static`, the operators are evaluated by the compiler and no
-            /// factorization code is linked in:
-            ///
-            /// ```
-            /// use aemstep::Linear;
-            /// static SYS: Linear<f32, 1> = match Linear::from_rows_f32(
-            ///     [[1.0]], [[0.28]], [[4.0]], 0.002,
-            /// ) {
-            ///     Ok(s) => s,
-            ///     Err(e) => panic!("{}", e.as_str()),
-            /// };
-            /// assert_eq!(SYS.time_step(), 0.002);
-            /// ```
-            ///
-            /// **Size limit at compile time.** The compiler evaluates about `4N³` flops;
-            /// past a budget of evaluation steps rustc stops the build with the
-            /// `long_running_const_eval` lint (deny by default). Measured with rustc 1.95:
-            /// `Linear<f32, N>` compiles in a `static` up to `N = 63` and stops at 64 (the
-            /// largest size is pinned by `tests/constructors.rs`). Larger `N` needs
-            /// `#![allow(long_running_const_eval)]` at the crate root of the firmware, or
-            /// [`Linear::new`] at run time.
-            ///
-            /// Errors: as [`Linear::new`].
-            pub const fn $from_rows(
-                m: Rows<N>,
-                c: Rows<N>,
-                k: Rows<N>,
-                h: f64,
-            ) -> Result<Self, Error> {
-                match Kernel::<$t, N, AemKinematics<$t>>::from_rows_aem(&m, &c, &k, h) {
-                    Ok(kernel) => Ok(Self { kernel }),
-                    Err(e) => Err(e),
-                }
-            }
-
-            /// The time step `h` (s), usable in `const` contexts: the same value as
-            /// [`Stepper::time_step`](crate::Stepper::time_step), which generic code (`S:
-            /// Stepper<T, N>`) still calls. Cost: none.
-            pub const fn time_step(&self) -> $t {
-                self.kernel.kin.h
-            }
-        }
-    };
-}
-const_ctor!(f32, from_rows_f32);
-const_ctor!(f64, from_rows_f64);
+// Const-fn construction, for operators computed at compile time into flash.
+aem_const_ctors!(
+    Linear,
+    /// `const fn` twin of [`Linear::new`]: `M, C, K` as row-major `f64` arrays
+    /// (`m[i][j]` is row `i`, column `j`), `h` in seconds. Bit-identical to
+    /// [`Linear::new`] given the same values. `from_rows_f32` builds a
+    /// `Linear<f32, N>`, `from_rows_f64` a `Linear<f64, N>`: the scalar in the name
+    /// lets a typed `static` infer `N` with no turbofish.
+    ///
+    /// **Matrices are row-major** (`m[i][j]`: row `i`, column `j`; [`Rows`](crate::models::Rows)); to pass
+    /// nalgebra data use [`models::rows_of`](crate::models::rows_of), and to convert these
+    /// arrays to nalgebra use [`models::matrix_of`](crate::models::matrix_of), not `SMatrix::from`,
+    /// which reads columns.
+    ///
+    /// In a `static`, the operators are evaluated by the compiler and no
+    /// factorization code is linked in:
+    ///
+    /// ```
+    /// use aemstep::Linear;
+    /// static SYS: Linear<f32, 1> = match Linear::from_rows_f32(
+    ///     [[1.0]], [[0.28]], [[4.0]], 0.002,
+    /// ) {
+    ///     Ok(s) => s,
+    ///     Err(e) => panic!("{}", e.as_str()),
+    /// };
+    /// assert_eq!(SYS.time_step(), 0.002);
+    /// ```
+    ///
+    /// **Size limit at compile time.** The compiler evaluates about `4N³` flops;
+    /// past a budget of evaluation steps rustc stops the build with the
+    /// `long_running_const_eval` lint (deny by default). Measured with rustc 1.95:
+    /// `Linear<f32, N>` compiles in a `static` up to `N = 63` and stops at 64 (the
+    /// largest size is pinned by `tests/constructors.rs`). Larger `N` needs
+    /// `#![allow(long_running_const_eval)]` at the crate root of the firmware, or
+    /// [`Linear::new`] at run time.
+    ///
+    /// Errors: as [`Linear::new`].
+);
 
 kernel_stepper!(Linear);

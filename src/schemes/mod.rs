@@ -21,7 +21,7 @@ mod newmark;
 pub use aform::AForm;
 pub use compensated::{CompensatedLinear, CompensatedState};
 pub use exact::Exact;
-pub(crate) use exact::exponential_blocks;
+pub(crate) use exact::{Exponential, exponential};
 pub(crate) use generalized_alpha::alpha_operators;
 pub use generalized_alpha::{AlphaParameters, GeneralizedAlpha};
 pub use input::LinearInput;
