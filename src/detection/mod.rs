@@ -294,7 +294,6 @@ impl<T, const S: usize, const I: usize, const O: usize> Innovations
 /// one of the crate's estimators' (e.g. `Dof::<3>` for a filter of your own with three
 /// independent innovation directions). Zero-sized.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Dof<const K: usize>;
 
 impl<const K: usize> Innovations for Dof<K> {
