@@ -47,9 +47,10 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::InputModel;
-use super::joint::{JointEstimate, joint_start, shift};
-use crate::linalg::{self, all_finite, finite_as, identity, matrix_t, round_rows, sym};
+use super::joint::{JointEstimate, joint_start, joint_start_covariances, shift};
+use crate::linalg::{self, finite_as, identity, matrix_t, round_rows, sym};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
+use crate::observer::{gain_t, innovation_t, predict_t, short_form_t};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real};
 
@@ -177,37 +178,14 @@ pub struct DualFilter<T, const S: usize, const I: usize, const O: usize> {
     order: DualOrder,
 }
 
-/// Every operator finite and fitting `T`.
+/// Every operator finite and fitting `T` (the checks of every fixed-gain estimator).
 const fn dual_checks<const S: usize, const I: usize, const O: usize>(
     model: &InputModel<S, I, O>,
     gains: &DualGains<S, I, O>,
     max: f64,
 ) -> Result<(), Error> {
     let (gw, gx) = (&gains.input.gain, &gains.state.gain);
-    if !(all_finite(&model.a)
-        && all_finite(&model.b)
-        && all_finite(&model.c)
-        && all_finite(&model.d)
-        && all_finite(&model.gamma1)
-        && all_finite(gw)
-        && all_finite(gx))
-    {
-        return Err(Error::NonFiniteInput);
-    }
-    if let Err(e) = crate::kinematics::check_time_step_as(model.time_step, max) {
-        return Err(e);
-    }
-    if !(finite_as(&model.a, max)
-        && finite_as(&model.b, max)
-        && finite_as(&model.c, max)
-        && finite_as(&model.d, max)
-        && finite_as(&model.gamma1, max)
-        && finite_as(gw, max)
-        && finite_as(gx, max))
-    {
-        return Err(Error::OperatorOverflow);
-    }
-    Ok(())
+    model.check_fixed_gains(gx, gx, gw, max)
 }
 
 impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I, O> {
@@ -662,11 +640,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
         w0: &SVector<T, I>,
         pw0: &SMatrix<T, I, I>,
     ) -> Result<DualKalmanFilterState<T, S, I, O>, Error> {
-        let estimate = joint_start(&self.gamma1, x0, w0)?;
-        let (pr, pwr) = (linalg::rows_f64(p0), linalg::rows_f64(pw0));
-        if !(is_covariance(&pr, false) && is_covariance(&pwr, false)) {
-            return Err(Error::InvalidCovariance);
-        }
+        let estimate = joint_start_covariances(&self.gamma1, x0, p0, w0, pw0)?;
         Ok(DualKalmanFilterState {
             estimate,
             p: *p0,
@@ -683,10 +657,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
         &self,
         s: &DualKalmanFilterState<T, S, I, O>,
     ) -> (SMatrix<T, S, S>, SMatrix<T, I, I>) {
-        (
-            sym(&(self.a * s.p * self.a.transpose() + self.q)),
-            sym(&(s.pw + self.qw)),
-        )
+        (predict_t(&self.a, &s.p, &self.q), sym(&(s.pw + self.qw)))
     }
 
     /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I`.
@@ -720,21 +691,21 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
         if present {
             // Input stage (the paper's Steps 1–3): the random walk measured through D̃,
             // its innovation from the previous filtered state.
-            let dp = self.d * pwm;
-            let sw = sym(&(dp * self.d.transpose() + self.r));
+            // Each stage is the Kalman core's correction (no cross term) in the paper's
+            // short form.
+            let (dp, sw) = innovation_t(&pwm, &self.d, &self.r, None);
             let cw = sw.cholesky().ok_or(Error::InvalidCovariance)?;
-            let gw = cw.solve(&dp).transpose();
+            let gw = gain_t(&cw, &dp);
             let w = e.w + gw * (y - self.c * e.xi - self.d * e.w);
             // State stage (Steps 4–6): predicted with the new ŵ_n.
             let xp = self.a * e.xi + self.b * w;
-            let cp = self.c * pm;
-            let sx = sym(&(cp * self.c.transpose() + self.r));
+            let (cp, sx) = innovation_t(&pm, &self.c, &self.r, None);
             let cx = sx.cholesky().ok_or(Error::InvalidCovariance)?;
-            let gx = cx.solve(&cp).transpose();
+            let gx = gain_t(&cx, &cp);
             next.estimate.xi = xp + gx * (y - self.c * xp - self.d * w);
             next.estimate.w = w;
-            next.pw = sym(&(pwm - gw * dp));
-            next.p = sym(&(pm - gx * cp));
+            next.pw = short_form_t(&pwm, &gw, &dp);
+            next.p = short_form_t(&pm, &gx, &cp);
             next.gain_w = gw;
             next.gain_x = gx;
         } else {

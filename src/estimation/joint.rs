@@ -495,6 +495,25 @@ pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
     }
 }
 
+/// The start of a time-varying joint filter ([`InputStateFilter`], the dual
+/// [`DualKalmanFilter`](super::DualKalmanFilter)): [`joint_start`], and the covariances of
+/// `ξ̂_0` (`p0`, `S×S`) and `ŵ_0` (`pw0`, `I×I`) symmetric positive semidefinite.
+/// Errors: [`Error::NonFiniteInput`], [`Error::InvalidCovariance`]. Cost: `O(S³ + I³)`.
+pub(super) fn joint_start_covariances<T: Real, const S: usize, const I: usize>(
+    gamma1: &[[T; I]; S],
+    x0: &SVector<T, S>,
+    p0: &SMatrix<T, S, S>,
+    w0: &SVector<T, I>,
+    pw0: &SMatrix<T, I, I>,
+) -> Result<JointEstimate<T, S, I>, Error> {
+    let estimate = joint_start(gamma1, x0, w0)?;
+    let (pr, pwr): (Mat<S, S>, Mat<I, I>) = (rows_f64(p0), rows_f64(pw0));
+    if !(is_covariance(&pr, false) && is_covariance(&pwr, false)) {
+        return Err(Error::InvalidCovariance);
+    }
+    Ok(estimate)
+}
+
 /// The fixed-gain joint input–state filter (the steady state of Gillijns & De Moor 2007)
 /// on `S` states, `I` unknown inputs, `O` measurements:
 ///
@@ -556,30 +575,12 @@ const fn observer_parts<const S: usize, const I: usize, const O: usize>(
     gains: &InputStateGains<S, I, O>,
     max: f64,
 ) -> Result<Mat<S, O>, Error> {
-    if !(all_finite(&gains.state_gain)
-        && all_finite(&gains.input_gain)
-        && all_finite(&model.a)
-        && all_finite(&model.b)
-        && all_finite(&model.c)
-        && all_finite(&model.d)
-        && all_finite(&model.gamma1))
-    {
-        return Err(Error::NonFiniteInput);
-    }
-    if let Err(e) = crate::kinematics::check_time_step_as(model.time_step, max) {
-        return Err(e);
-    }
+    // (`L` from unchecked gains is only compared, never kept: the checks come first in
+    // effect.)
     let kd = mul(&gains.state_gain, &model.d);
     let l = add_scaled(&gains.state_gain, -1.0, &mul(&kd, &gains.input_gain));
-    if !(finite_as(&model.a, max)
-        && finite_as(&model.b, max)
-        && finite_as(&model.c, max)
-        && finite_as(&model.gamma1, max)
-        && finite_as(&model.d, max)
-        && finite_as(&l, max)
-        && finite_as(&gains.input_gain, max))
-    {
-        return Err(Error::OperatorOverflow);
+    if let Err(e) = model.check_fixed_gains(&gains.state_gain, &l, &gains.input_gain, max) {
+        return Err(e);
     }
     Ok(l)
 }
@@ -918,11 +919,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         w0: &SVector<T, I>,
         pw0: &SMatrix<T, I, I>,
     ) -> Result<InputStateFilterState<T, S, I, O>, Error> {
-        let estimate = joint_start(&self.gamma1, x0, w0)?;
-        let (pr, pwr): (Mat<S, S>, Mat<I, I>) = (rows_f64(p0), rows_f64(pw0));
-        if !(is_covariance(&pr, false) && is_covariance(&pwr, false)) {
-            return Err(Error::InvalidCovariance);
-        }
+        let estimate = joint_start_covariances(&self.gamma1, x0, p0, w0, pw0)?;
         Ok(InputStateFilterState {
             estimate,
             p: *p0,

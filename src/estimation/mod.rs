@@ -179,7 +179,7 @@ pub const RANK_TOLERANCE: f64 = 1e-10;
 impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
     /// Every matrix finite: the estimators' first check of a model (which may have been
     /// built or edited by hand). Errors: [`Error::NonFiniteInput`].
-    pub(crate) fn check_finite(&self) -> Result<(), Error> {
+    pub(crate) const fn check_finite(&self) -> Result<(), Error> {
         if all_finite(&self.a)
             && all_finite(&self.b)
             && all_finite(&self.c)
@@ -194,12 +194,43 @@ impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
 
     /// Every matrix rounds to a finite value of the scalar type whose largest finite value
     /// is `max`.
-    pub(crate) fn fits(&self, max: f64) -> bool {
+    pub(crate) const fn fits(&self, max: f64) -> bool {
         finite_as(&self.a, max)
             && finite_as(&self.b, max)
             && finite_as(&self.c, max)
             && finite_as(&self.d, max)
             && finite_as(&self.gamma1, max)
+    }
+
+    /// The checks of a fixed-gain estimator on this model (`const fn`, the run-time
+    /// constructors and the `const fn` twins alike): the model, the state gain `gx`
+    /// (`S×O`) and the input gain `gw` (`I×O`) finite, the time step a valid one of the
+    /// scalar type whose largest finite value is `max`, and the model, `stored` (the
+    /// state gain as the estimator keeps it: `gx` itself, or the joint filter's
+    /// `L = K (I − D̃ M)`) and `gw` fitting that type.
+    ///
+    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
+    /// [`Error::OperatorOverflow`]. Cost: `O(S² + S·O)` comparisons.
+    pub(crate) const fn check_fixed_gains(
+        &self,
+        gx: &Mat<S, O>,
+        stored: &Mat<S, O>,
+        gw: &Mat<I, O>,
+        max: f64,
+    ) -> Result<(), Error> {
+        if let Err(e) = self.check_finite() {
+            return Err(e);
+        }
+        if !(all_finite(gx) && all_finite(gw)) {
+            return Err(Error::NonFiniteInput);
+        }
+        if let Err(e) = crate::kinematics::check_time_step_as(self.time_step, max) {
+            return Err(e);
+        }
+        if !(self.fits(max) && finite_as(stored, max) && finite_as(gw, max)) {
+            return Err(Error::OperatorOverflow);
+        }
+        Ok(())
     }
 
     /// The standard form of `model` measured by `meas` (`const fn`): `A = Φ`,

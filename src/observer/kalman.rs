@@ -5,9 +5,9 @@ use nalgebra::{SMatrix, SVector};
 
 use super::fixed::{Estimate, initial_estimate};
 use super::kalman_core::is_covariance;
-use super::kalman_core::{cross_is_valid, gain_t, innovation_t, is_zero, joseph_t};
+use super::kalman_core::{cross_is_valid, gain_t, innovation_t, is_zero, joseph_t, predict_t};
 use super::state_space::{Measurement, StateSpace};
-use crate::linalg::{Mat, all_finite, finite_as, matrix_t, rows_f64, sym};
+use crate::linalg::{Mat, all_finite, finite_as, matrix_t, rows_f64};
 use crate::{Error, Real};
 
 /// The state of a [`Kalman`] filter: the [`Estimate`] and its a-posteriori error
@@ -160,7 +160,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
     /// The a-priori covariance of the next step, `P⁻ = Φ P Φᵀ + Q` (what converges to
     /// the Riccati solution). Cost: `2S³`.
     pub fn predicted_covariance(&self, s: &KalmanState<T, S, I>) -> SMatrix<T, S, S> {
-        sym(&(self.phi * s.p * self.phi.transpose() + self.q))
+        predict_t(&self.phi, &s.p, &self.q)
     }
 
     /// One filter step with input `w` (`w_n`) and measurement `y` (a non-finite entry:

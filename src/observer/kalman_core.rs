@@ -242,3 +242,25 @@ pub(crate) fn joseph_t<T: Real, const S: usize, const O: usize>(
         }
     }
 }
+
+/// The a-priori covariance `P⁻ = Φ P Φᵀ + Q`, symmetrized: the prediction of the
+/// time-varying filters whose state noise enters alone (the Kalman filter, the dual
+/// filter's state stage). Cost: `2S³` multiply-adds.
+pub(crate) fn predict_t<T: Real, const S: usize>(
+    phi: &SMatrix<T, S, S>,
+    p: &SMatrix<T, S, S>,
+    q: &SMatrix<T, S, S>,
+) -> SMatrix<T, S, S> {
+    sym(&(phi * p * phi.transpose() + q))
+}
+
+/// The a-posteriori covariance in the short form, `P⁻ − K Xᵀ` (`Xᵀ = H P⁻` of
+/// [`innovation_t`] without a cross term), symmetrized: the form of the filters that
+/// publish it (the dual filter's stages). Cost: `S²·O` multiply-adds.
+pub(crate) fn short_form_t<T: Real, const S: usize, const O: usize>(
+    pm: &SMatrix<T, S, S>,
+    k: &SMatrix<T, S, O>,
+    xt: &SMatrix<T, O, S>,
+) -> SMatrix<T, S, S> {
+    sym(&(pm - k * xt))
+}

@@ -88,6 +88,7 @@ pub use kalman::{Kalman, KalmanState};
 // For the joint input–state estimators (`crate::estimation`).
 pub(crate) use kalman_core::{
     cross_is_valid, cross_riccati_start, gain_t, innovation_parts, innovation_t, is_zero,
+    predict_t, short_form_t,
 };
 pub(crate) use kalman_core::{is_covariance, symmetrize};
 pub(crate) use riccati::{A_SMALL, balance, doubling, inf_norm};
