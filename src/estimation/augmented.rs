@@ -206,21 +206,14 @@ impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedMo
 
 #[cfg(test)]
 mod tests {
+    use super::super::roof_force_fixture;
     use super::*;
-    use crate::models;
-    use crate::observer::Outputs;
 
     /// Regression: `from_parts` did not check `Γ₁`, and a NaN there gave NaN states from
     /// `split`; it is now refused with a typed error.
     #[test]
     fn augmented_model_refuses_a_non_finite_gamma1() {
-        let (m, c, k) = models::five_storey_building();
-        let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02).unwrap();
-        let mut out = Outputs::<5, 1, 2>::zero();
-        out.a[0][4] = 1.0;
-        out.u[1][4] = 1.0;
-        let mut model = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
+        let mut model = roof_force_fixture();
         let q = [[0.0; 10]; 10];
         let qw = [[1.0]];
         assert!(AugmentedModel::<10, 1, 11, 2>::from_parts(&model, &q, &qw).is_ok());

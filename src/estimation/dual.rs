@@ -64,6 +64,32 @@ pub struct DualGains<const S: usize, const I: usize, const O: usize> {
     pub state: SteadyState<S, O>,
 }
 
+/// One stage of the dual filter as a model with no known input, `x_n = Φ x_{n−1}`,
+/// `y_n = H x_n` (time step `h`, s), for [`SteadyState::from_parts`]. Cost: a copy.
+const fn stage<const S: usize, const O: usize>(
+    phi: [[f64; S]; S],
+    h: [[f64; S]; O],
+    time_step: f64,
+) -> (StateSpace<0, S, 0>, Measurement<S, 0, O>) {
+    let model = StateSpace::<0, S, 0> {
+        phi,
+        gamma0: [[0.0; 0]; S],
+        gamma1: [[0.0; 0]; S],
+        dof_u: [],
+        dof_v: [],
+        dof_a: [],
+        dof_a_input: [],
+        time_step,
+    };
+    (
+        model,
+        Measurement {
+            h,
+            d: [[0.0; 0]; O],
+        },
+    )
+}
+
 impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
     /// The two steady gains (`const fn`): input stage with the random walk's covariance
     /// `qw` (`I×I`, input units squared per step), state stage with `q` (`S×S` on `ξ`),
@@ -81,39 +107,13 @@ impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
         qw: &[[f64; I]; I],
         r: &[[f64; O]; O],
     ) -> Result<Self, Error> {
-        let input_model = StateSpace::<0, I, 0> {
-            phi: identity(),
-            gamma0: [[0.0; 0]; I],
-            gamma1: [[0.0; 0]; I],
-            dof_u: [],
-            dof_v: [],
-            dof_a: [],
-            dof_a_input: [],
-            time_step: model.time_step,
-        };
-        let input_meas = Measurement::<I, 0, O> {
-            h: model.d,
-            d: [[0.0; 0]; O],
-        };
+        let (input_model, input_meas) = stage(identity(), model.d, model.time_step);
         let input = match SteadyState::from_parts(&input_model, &input_meas, qw, r) {
             Ok(s) => s,
             Err(Error::RiccatiNotConverged) => return Err(Error::InputNotIdentifiable),
             Err(e) => return Err(e),
         };
-        let state_model = StateSpace::<0, S, 0> {
-            phi: model.a,
-            gamma0: [[0.0; 0]; S],
-            gamma1: [[0.0; 0]; S],
-            dof_u: [],
-            dof_v: [],
-            dof_a: [],
-            dof_a_input: [],
-            time_step: model.time_step,
-        };
-        let state_meas = Measurement::<S, 0, O> {
-            h: model.c,
-            d: [[0.0; 0]; O],
-        };
+        let (state_model, state_meas) = stage(model.a, model.c, model.time_step);
         let state = match SteadyState::from_parts(&state_model, &state_meas, q, r) {
             Ok(s) => s,
             Err(e) => return Err(e),

@@ -5,12 +5,12 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::InputModel;
-use crate::linalg::{self, Mat, add_scaled, all_finite, finite_as, identity, max_abs, mul};
+use crate::linalg::{self, Mat, add_scaled, all_finite, identity, max_abs, mul};
 use crate::linalg::{matrix_t, round_rows, rows_f64, sym, transpose};
-use crate::observer::{A_SMALL, balance, doubling, inf_norm, is_covariance, lu_of, symmetrize};
-use crate::observer::{
-    cross_is_valid, cross_riccati_start, gain_t, innovation_parts, innovation_t, is_zero,
-};
+use crate::observer::symmetrize;
+use crate::observer::{A_SMALL, balance, doubling_solution, inf_norm, is_covariance, lu_of};
+use crate::observer::{checked_cross_t, cross_is_valid, cross_riccati_start, gain_t};
+use crate::observer::{innovation_parts, innovation_t, is_zero, noise_fits};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
 
@@ -285,17 +285,14 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
                 Err(e) => return Err(e),
             },
         };
-        let (x, k, converged) = match doubling(start.0, start.1, start.2, STEADY_MAX_ITERATIONS) {
+        // With the cross term the doubling solved for Y: P⁻ = Y + Q.
+        let q_cross = match n {
+            None => None,
+            Some(_) => Some(q),
+        };
+        let (x, k) = match doubling_solution(start, STEADY_MAX_ITERATIONS, q_cross) {
             Some(v) => v,
             None => return Err(Error::InputNotIdentifiable),
-        };
-        if !(converged && is_covariance(&x, false)) {
-            return Err(Error::InputNotIdentifiable);
-        }
-        // With the cross term the doubling solved for Y: P⁻ = Y + Q.
-        let x = match n {
-            None => x,
-            Some(_) => symmetrize(&add_scaled(&x, 1.0, &symmetrize(q))),
         };
         let (kx, gm, pw, rt) = match step_gains(model, &x, r, n) {
             Some(v) => v,
@@ -884,15 +881,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         }
         model.check_finite()?;
         model.weighted_feedthrough(&rr)?;
-        let zero = is_zero(n);
-        if !zero && !cross_is_valid(&qr, &rr, n) {
-            return Err(Error::InvalidCovariance);
-        }
-        let fits = model.fits(T::MAX)
-            && finite_as(&qr, T::MAX)
-            && finite_as(&rr, T::MAX)
-            && finite_as(n, T::MAX);
-        if !fits {
+        let cross = checked_cross_t(&qr, &rr, n)?;
+        if !(model.fits(T::MAX) && noise_fits(&qr, &rr, n, T::MAX)) {
             return Err(Error::OperatorOverflow);
         }
         Ok(Self {
@@ -903,7 +893,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
             gamma1: round_rows(&model.gamma1),
             q: matrix_t(&qr),
             r: matrix_t(&rr),
-            cross: if zero { None } else { Some(matrix_t(n)) },
+            cross,
         })
     }
 
@@ -1015,19 +1005,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
 
 #[cfg(test)]
 mod tests {
+    use super::super::roof_force_fixture as model;
     use super::*;
-    use crate::models;
-    use crate::observer::{Outputs, StateSpace};
-
-    fn model() -> InputModel<10, 1, 2> {
-        let (m, c, k) = models::five_storey_building();
-        let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02).unwrap();
-        let mut out = Outputs::<5, 1, 2>::zero();
-        out.a[0][4] = 1.0;
-        out.u[1][4] = 1.0;
-        InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap()
-    }
 
     /// Regression: the checked steps of the joint estimators wrapped their counters
     /// (`u64::MAX + 1 = 0`); they now refuse with a typed error, the state unchanged.

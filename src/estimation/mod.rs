@@ -374,3 +374,18 @@ const fn full_rank<const I: usize>(f: &Mat<I, I>) -> bool {
     }
     true
 }
+
+/// The fixture of the estimators' unit tests: the 5-storey building (AEM, `h = 0.02` s)
+/// with an unknown force at the roof, the roof's absolute acceleration and displacement
+/// measured.
+#[cfg(test)]
+fn roof_force_fixture() -> InputModel<10, 1, 2> {
+    use crate::observer::Outputs;
+    let (m, c, k) = crate::models::five_storey_building();
+    let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
+    let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02).unwrap();
+    let mut out = Outputs::<5, 1, 2>::zero();
+    out.a[0][4] = 1.0;
+    out.u[1][4] = 1.0;
+    InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap()
+}

@@ -387,21 +387,13 @@ lag_const!(f64, from_parts_f64);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::{self, base_excitation};
-    use crate::observer::Outputs;
+    use crate::observer::building_fixture;
 
     /// Regression: the smoother's step wrapped its counters (`u64::MAX + 1 = 0`); it now
     /// refuses with a typed error, the state unchanged.
     #[test]
     fn smoother_refuses_to_wrap_its_counters() {
-        let (m, c, k) = models::five_storey_building();
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02).unwrap();
-        let meas = ss
-            .outputs(&Outputs::absolute_accelerations(
-                Outputs::<5, 1, 2>::select([1, 4]),
-                0,
-            ))
-            .unwrap();
+        let (ss, meas) = building_fixture();
         let q = SMatrix::<f64, 10, 10>::identity() * 1e-10;
         let r = SMatrix::<f64, 2, 2>::identity() * 0.01;
         let kf = SteadyState::new(&ss, &meas, &q, &r).unwrap();

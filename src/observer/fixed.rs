@@ -437,21 +437,13 @@ readout_const!(f64, from_parts_f64);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::{self, base_excitation};
-    use crate::observer::Outputs;
+    use crate::observer::building_fixture;
 
     /// Regression: the checked step wrapped its counters (`u64::MAX + 1 = 0`); it now
     /// refuses with a typed error and leaves the estimate bit-identical.
     #[test]
     fn observer_try_step_refuses_to_wrap_its_counters() {
-        let (m, c, k) = models::five_storey_building();
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02).unwrap();
-        let meas = ss
-            .outputs(&Outputs::absolute_accelerations(
-                Outputs::<5, 1, 2>::select([1, 4]),
-                0,
-            ))
-            .unwrap();
+        let (ss, meas) = building_fixture();
         let obs = Observer::<f64, 10, 1, 2>::new(&ss, &meas, &SMatrix::zeros()).unwrap();
         let w = SVector::from([0.1]);
         let mut e = obs.start_at_rest(&w).unwrap();

@@ -5,7 +5,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::fixed::{Estimate, initial_estimate};
 use super::kalman_core::is_covariance;
-use super::kalman_core::{cross_is_valid, gain_t, innovation_t, is_zero, joseph_t, predict_t};
+use super::kalman_core::{checked_cross_t, gain_t, innovation_t, joseph_t, noise_fits, predict_t};
 use super::state_space::{Measurement, StateSpace};
 use crate::linalg::{Mat, all_finite, finite_as, matrix_t, rows_f64};
 use crate::{Error, Real};
@@ -109,10 +109,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         if !(is_covariance(&qr, false) && is_covariance(&rr, true)) {
             return Err(Error::InvalidCovariance);
         }
-        let zero = is_zero(n);
-        if !zero && !cross_is_valid(&qr, &rr, n) {
-            return Err(Error::InvalidCovariance);
-        }
+        let cross = checked_cross_t(&qr, &rr, n)?;
         if !(all_finite(&meas.h) && all_finite(&meas.d)) {
             return Err(Error::NonFiniteInput);
         }
@@ -121,9 +118,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
             && finite_as(&model.gamma1, T::MAX)
             && finite_as(&meas.h, T::MAX)
             && finite_as(&meas.d, T::MAX)
-            && finite_as(&qr, T::MAX)
-            && finite_as(&rr, T::MAX)
-            && finite_as(n, T::MAX);
+            && noise_fits(&qr, &rr, n, T::MAX);
         if !fits {
             return Err(Error::OperatorOverflow);
         }
@@ -135,7 +130,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
             d: matrix_t(&meas.d),
             q: matrix_t(&qr),
             r: matrix_t(&rr),
-            cross: if zero { None } else { Some(matrix_t(n)) },
+            cross,
         })
     }
 
@@ -241,21 +236,13 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::{self, base_excitation};
-    use crate::observer::Outputs;
+    use crate::observer::building_fixture;
 
     /// Regression: the checked step wrapped its counters (`u64::MAX + 1 = 0`); it now
     /// refuses with a typed error and leaves the state bit-identical.
     #[test]
     fn kalman_step_refuses_to_wrap_its_counters() {
-        let (m, c, k) = models::five_storey_building();
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02).unwrap();
-        let meas = ss
-            .outputs(&Outputs::absolute_accelerations(
-                Outputs::<5, 1, 2>::select([1, 4]),
-                0,
-            ))
-            .unwrap();
+        let (ss, meas) = building_fixture();
         let q = SMatrix::<f64, 10, 10>::identity() * 1e-10;
         let r = SMatrix::<f64, 2, 2>::identity() * 0.01;
         let kal = Kalman::<f64, 10, 1, 2>::new(&ss, &meas, &q, &r).unwrap();

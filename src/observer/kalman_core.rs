@@ -43,10 +43,11 @@
 use nalgebra::{Cholesky, SMatrix};
 
 use super::state_space::lu_of;
-use crate::Real;
 use crate::linalg::cholesky::cholesky;
 use crate::linalg::lu::Lu;
-use crate::linalg::{Mat, add_scaled, all_finite, is_symmetric, max_abs, mul, sym, transpose};
+use crate::linalg::{Mat, add_scaled, all_finite, finite_as, is_symmetric, matrix_t, max_abs};
+use crate::linalg::{mul, sym, transpose};
+use crate::{Error, Real};
 
 /// `a` symmetric to `64 ε max|a|` and all finite.
 const fn symmetric<const N: usize>(a: &Mat<N, N>) -> bool {
@@ -263,4 +264,34 @@ pub(crate) fn short_form_t<T: Real, const S: usize, const O: usize>(
     xt: &SMatrix<T, O, S>,
 ) -> SMatrix<T, S, S> {
     sym(&(pm - k * xt))
+}
+
+/// The cross covariance `n` (`S×O`) of a time-varying filter with noises `q` (`S×S`) and
+/// `r` (`O×O`, both checked by the caller), rounded to `T`: `None` when every entry is
+/// exactly zero (the filters' original code path, bit for bit), else `n` after
+/// [`cross_is_valid`]. Whether `n` fits `T` is [`noise_fits`]'s to say.
+/// Errors: [`Error::InvalidCovariance`]. Cost: as [`cross_is_valid`].
+pub(crate) fn checked_cross_t<T: Real, const S: usize, const O: usize>(
+    q: &Mat<S, S>,
+    r: &Mat<O, O>,
+    n: &Mat<S, O>,
+) -> Result<Option<SMatrix<T, S, O>>, Error> {
+    if is_zero(n) {
+        Ok(None)
+    } else if cross_is_valid(q, r, n) {
+        Ok(Some(matrix_t(n)))
+    } else {
+        Err(Error::InvalidCovariance)
+    }
+}
+
+/// The noise model `q` (`S×S`), `r` (`O×O`) and `n` (`S×O`) rounds to finite values of the
+/// scalar type whose largest finite value is `max`. Cost: `S² + O² + S·O` comparisons.
+pub(crate) const fn noise_fits<const S: usize, const O: usize>(
+    q: &Mat<S, S>,
+    r: &Mat<O, O>,
+    n: &Mat<S, O>,
+    max: f64,
+) -> bool {
+    finite_as(q, max) && finite_as(r, max) && finite_as(n, max)
 }
