@@ -47,7 +47,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::InputModel;
-use super::joint::{JointEstimate, joint_start, joint_start_covariances, shift};
+use super::joint::{JointEstimate, check_counts, joint_start_covariances};
 use crate::linalg::{self, finite_as, identity, matrix_t, round_rows, sym};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
 use crate::observer::{gain_t, innovation_t, predict_t, short_form_t};
@@ -188,6 +188,8 @@ const fn dual_checks<const S: usize, const I: usize, const O: usize>(
     model.check_fixed_gains(gx, gx, gw, max)
 }
 
+joint_accessors!(fixed DualFilter);
+
 impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I, O> {
     /// The dual filter of `model` with the steady `gains`, rounded once to `T`.
     ///
@@ -220,26 +222,6 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
         self.order
     }
 
-    /// The time step `h` (s).
-    pub fn time_step(&self) -> T {
-        self.time_step
-    }
-
-    /// The start from a physical state `x0` and input `w0` (`ξ̂_0 = x0 − Γ₁ w0`).
-    /// Errors: [`Error::NonFiniteInput`].
-    pub fn start(
-        &self,
-        x0: &SVector<T, S>,
-        w0: &SVector<T, I>,
-    ) -> Result<JointEstimate<T, S, I>, Error> {
-        joint_start(&self.gamma1, x0, w0)
-    }
-
-    /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I`.
-    pub fn state(&self, e: &JointEstimate<T, S, I>) -> SVector<T, S> {
-        shift(&self.gamma1, &e.xi, &e.w, T::one())
-    }
-
     /// One step of the joint error dynamics without noise (a constant input and state
     /// increment, exact data): the errors `(ξ − ξ̂, w − ŵ)` of a step from the errors
     /// `(ex, ew)` before it, in the filter's [`DualOrder`]:
@@ -261,57 +243,19 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
         ex: &SVector<T, S>,
         ew: &SVector<T, I>,
     ) -> (SVector<T, S>, SVector<T, I>) {
-        let predict = |ex: &SVector<T, S>, ew: &SVector<T, I>| {
-            SVector::<T, S>::from_fn(|i, _| {
-                let mut s = T::zero();
-                for j in 0..S {
-                    s += self.a[i][j] * ex[j];
-                }
-                for j in 0..I {
-                    s += self.b[i][j] * ew[j];
-                }
-                s
-            })
-        };
-        let output = |ex: &SVector<T, S>, ew: &SVector<T, I>| {
-            SVector::<T, O>::from_fn(|o, _| {
-                let mut s = T::zero();
-                for j in 0..S {
-                    s += self.c[o][j] * ex[j];
-                }
-                for j in 0..I {
-                    s += self.d[o][j] * ew[j];
-                }
-                s
-            })
-        };
-        let input_stage = |nu: &SVector<T, O>| {
-            SVector::<T, I>::from_fn(|i, _| {
-                let mut s = ew[i];
-                for o in 0..O {
-                    s -= self.gain_w[i][o] * nu[o];
-                }
-                s
-            })
-        };
+        let predict = |ex: &SVector<T, S>, ew: &SVector<T, I>| mul2(&self.a, &self.b, ex, ew);
+        let output = |ex: &SVector<T, S>, ew: &SVector<T, I>| mul2(&self.c, &self.d, ex, ew);
         let (em, ew1) = match self.order {
             DualOrder::Paper => {
-                let ew1 = input_stage(&output(ex, ew));
+                let ew1 = less_gain(ew, &self.gain_w, &output(ex, ew));
                 (predict(ex, &ew1), ew1)
             }
             DualOrder::PredictedState => {
                 let em = predict(ex, ew);
-                (em, input_stage(&output(&em, ew)))
+                (em, less_gain(ew, &self.gain_w, &output(&em, ew)))
             }
         };
-        let nu2 = output(&em, &ew1);
-        let ex1 = SVector::<T, S>::from_fn(|i, _| {
-            let mut s = em[i];
-            for o in 0..O {
-                s -= self.gain_x[i][o] * nu2[o];
-            }
-            s
-        });
+        let ex1 = less_gain(&em, &self.gain_x, &output(&em, &ew1));
         (ex1, ew1)
     }
 
@@ -416,12 +360,45 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
     /// counter would pass `u64::MAX` (1.8e19 steps: 2.9 million years at 200 kHz, so only
     /// a corrupted or forged estimate), `e` unchanged.
     pub fn try_step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) -> Result<(), Error> {
-        let missing = u64::from(!y.iter().all(|v| v.is_finite()));
-        if e.n.checked_add(1).is_none() || e.missing.checked_add(missing).is_none() {
-            return Err(Error::StepCountOverflow);
-        }
+        check_counts(e, y)?;
         commit_if_finite(e, |next| self.step(next, y))
     }
+}
+
+/// `M₁ e_ξ + M₂ e_w` (from `+0`, `M₁`'s terms first): the error dynamics' prediction
+/// (`A`, `B`) and output (`C`, `D̃`). Cost: `R·(S + I)` multiply-adds.
+fn mul2<T: Real, const R: usize, const S: usize, const I: usize>(
+    m1: &[[T; S]; R],
+    m2: &[[T; I]; R],
+    ex: &SVector<T, S>,
+    ew: &SVector<T, I>,
+) -> SVector<T, R> {
+    SVector::from_fn(|i, _| {
+        let mut s = T::zero();
+        for j in 0..S {
+            s += m1[i][j] * ex[j];
+        }
+        for j in 0..I {
+            s += m2[i][j] * ew[j];
+        }
+        s
+    })
+}
+
+/// `e − G ν`: an error after a stage's correction with gain `G`. Cost: `R·O`
+/// multiply-adds.
+fn less_gain<T: Real, const R: usize, const O: usize>(
+    e: &SVector<T, R>,
+    g: &[[T; O]; R],
+    nu: &SVector<T, O>,
+) -> SVector<T, R> {
+    SVector::from_fn(|i, _| {
+        let mut s = e[i];
+        for o in 0..O {
+            s -= g[i][o] * nu[o];
+        }
+        s
+    })
 }
 
 macro_rules! dual_const {
@@ -574,6 +551,8 @@ pub struct DualKalmanFilter<T, const S: usize, const I: usize, const O: usize> {
     time_step: T,
 }
 
+joint_accessors!(varying DualKalmanFilter, DualKalmanFilterState);
+
 impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T, S, I, O> {
     /// The filter of `model` with process noise `q` (`S×S` on `ξ`, symmetric positive
     /// semidefinite, units of `x` squared per step), the random walk's covariance `qw`
@@ -658,11 +637,6 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
         s: &DualKalmanFilterState<T, S, I, O>,
     ) -> (SMatrix<T, S, S>, SMatrix<T, I, I>) {
         (predict_t(&self.a, &s.p, &self.q), sym(&(s.pw + self.qw)))
-    }
-
-    /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I`.
-    pub fn state(&self, s: &DualKalmanFilterState<T, S, I, O>) -> SVector<T, S> {
-        shift(&self.gamma1, &s.estimate.xi, &s.estimate.w, T::one())
     }
 
     /// One filter step with the measurement `y` (`y_n`; a non-finite entry: missing).

@@ -582,6 +582,8 @@ const fn observer_parts<const S: usize, const I: usize, const O: usize>(
     Ok(l)
 }
 
+joint_accessors!(fixed InputStateObserver);
+
 impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver<T, S, I, O> {
     /// The fixed-gain filter of `model` with the steady-state `gains`, rounded once to `T`.
     ///
@@ -604,36 +606,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
         })
     }
 
-    /// The time step `h` (s).
-    pub fn time_step(&self) -> T {
-        self.time_step
-    }
-
-    /// The start from a physical state `x0` and input `w0`: `ξ̂_0 = x0 − Γ₁ w0`,
-    /// `ŵ_0 = w0`. Errors: [`Error::NonFiniteInput`].
-    pub fn start(
-        &self,
-        x0: &SVector<T, S>,
-        w0: &SVector<T, I>,
-    ) -> Result<JointEstimate<T, S, I>, Error> {
-        joint_start(&self.gamma1, x0, w0)
-    }
-
     /// The start at rest with no input (`ξ̂_0 = 0`, `ŵ_0 = 0`).
     pub fn start_at_rest(&self) -> JointEstimate<T, S, I> {
-        JointEstimate {
-            xi: SVector::zeros(),
-            w: SVector::zeros(),
-            n: 0,
-            missing: 0,
-        }
-    }
-
-    /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n` (`[u; v]` for a full model: read
-    /// drifts etc. from `(x̂_n, ŵ_n)` with a [`Readout`](crate::observer::Readout)).
-    /// Cost: `S·I` multiply-adds.
-    pub fn state(&self, e: &JointEstimate<T, S, I>) -> SVector<T, S> {
-        shift(&self.gamma1, &e.xi, &e.w, T::one())
+        JointEstimate::default()
     }
 
     /// One step with the measurement `y` (`y_n`). A non-finite entry of `y` is a missing
@@ -838,6 +813,8 @@ pub struct InputStateFilter<T, const S: usize, const I: usize, const O: usize> {
     cross: Option<SMatrix<T, S, O>>,
 }
 
+joint_accessors!(varying InputStateFilter, InputStateFilterState);
+
 impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T, S, I, O> {
     /// The filter of `model`, process noise `q` (`S×S` on `ξ`, symmetric positive
     /// semidefinite), measurement noise `r` (`O×O`, symmetric positive definite), in
@@ -929,11 +906,6 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
             + apb.transpose()
             + self.b * s.pw * self.b.transpose()
             + self.q))
-    }
-
-    /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I`.
-    pub fn state(&self, s: &InputStateFilterState<T, S, I, O>) -> SVector<T, S> {
-        shift(&self.gamma1, &s.estimate.xi, &s.estimate.w, T::one())
     }
 
     /// One filter step with the measurement `y` (`y_n`; a non-finite entry: missing).

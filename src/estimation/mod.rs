@@ -135,6 +135,51 @@
 //! checks it against the paper's recursion with the cross term written in the test, and the
 //! residual's `χ²_{O−I}` mean by simulation. (The dual filter does not take `N`.)
 
+/// The accessors the joint input–state estimators share (each keeps `gamma1: [[T; I]; S]`
+/// and, the fixed-gain ones, `time_step: T`): for a fixed-gain estimator on
+/// [`JointEstimate`] (`fixed`) the time step, the start and the physical state; for a
+/// time-varying one (`varying`, with its state type) the physical state.
+macro_rules! joint_accessors {
+    (fixed $ty:ident) => {
+        impl<T: $crate::Real, const S: usize, const I: usize, const O: usize> $ty<T, S, I, O> {
+            /// The time step `h` (s).
+            pub fn time_step(&self) -> T {
+                self.time_step
+            }
+
+            /// The start from a physical state `x0` and input `w0`: `ξ̂_0 = x0 − Γ₁ w0`,
+            /// `ŵ_0 = w0`. Errors: [`Error::NonFiniteInput`](crate::Error::NonFiniteInput).
+            /// Cost: `S·I` multiply-adds.
+            pub fn start(
+                &self,
+                x0: &nalgebra::SVector<T, S>,
+                w0: &nalgebra::SVector<T, I>,
+            ) -> Result<$crate::estimation::JointEstimate<T, S, I>, $crate::Error> {
+                $crate::estimation::joint::joint_start(&self.gamma1, x0, w0)
+            }
+
+            /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n` (`[u; v]` for a full model:
+            /// read drifts etc. from `(x̂_n, ŵ_n)` with a
+            /// [`Readout`](crate::observer::Readout)). Cost: `S·I` multiply-adds.
+            pub fn state(
+                &self,
+                e: &$crate::estimation::JointEstimate<T, S, I>,
+            ) -> nalgebra::SVector<T, S> {
+                $crate::estimation::joint::shift(&self.gamma1, &e.xi, &e.w, T::one())
+            }
+        }
+    };
+    (varying $ty:ident, $state:ident) => {
+        impl<T: $crate::Real, const S: usize, const I: usize, const O: usize> $ty<T, S, I, O> {
+            /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I` multiply-adds.
+            pub fn state(&self, s: &$state<T, S, I, O>) -> nalgebra::SVector<T, S> {
+                let e = &s.estimate;
+                $crate::estimation::joint::shift(&self.gamma1, &e.xi, &e.w, T::one())
+            }
+        }
+    };
+}
+
 pub mod augmented;
 pub mod dual;
 mod joint;
