@@ -47,9 +47,10 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::InputModel;
-use super::joint::{JointEstimate, check_counts, joint_start_covariances};
+use super::joint::{JointEstimate, joint_start_covariances};
 use crate::linalg::{self, finite_as, identity, matrix_t, round_rows, sym};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
+use crate::observer::{check_counts, next_counts};
 use crate::observer::{gain_t, innovation_t, predict_t, short_form_t};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real};
@@ -266,10 +267,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
     #[inline]
     pub fn step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) {
         let present = y.iter().all(|v| v.is_finite());
-        let (Some(n), Some(missing)) = (
-            e.n.checked_add(1),
-            e.missing.checked_add(u64::from(!present)),
-        ) else {
+        let Some((n, missing)) = next_counts(e.n, e.missing, present) else {
             return;
         };
         e.n = n;
@@ -360,7 +358,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
     /// counter would pass `u64::MAX` (1.8e19 steps: 2.9 million years at 200 kHz, so only
     /// a corrupted or forged estimate), `e` unchanged.
     pub fn try_step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) -> Result<(), Error> {
-        check_counts(e, y)?;
+        check_counts(e.n, e.missing, y)?;
         commit_if_finite(e, |next| self.step(next, y))
     }
 }
@@ -654,12 +652,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
     ) -> Result<(), Error> {
         let e = &s.estimate;
         let present = y.iter().all(|v| v.is_finite());
-        let (Some(n), Some(missing)) = (
-            e.n.checked_add(1),
-            e.missing.checked_add(u64::from(!present)),
-        ) else {
-            return Err(Error::StepCountOverflow);
-        };
+        let (n, missing) = next_counts(e.n, e.missing, present).ok_or(Error::StepCountOverflow)?;
         let (pm, pwm) = self.predicted_covariances(s);
         let mut next = *s;
         if present {

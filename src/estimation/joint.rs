@@ -7,10 +7,11 @@ use nalgebra::{SMatrix, SVector};
 use super::InputModel;
 use crate::linalg::{self, Mat, add_scaled, all_finite, identity, max_abs, mul};
 use crate::linalg::{matrix_t, round_rows, rows_f64, sym, transpose};
+use crate::observer::noise_fits;
 use crate::observer::symmetrize;
 use crate::observer::{A_SMALL, balance, doubling_solution, inf_norm, is_covariance, lu_of};
+use crate::observer::{check_counts, innovation_parts, innovation_t, is_zero, next_counts};
 use crate::observer::{checked_cross_t, cross_is_valid, cross_riccati_start, gain_t};
-use crate::observer::{innovation_parts, innovation_t, is_zero, noise_fits};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
 
@@ -460,19 +461,6 @@ pub(super) fn shift<T: Real, const S: usize, const I: usize>(
     })
 }
 
-/// The checked steps' counters: room for one more step and, if `y` is missing, one more
-/// missing sample. Errors: [`Error::StepCountOverflow`].
-pub(super) fn check_counts<T: Real, const S: usize, const I: usize, const O: usize>(
-    e: &JointEstimate<T, S, I>,
-    y: &SVector<T, O>,
-) -> Result<(), Error> {
-    if e.n == u64::MAX || (e.missing == u64::MAX && !y.iter().all(|v| v.is_finite())) {
-        Err(Error::StepCountOverflow)
-    } else {
-        Ok(())
-    }
-}
-
 /// The start of a joint estimate: `ξ̂_0 = x0 − Γ₁ w0`, `ŵ_0 = w0`, all finite.
 pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
     gamma1: &[[T; I]; S],
@@ -694,7 +682,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
     /// the unchecked [`InputStateObserver::step`] wraps after `2⁶⁴` steps). Cost: a step
     /// plus a copy and a scan.
     pub fn try_step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) -> Result<(), Error> {
-        check_counts(e, y)?;
+        check_counts(e.n, e.missing, y)?;
         commit_if_finite(e, |next| self.step(next, y))
     }
 
@@ -708,7 +696,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
         e: &mut JointEstimate<T, S, I>,
         y: &SVector<T, O>,
     ) -> Result<SVector<T, O>, Error> {
-        check_counts(e, y)?;
+        check_counts(e.n, e.missing, y)?;
         let mut nu = SVector::zeros();
         commit_if_finite(e, |next| nu = self.step_innovation(next, y))?;
         Ok(nu)
@@ -923,7 +911,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         let xp = self.a * e.xi + self.b * e.w;
         let pm = self.predicted_covariance(s);
         let mut next = *s;
-        if y.iter().all(|v| v.is_finite()) {
+        let present = y.iter().all(|v| v.is_finite());
+        if present {
             // R̃ and K from the one Kalman core (with N where it is set).
             let (cp, rt) = innovation_t(&pm, &self.c, &self.r, self.cross.as_ref());
             let chol = rt.cholesky().ok_or(Error::InvalidCovariance)?;
@@ -947,17 +936,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         } else {
             next.estimate.xi = xp;
             next.p = pm;
-            next.estimate.missing = next
-                .estimate
-                .missing
-                .checked_add(1)
-                .ok_or(Error::StepCountOverflow)?;
         }
-        next.estimate.n = next
-            .estimate
-            .n
-            .checked_add(1)
-            .ok_or(Error::StepCountOverflow)?;
+        (next.estimate.n, next.estimate.missing) =
+            next_counts(e.n, e.missing, present).ok_or(Error::StepCountOverflow)?;
         let finite = next
             .estimate
             .xi

@@ -25,7 +25,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::linalg::{self, Mat, add_scaled, all_finite, finite_as, identity, mul, round_rows};
 use crate::linalg::{rows_f64, transpose};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance, lu_of, symmetrize};
-use crate::observer::{innovation_parts, is_zero};
+use crate::observer::{innovation_parts, is_zero, next_counts};
 use crate::{Error, Real, StepState};
 
 /// The gains `K_1 … K_L` (`K_0` is the filter gain), from the steady solution and `r`.
@@ -324,14 +324,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize>
             next.past_w[head] = s.w.into();
             next.head = (head + 1) % L;
         }
-        if !measured {
-            next.missing = next
-                .missing
-                .checked_add(1)
-                .ok_or(Error::StepCountOverflow)?;
-        }
         next.w = *w;
-        next.n = next.n.checked_add(1).ok_or(Error::StepCountOverflow)?;
+        (next.n, next.missing) =
+            next_counts(s.n, s.missing, measured).ok_or(Error::StepCountOverflow)?;
         if !next.is_finite() {
             return Err(Error::NonFiniteState);
         }

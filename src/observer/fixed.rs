@@ -50,18 +50,29 @@ impl<T: Real, const S: usize, const I: usize> StepState for Estimate<T, S, I> {
     }
 }
 
+/// The counters after one more step of every estimator: the step count `n + 1` and the
+/// count of missing samples, `missing + 1` unless the measurement is `present`; `None`
+/// where either would pass `u64::MAX` (the step is then refused, never wrapped).
+/// Cost: two checked additions.
+#[inline(always)]
+pub(crate) fn next_counts(n: u64, missing: u64, present: bool) -> Option<(u64, u64)> {
+    match (n.checked_add(1), missing.checked_add(u64::from(!present))) {
+        (Some(n), Some(missing)) => Some((n, missing)),
+        _ => None,
+    }
+}
+
 /// The checked steps' counter check: the step count `n` and, if `y` is missing (a
-/// non-finite entry), the count of missing samples `missing` must have room for one more.
-/// Errors: [`Error::StepCountOverflow`].
+/// non-finite entry), the count of missing samples `missing` must have room for one more
+/// ([`next_counts`]). Errors: [`Error::StepCountOverflow`].
 pub(crate) fn check_counts<T: Real, const O: usize>(
     n: u64,
     missing: u64,
     y: &SVector<T, O>,
 ) -> Result<(), Error> {
-    if n == u64::MAX || (missing == u64::MAX && !y.iter().all(|v| v.is_finite())) {
-        Err(Error::StepCountOverflow)
-    } else {
-        Ok(())
+    match next_counts(n, missing, y.iter().all(|v| v.is_finite())) {
+        Some(_) => Ok(()),
+        None => Err(Error::StepCountOverflow),
     }
 }
 

@@ -3,7 +3,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::fixed::{Estimate, initial_estimate};
+use super::fixed::{Estimate, initial_estimate, next_counts};
 use super::kalman_core::is_covariance;
 use super::kalman_core::{checked_cross_t, gain_t, innovation_t, joseph_t, noise_fits, predict_t};
 use super::state_space::{Measurement, StateSpace};
@@ -198,7 +198,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         // Xᵀ = H P⁻ (+ Nᵀ), Σ = H P⁻ Hᵀ + R (+ H N + Nᵀ Hᵀ): the one Kalman core.
         let (xt, si) = innovation_t(&pm, &self.h, &self.r, cross);
         let innov = y - self.h * xp - self.d * w;
-        if y.iter().all(|v| v.is_finite()) {
+        let present = y.iter().all(|v| v.is_finite());
+        if present {
             let chol = si.cholesky().ok_or(Error::InvalidCovariance)?;
             // Kᵀ = Σ⁻¹ Xᵀ.
             let k = gain_t(&chol, &xt);
@@ -207,18 +208,11 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         } else {
             next.estimate.x = xp;
             next.p = pm;
-            next.estimate.missing = next
-                .estimate
-                .missing
-                .checked_add(1)
-                .ok_or(Error::StepCountOverflow)?;
         }
         next.estimate.w = *w;
-        next.estimate.n = next
-            .estimate
-            .n
-            .checked_add(1)
-            .ok_or(Error::StepCountOverflow)?;
+        (next.estimate.n, next.estimate.missing) =
+            next_counts(s.estimate.n, s.estimate.missing, present)
+                .ok_or(Error::StepCountOverflow)?;
         let finite = next
             .estimate
             .x
