@@ -23,7 +23,7 @@
 //! the input updated from the predicted state `ξ⁻ = A ξ̂_{n−1} + B ŵ_{n−1}`, the state
 //! predicted with the old input), arguing that `ξ⁻` is the model's own prediction. A scene
 //! refutes that: the 5-storey building with an unknown roof force, the exact zero-order
-//! hold at 200 Hz ([`StateSpace::zero_order_hold`]), accelerations of floors 1, 3, 5
+//! hold at 200 Hz ([`StateSpace::zero_order_hold`](crate::observer::StateSpace::zero_order_hold)), accelerations of floors 1, 3, 5
 //! (σ = 1 mm/s²) and the roof displacement (σ = 10 µm), process noise `Q = 1e-14 I`: with
 //! the same gains, that order's error dynamics have a spectral radius of 1.0014 to 1.0018
 //! for every random-walk variance `Q_w` from 1e4 to 1e10 N² (the force estimate grows
@@ -46,10 +46,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::InputModel;
 use super::joint::{JointEstimate, joint_start_covariances};
+use super::{InputModel, bare_model};
 use crate::linalg::{self, finite_as, identity, matrix_t, round_rows, sym};
-use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
+use crate::observer::{SteadyState, is_covariance};
 use crate::observer::{check_counts, next_counts};
 use crate::observer::{gain_t, innovation_t, predict_t, short_form_t};
 use crate::stepper::commit_if_finite;
@@ -63,32 +63,6 @@ pub struct DualGains<const S: usize, const I: usize, const O: usize> {
     pub input: SteadyState<I, O>,
     /// The state stage's Kalman solution: `G_x` (`S×O`) is its `gain`.
     pub state: SteadyState<S, O>,
-}
-
-/// One stage of the dual filter as a model with no known input, `x_n = Φ x_{n−1}`,
-/// `y_n = H x_n` (time step `h`, s), for [`SteadyState::from_parts`]. Cost: a copy.
-const fn stage<const S: usize, const O: usize>(
-    phi: [[f64; S]; S],
-    h: [[f64; S]; O],
-    time_step: f64,
-) -> (StateSpace<0, S, 0>, Measurement<S, 0, O>) {
-    let model = StateSpace::<0, S, 0> {
-        phi,
-        gamma0: [[0.0; 0]; S],
-        gamma1: [[0.0; 0]; S],
-        dof_u: [],
-        dof_v: [],
-        dof_a: [],
-        dof_a_input: [],
-        time_step,
-    };
-    (
-        model,
-        Measurement {
-            h,
-            d: [[0.0; 0]; O],
-        },
-    )
 }
 
 impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
@@ -108,13 +82,13 @@ impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
         qw: &[[f64; I]; I],
         r: &[[f64; O]; O],
     ) -> Result<Self, Error> {
-        let (input_model, input_meas) = stage(identity(), model.d, model.time_step);
+        let (input_model, input_meas) = bare_model(identity(), model.d, model.time_step);
         let input = match SteadyState::from_parts(&input_model, &input_meas, qw, r) {
             Ok(s) => s,
             Err(Error::RiccatiNotConverged) => return Err(Error::InputNotIdentifiable),
             Err(e) => return Err(e),
         };
-        let (state_model, state_meas) = stage(model.a, model.c, model.time_step);
+        let (state_model, state_meas) = bare_model(model.a, model.c, model.time_step);
         let state = match SteadyState::from_parts(&state_model, &state_meas, q, r) {
             Ok(s) => s,
             Err(e) => return Err(e),
@@ -708,7 +682,7 @@ mod tests {
 
     use super::*;
     use crate::models;
-    use crate::observer::Outputs;
+    use crate::observer::{Outputs, StateSpace};
 
     fn model() -> InputModel<4, 1, 2> {
         let (m, k) = models::shear_building([1.0e3, 1.0e3], [1.0e6, 1.0e6]);
