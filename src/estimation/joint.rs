@@ -7,10 +7,10 @@ use nalgebra::{SMatrix, SVector};
 use super::InputModel;
 use crate::linalg::{self, Mat, add_scaled, all_finite, identity, max_abs, mul};
 use crate::linalg::{matrix_t, round_rows, rows_f64, sym, transpose};
-use crate::observer::noise_fits;
 use crate::observer::symmetrize;
 use crate::observer::{A_SMALL, balance, doubling_solution, inf_norm, is_covariance, lu_of};
 use crate::observer::{check_counts, innovation_parts, innovation_t, is_zero, next_counts};
+use crate::observer::{check_start_covariance, noise_fits};
 use crate::observer::{checked_cross_t, cross_is_valid, cross_riccati_start, gain_t};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
@@ -492,10 +492,8 @@ pub(super) fn joint_start_covariances<T: Real, const S: usize, const I: usize>(
     pw0: &SMatrix<T, I, I>,
 ) -> Result<JointEstimate<T, S, I>, Error> {
     let estimate = joint_start(gamma1, x0, w0)?;
-    let (pr, pwr): (Mat<S, S>, Mat<I, I>) = (rows_f64(p0), rows_f64(pw0));
-    if !(is_covariance(&pr, false) && is_covariance(&pwr, false)) {
-        return Err(Error::InvalidCovariance);
-    }
+    check_start_covariance(p0)?;
+    check_start_covariance(pw0)?;
     Ok(estimate)
 }
 

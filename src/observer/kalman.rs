@@ -5,7 +5,8 @@ use nalgebra::{SMatrix, SVector};
 
 use super::fixed::{Estimate, initial_estimate, next_counts};
 use super::kalman_core::is_covariance;
-use super::kalman_core::{checked_cross_t, gain_t, innovation_t, joseph_t, noise_fits, predict_t};
+use super::kalman_core::{check_start_covariance, checked_cross_t, gain_t, innovation_t, joseph_t};
+use super::kalman_core::{noise_fits, predict_t};
 use super::state_space::{Measurement, StateSpace};
 use crate::linalg::{Mat, all_finite, finite_as, matrix_t, rows_f64};
 use crate::{Error, Real};
@@ -145,10 +146,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         w0: &SVector<T, I>,
     ) -> Result<KalmanState<T, S, I>, Error> {
         let estimate = initial_estimate(x0, w0)?;
-        let pr: [[f64; S]; S] = rows_f64(p0);
-        if !is_covariance(&pr, false) {
-            return Err(Error::InvalidCovariance);
-        }
+        check_start_covariance(p0)?;
         Ok(KalmanState { estimate, p: *p0 })
     }
 

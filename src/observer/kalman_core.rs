@@ -46,7 +46,7 @@ use super::state_space::lu_of;
 use crate::linalg::cholesky::cholesky;
 use crate::linalg::lu::Lu;
 use crate::linalg::{Mat, add_scaled, all_finite, finite_as, is_symmetric, matrix_t, max_abs};
-use crate::linalg::{mul, sym, transpose};
+use crate::linalg::{mul, rows_f64, sym, transpose};
 use crate::{Error, Real};
 
 /// `a` symmetric to `64 ε max|a|` and all finite.
@@ -294,4 +294,18 @@ pub(crate) const fn noise_fits<const S: usize, const O: usize>(
     max: f64,
 ) -> bool {
     finite_as(q, max) && finite_as(r, max) && finite_as(n, max)
+}
+
+/// A filter's start covariance `p` (`S×S`, in the filter's scalar type) is a covariance:
+/// finite, symmetric, positive semidefinite ([`is_covariance`] on its `f64` values).
+/// Errors: [`Error::InvalidCovariance`]. Cost: `S³/6` flops.
+pub(crate) fn check_start_covariance<T: Real, const S: usize>(
+    p: &SMatrix<T, S, S>,
+) -> Result<(), Error> {
+    let pr: Mat<S, S> = rows_f64(p);
+    if is_covariance(&pr, false) {
+        Ok(())
+    } else {
+        Err(Error::InvalidCovariance)
+    }
 }

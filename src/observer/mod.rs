@@ -88,8 +88,8 @@ pub(crate) use fixed::{check_counts, next_counts};
 pub use kalman::{Kalman, KalmanState};
 // For the joint input–state estimators (`crate::estimation`).
 pub(crate) use kalman_core::{
-    checked_cross_t, cross_is_valid, cross_riccati_start, gain_t, innovation_parts, innovation_t,
-    is_zero, noise_fits, predict_t, short_form_t,
+    check_start_covariance, checked_cross_t, cross_is_valid, cross_riccati_start, gain_t,
+    innovation_parts, innovation_t, is_zero, noise_fits, predict_t, short_form_t,
 };
 pub(crate) use kalman_core::{is_covariance, symmetrize};
 pub(crate) use riccati::{A_SMALL, balance, doubling_solution, inf_norm};
