@@ -391,27 +391,9 @@ impl<T: Real, const S: usize, const I: usize> JointEstimate<T, S, I> {
     pub fn input(&self) -> &SVector<T, I> {
         &self.w
     }
-    /// Steps taken since the start.
-    pub fn steps(&self) -> u64 {
-        self.n
-    }
-    /// Steps whose measurement was missing (a non-finite entry): predicted, not corrected,
-    /// the input estimate held.
-    pub fn missing(&self) -> u64 {
-        self.missing
-    }
 }
 
-impl<T: Real, const S: usize, const I: usize> StepState for JointEstimate<T, S, I> {
-    #[inline]
-    fn is_finite(&self) -> bool {
-        self.xi.iter().chain(self.w.iter()).all(|v| v.is_finite())
-    }
-    #[inline]
-    fn steps(&self) -> u64 {
-        self.n
-    }
-}
+crate::observer::estimate_counters!(JointEstimate, xi);
 
 /// At rest: as `JointEstimate::at_rest_f32`/`at_rest_f64`, for any `T`.
 impl<T: Real, const S: usize, const I: usize> Default for JointEstimate<T, S, I> {

@@ -29,26 +29,41 @@ impl<T: Real, const S: usize, const I: usize> Estimate<T, S, I> {
     pub fn last_input(&self) -> &SVector<T, I> {
         &self.w
     }
-    /// Steps taken since the start.
-    pub fn steps(&self) -> u64 {
-        self.n
-    }
-    /// Steps whose measurement was missing (a non-finite entry): predicted, not corrected.
-    pub fn missing(&self) -> u64 {
-        self.missing
-    }
 }
 
-impl<T: Real, const S: usize, const I: usize> StepState for Estimate<T, S, I> {
-    #[inline]
-    fn is_finite(&self) -> bool {
-        self.x.iter().chain(self.w.iter()).all(|v| v.is_finite())
-    }
-    #[inline]
-    fn steps(&self) -> u64 {
-        self.n
-    }
+/// The counters and the finiteness every estimate shares (the observers' [`Estimate`],
+/// the joint estimators' [`JointEstimate`](crate::estimation::JointEstimate)): a state
+/// `$x` (`S` values), the input `w` (`I` values), the step count `n` and the count of
+/// missing samples `missing`.
+macro_rules! estimate_counters {
+    ($ty:ident, $x:ident) => {
+        impl<T: $crate::Real, const S: usize, const I: usize> $ty<T, S, I> {
+            /// Steps taken since the start.
+            pub fn steps(&self) -> u64 {
+                self.n
+            }
+            /// Steps whose measurement was missing (a non-finite entry): predicted, not
+            /// corrected (a joint estimator also holds its input estimate).
+            pub fn missing(&self) -> u64 {
+                self.missing
+            }
+        }
+
+        impl<T: $crate::Real, const S: usize, const I: usize> $crate::StepState for $ty<T, S, I> {
+            #[inline]
+            fn is_finite(&self) -> bool {
+                self.$x.iter().chain(self.w.iter()).all(|v| v.is_finite())
+            }
+            #[inline]
+            fn steps(&self) -> u64 {
+                self.n
+            }
+        }
+    };
 }
+pub(crate) use estimate_counters;
+
+estimate_counters!(Estimate, x);
 
 /// The counters after one more step of every estimator: the step count `n + 1` and the
 /// count of missing samples, `missing + 1` unless the measurement is `present`; `None`
