@@ -24,8 +24,8 @@
 
 use nalgebra::SVector;
 
-use super::InputModel;
-use crate::linalg::{Mat, all_finite};
+use super::{InputModel, bare_model};
+use crate::linalg::{Mat, all_finite, identity};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
 use crate::{Error, Real};
 
@@ -46,6 +46,25 @@ pub struct AugmentedModel<const S: usize, const I: usize, const Z: usize, const 
     pub cross_noise: [[f64; O]; Z],
     /// `Γ₁` of the physical state `x = ξ + Γ₁ w`.
     pub gamma1: [[f64; I]; S],
+}
+
+/// `src` (`R₂×C₂`) copied into `dst` (`R×C`) with its first entry at `(r0, c0)` (the block
+/// must fit). Cost: `R₂·C₂` copies.
+const fn put<const R: usize, const C: usize, const R2: usize, const C2: usize>(
+    dst: &mut Mat<R, C>,
+    src: &Mat<R2, C2>,
+    r0: usize,
+    c0: usize,
+) {
+    let mut i = 0;
+    while i < R2 {
+        let mut j = 0;
+        while j < C2 {
+            dst[r0 + i][c0 + j] = src[i][j];
+            j += 1;
+        }
+        i += 1;
+    }
 }
 
 impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedModel<S, I, Z, O> {
@@ -86,77 +105,25 @@ impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedMo
             return Err(Error::InvalidCovariance);
         }
         // Γ₁ too: `split` forms x̂ = ξ̂ + Γ₁ ŵ from it (a NaN there gave NaN states).
-        if !(all_finite(&m.a)
-            && all_finite(&m.b)
-            && all_finite(&m.c)
-            && all_finite(&m.d)
-            && all_finite(&m.gamma1))
-        {
-            return Err(Error::NonFiniteInput);
+        if let Err(e) = m.check_finite() {
+            return Err(e);
         }
-        let mut cross: Mat<Z, O> = [[0.0; O]; Z];
         let mut phi: Mat<Z, Z> = [[0.0; Z]; Z];
+        put(&mut phi, &m.a, 0, 0);
+        put(&mut phi, &m.b, 0, S);
+        put(&mut phi, &identity::<I>(), S, S);
         let mut pn: Mat<Z, Z> = [[0.0; Z]; Z];
+        put(&mut pn, q, 0, 0);
+        put(&mut pn, qw, S, S);
+        let mut cross: Mat<Z, O> = [[0.0; O]; Z];
+        put(&mut cross, n, 0, 0);
         let mut h: Mat<O, Z> = [[0.0; Z]; O];
-        let mut i = 0;
-        while i < S {
-            let mut j = 0;
-            while j < S {
-                phi[i][j] = m.a[i][j];
-                pn[i][j] = q[i][j];
-                j += 1;
-            }
-            let mut j = 0;
-            while j < O {
-                cross[i][j] = n[i][j];
-                j += 1;
-            }
-            let mut j = 0;
-            while j < I {
-                phi[i][S + j] = m.b[i][j];
-                j += 1;
-            }
-            i += 1;
-        }
-        let mut i = 0;
-        while i < I {
-            phi[S + i][S + i] = 1.0;
-            let mut j = 0;
-            while j < I {
-                pn[S + i][S + j] = qw[i][j];
-                j += 1;
-            }
-            i += 1;
-        }
-        let mut o = 0;
-        while o < O {
-            let mut j = 0;
-            while j < S {
-                h[o][j] = m.c[o][j];
-                j += 1;
-            }
-            let mut j = 0;
-            while j < I {
-                h[o][S + j] = m.d[o][j];
-                j += 1;
-            }
-            o += 1;
-        }
+        put(&mut h, &m.c, 0, 0);
+        put(&mut h, &m.d, 0, S);
+        let (model, measurement) = bare_model(phi, h, m.time_step);
         Ok(Self {
-            model: StateSpace {
-                phi,
-                gamma0: [[0.0; 0]; Z],
-                gamma1: [[0.0; 0]; Z],
-                dof_u: [],
-                dof_v: [],
-                dof_a: [],
-                dof_a_input: [],
-                time_step: m.time_step,
-            },
-            measurement: Measurement {
-                h,
-                d: [[0.0; 0]; O],
-            },
+            model,
+            measurement,
             process_noise: pn,
             cross_noise: cross,
             gamma1: m.gamma1,
@@ -206,21 +173,14 @@ impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedMo
 
 #[cfg(test)]
 mod tests {
+    use super::super::roof_force_fixture;
     use super::*;
-    use crate::models;
-    use crate::observer::Outputs;
 
     /// Regression: `from_parts` did not check `Γ₁`, and a NaN there gave NaN states from
     /// `split`; it is now refused with a typed error.
     #[test]
     fn augmented_model_refuses_a_non_finite_gamma1() {
-        let (m, c, k) = models::five_storey_building();
-        let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02).unwrap();
-        let mut out = Outputs::<5, 1, 2>::zero();
-        out.a[0][4] = 1.0;
-        out.u[1][4] = 1.0;
-        let mut model = InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap();
+        let mut model = roof_force_fixture();
         let q = [[0.0; 10]; 10];
         let qw = [[1.0]];
         assert!(AugmentedModel::<10, 1, 11, 2>::from_parts(&model, &q, &qw).is_ok());

@@ -23,7 +23,7 @@
 //! the input updated from the predicted state `ξ⁻ = A ξ̂_{n−1} + B ŵ_{n−1}`, the state
 //! predicted with the old input), arguing that `ξ⁻` is the model's own prediction. A scene
 //! refutes that: the 5-storey building with an unknown roof force, the exact zero-order
-//! hold at 200 Hz ([`StateSpace::zero_order_hold`]), accelerations of floors 1, 3, 5
+//! hold at 200 Hz ([`StateSpace::zero_order_hold`](crate::observer::StateSpace::zero_order_hold)), accelerations of floors 1, 3, 5
 //! (σ = 1 mm/s²) and the roof displacement (σ = 10 µm), process noise `Q = 1e-14 I`: with
 //! the same gains, that order's error dynamics have a spectral radius of 1.0014 to 1.0018
 //! for every random-walk variance `Q_w` from 1e4 to 1e10 N² (the force estimate grows
@@ -46,10 +46,12 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::InputModel;
-use super::joint::{JointEstimate, joint_start, shift};
-use crate::linalg::{self, all_finite, finite_as, identity, matrix_t, round_rows, sym};
-use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
+use super::joint::{JointEstimate, joint_start_covariances};
+use super::{InputModel, bare_model};
+use crate::linalg::{self, finite_as, identity, matrix_t, round_rows, sym};
+use crate::observer::{SteadyState, is_covariance};
+use crate::observer::{check_counts, next_counts};
+use crate::observer::{gain_t, innovation_t, predict_t, short_form_t};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real};
 
@@ -80,39 +82,13 @@ impl<const S: usize, const I: usize, const O: usize> DualGains<S, I, O> {
         qw: &[[f64; I]; I],
         r: &[[f64; O]; O],
     ) -> Result<Self, Error> {
-        let input_model = StateSpace::<0, I, 0> {
-            phi: identity(),
-            gamma0: [[0.0; 0]; I],
-            gamma1: [[0.0; 0]; I],
-            dof_u: [],
-            dof_v: [],
-            dof_a: [],
-            dof_a_input: [],
-            time_step: model.time_step,
-        };
-        let input_meas = Measurement::<I, 0, O> {
-            h: model.d,
-            d: [[0.0; 0]; O],
-        };
+        let (input_model, input_meas) = bare_model(identity(), model.d, model.time_step);
         let input = match SteadyState::from_parts(&input_model, &input_meas, qw, r) {
             Ok(s) => s,
             Err(Error::RiccatiNotConverged) => return Err(Error::InputNotIdentifiable),
             Err(e) => return Err(e),
         };
-        let state_model = StateSpace::<0, S, 0> {
-            phi: model.a,
-            gamma0: [[0.0; 0]; S],
-            gamma1: [[0.0; 0]; S],
-            dof_u: [],
-            dof_v: [],
-            dof_a: [],
-            dof_a_input: [],
-            time_step: model.time_step,
-        };
-        let state_meas = Measurement::<S, 0, O> {
-            h: model.c,
-            d: [[0.0; 0]; O],
-        };
+        let (state_model, state_meas) = bare_model(model.a, model.c, model.time_step);
         let state = match SteadyState::from_parts(&state_model, &state_meas, q, r) {
             Ok(s) => s,
             Err(e) => return Err(e),
@@ -177,38 +153,17 @@ pub struct DualFilter<T, const S: usize, const I: usize, const O: usize> {
     order: DualOrder,
 }
 
-/// Every operator finite and fitting `T`.
+/// Every operator finite and fitting `T` (the checks of every fixed-gain estimator).
 const fn dual_checks<const S: usize, const I: usize, const O: usize>(
     model: &InputModel<S, I, O>,
     gains: &DualGains<S, I, O>,
     max: f64,
 ) -> Result<(), Error> {
     let (gw, gx) = (&gains.input.gain, &gains.state.gain);
-    if !(all_finite(&model.a)
-        && all_finite(&model.b)
-        && all_finite(&model.c)
-        && all_finite(&model.d)
-        && all_finite(&model.gamma1)
-        && all_finite(gw)
-        && all_finite(gx))
-    {
-        return Err(Error::NonFiniteInput);
-    }
-    if let Err(e) = crate::kinematics::check_time_step_as(model.time_step, max) {
-        return Err(e);
-    }
-    if !(finite_as(&model.a, max)
-        && finite_as(&model.b, max)
-        && finite_as(&model.c, max)
-        && finite_as(&model.d, max)
-        && finite_as(&model.gamma1, max)
-        && finite_as(gw, max)
-        && finite_as(gx, max))
-    {
-        return Err(Error::OperatorOverflow);
-    }
-    Ok(())
+    model.check_fixed_gains(gx, gx, gw, max)
 }
+
+joint_accessors!(fixed DualFilter);
 
 impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I, O> {
     /// The dual filter of `model` with the steady `gains`, rounded once to `T`.
@@ -242,26 +197,6 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
         self.order
     }
 
-    /// The time step `h` (s).
-    pub fn time_step(&self) -> T {
-        self.time_step
-    }
-
-    /// The start from a physical state `x0` and input `w0` (`ξ̂_0 = x0 − Γ₁ w0`).
-    /// Errors: [`Error::NonFiniteInput`].
-    pub fn start(
-        &self,
-        x0: &SVector<T, S>,
-        w0: &SVector<T, I>,
-    ) -> Result<JointEstimate<T, S, I>, Error> {
-        joint_start(&self.gamma1, x0, w0)
-    }
-
-    /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I`.
-    pub fn state(&self, e: &JointEstimate<T, S, I>) -> SVector<T, S> {
-        shift(&self.gamma1, &e.xi, &e.w, T::one())
-    }
-
     /// One step of the joint error dynamics without noise (a constant input and state
     /// increment, exact data): the errors `(ξ − ξ̂, w − ŵ)` of a step from the errors
     /// `(ex, ew)` before it, in the filter's [`DualOrder`]:
@@ -283,57 +218,19 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
         ex: &SVector<T, S>,
         ew: &SVector<T, I>,
     ) -> (SVector<T, S>, SVector<T, I>) {
-        let predict = |ex: &SVector<T, S>, ew: &SVector<T, I>| {
-            SVector::<T, S>::from_fn(|i, _| {
-                let mut s = T::zero();
-                for j in 0..S {
-                    s += self.a[i][j] * ex[j];
-                }
-                for j in 0..I {
-                    s += self.b[i][j] * ew[j];
-                }
-                s
-            })
-        };
-        let output = |ex: &SVector<T, S>, ew: &SVector<T, I>| {
-            SVector::<T, O>::from_fn(|o, _| {
-                let mut s = T::zero();
-                for j in 0..S {
-                    s += self.c[o][j] * ex[j];
-                }
-                for j in 0..I {
-                    s += self.d[o][j] * ew[j];
-                }
-                s
-            })
-        };
-        let input_stage = |nu: &SVector<T, O>| {
-            SVector::<T, I>::from_fn(|i, _| {
-                let mut s = ew[i];
-                for o in 0..O {
-                    s -= self.gain_w[i][o] * nu[o];
-                }
-                s
-            })
-        };
+        let predict = |ex: &SVector<T, S>, ew: &SVector<T, I>| mul2(&self.a, &self.b, ex, ew);
+        let output = |ex: &SVector<T, S>, ew: &SVector<T, I>| mul2(&self.c, &self.d, ex, ew);
         let (em, ew1) = match self.order {
             DualOrder::Paper => {
-                let ew1 = input_stage(&output(ex, ew));
+                let ew1 = less_gain(ew, &self.gain_w, &output(ex, ew));
                 (predict(ex, &ew1), ew1)
             }
             DualOrder::PredictedState => {
                 let em = predict(ex, ew);
-                (em, input_stage(&output(&em, ew)))
+                (em, less_gain(ew, &self.gain_w, &output(&em, ew)))
             }
         };
-        let nu2 = output(&em, &ew1);
-        let ex1 = SVector::<T, S>::from_fn(|i, _| {
-            let mut s = em[i];
-            for o in 0..O {
-                s -= self.gain_x[i][o] * nu2[o];
-            }
-            s
-        });
+        let ex1 = less_gain(&em, &self.gain_x, &output(&em, &ew1));
         (ex1, ew1)
     }
 
@@ -344,10 +241,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
     #[inline]
     pub fn step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) {
         let present = y.iter().all(|v| v.is_finite());
-        let (Some(n), Some(missing)) = (
-            e.n.checked_add(1),
-            e.missing.checked_add(u64::from(!present)),
-        ) else {
+        let Some((n, missing)) = next_counts(e.n, e.missing, present) else {
             return;
         };
         e.n = n;
@@ -438,12 +332,45 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
     /// counter would pass `u64::MAX` (1.8e19 steps: 2.9 million years at 200 kHz, so only
     /// a corrupted or forged estimate), `e` unchanged.
     pub fn try_step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) -> Result<(), Error> {
-        let missing = u64::from(!y.iter().all(|v| v.is_finite()));
-        if e.n.checked_add(1).is_none() || e.missing.checked_add(missing).is_none() {
-            return Err(Error::StepCountOverflow);
-        }
+        check_counts(e.n, e.missing, y)?;
         commit_if_finite(e, |next| self.step(next, y))
     }
+}
+
+/// `M₁ e_ξ + M₂ e_w` (from `+0`, `M₁`'s terms first): the error dynamics' prediction
+/// (`A`, `B`) and output (`C`, `D̃`). Cost: `R·(S + I)` multiply-adds.
+fn mul2<T: Real, const R: usize, const S: usize, const I: usize>(
+    m1: &[[T; S]; R],
+    m2: &[[T; I]; R],
+    ex: &SVector<T, S>,
+    ew: &SVector<T, I>,
+) -> SVector<T, R> {
+    SVector::from_fn(|i, _| {
+        let mut s = T::zero();
+        for j in 0..S {
+            s += m1[i][j] * ex[j];
+        }
+        for j in 0..I {
+            s += m2[i][j] * ew[j];
+        }
+        s
+    })
+}
+
+/// `e − G ν`: an error after a stage's correction with gain `G`. Cost: `R·O`
+/// multiply-adds.
+fn less_gain<T: Real, const R: usize, const O: usize>(
+    e: &SVector<T, R>,
+    g: &[[T; O]; R],
+    nu: &SVector<T, O>,
+) -> SVector<T, R> {
+    SVector::from_fn(|i, _| {
+        let mut s = e[i];
+        for o in 0..O {
+            s -= g[i][o] * nu[o];
+        }
+        s
+    })
 }
 
 macro_rules! dual_const {
@@ -596,6 +523,8 @@ pub struct DualKalmanFilter<T, const S: usize, const I: usize, const O: usize> {
     time_step: T,
 }
 
+joint_accessors!(varying DualKalmanFilter, DualKalmanFilterState);
+
 impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T, S, I, O> {
     /// The filter of `model` with process noise `q` (`S×S` on `ξ`, symmetric positive
     /// semidefinite, units of `x` squared per step), the random walk's covariance `qw`
@@ -662,11 +591,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
         w0: &SVector<T, I>,
         pw0: &SMatrix<T, I, I>,
     ) -> Result<DualKalmanFilterState<T, S, I, O>, Error> {
-        let estimate = joint_start(&self.gamma1, x0, w0)?;
-        let (pr, pwr) = (linalg::rows_f64(p0), linalg::rows_f64(pw0));
-        if !(is_covariance(&pr, false) && is_covariance(&pwr, false)) {
-            return Err(Error::InvalidCovariance);
-        }
+        let estimate = joint_start_covariances(&self.gamma1, x0, p0, w0, pw0)?;
         Ok(DualKalmanFilterState {
             estimate,
             p: *p0,
@@ -683,15 +608,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
         &self,
         s: &DualKalmanFilterState<T, S, I, O>,
     ) -> (SMatrix<T, S, S>, SMatrix<T, I, I>) {
-        (
-            sym(&(self.a * s.p * self.a.transpose() + self.q)),
-            sym(&(s.pw + self.qw)),
-        )
-    }
-
-    /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I`.
-    pub fn state(&self, s: &DualKalmanFilterState<T, S, I, O>) -> SVector<T, S> {
-        shift(&self.gamma1, &s.estimate.xi, &s.estimate.w, T::one())
+        (predict_t(&self.a, &s.p, &self.q), sym(&(s.pw + self.qw)))
     }
 
     /// One filter step with the measurement `y` (`y_n`; a non-finite entry: missing).
@@ -709,32 +626,27 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualKalmanFilter<T
     ) -> Result<(), Error> {
         let e = &s.estimate;
         let present = y.iter().all(|v| v.is_finite());
-        let (Some(n), Some(missing)) = (
-            e.n.checked_add(1),
-            e.missing.checked_add(u64::from(!present)),
-        ) else {
-            return Err(Error::StepCountOverflow);
-        };
+        let (n, missing) = next_counts(e.n, e.missing, present).ok_or(Error::StepCountOverflow)?;
         let (pm, pwm) = self.predicted_covariances(s);
         let mut next = *s;
         if present {
             // Input stage (the paper's Steps 1–3): the random walk measured through D̃,
             // its innovation from the previous filtered state.
-            let dp = self.d * pwm;
-            let sw = sym(&(dp * self.d.transpose() + self.r));
+            // Each stage is the Kalman core's correction (no cross term) in the paper's
+            // short form.
+            let (dp, sw) = innovation_t(&pwm, &self.d, &self.r, None);
             let cw = sw.cholesky().ok_or(Error::InvalidCovariance)?;
-            let gw = cw.solve(&dp).transpose();
+            let gw = gain_t(&cw, &dp);
             let w = e.w + gw * (y - self.c * e.xi - self.d * e.w);
             // State stage (Steps 4–6): predicted with the new ŵ_n.
             let xp = self.a * e.xi + self.b * w;
-            let cp = self.c * pm;
-            let sx = sym(&(cp * self.c.transpose() + self.r));
+            let (cp, sx) = innovation_t(&pm, &self.c, &self.r, None);
             let cx = sx.cholesky().ok_or(Error::InvalidCovariance)?;
-            let gx = cx.solve(&cp).transpose();
+            let gx = gain_t(&cx, &cp);
             next.estimate.xi = xp + gx * (y - self.c * xp - self.d * w);
             next.estimate.w = w;
-            next.pw = sym(&(pwm - gw * dp));
-            next.p = sym(&(pm - gx * cp));
+            next.pw = short_form_t(&pwm, &gw, &dp);
+            next.p = short_form_t(&pm, &gx, &cp);
             next.gain_w = gw;
             next.gain_x = gx;
         } else {
@@ -770,7 +682,7 @@ mod tests {
 
     use super::*;
     use crate::models;
-    use crate::observer::Outputs;
+    use crate::observer::{Outputs, StateSpace};
 
     fn model() -> InputModel<4, 1, 2> {
         let (m, k) = models::shear_building([1.0e3, 1.0e3], [1.0e6, 1.0e6]);

@@ -5,12 +5,13 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::InputModel;
-use crate::linalg::{self, Mat, add_scaled, all_finite, finite_as, identity, max_abs, mul};
+use crate::linalg::{self, Mat, add_scaled, all_finite, identity, max_abs, mul};
 use crate::linalg::{matrix_t, round_rows, rows_f64, sym, transpose};
-use crate::observer::{A_SMALL, balance, doubling, inf_norm, is_covariance, lu_of, symmetrize};
-use crate::observer::{
-    cross_is_valid, cross_riccati_start, gain_t, innovation_parts, innovation_t, is_zero,
-};
+use crate::observer::symmetrize;
+use crate::observer::{A_SMALL, balance, doubling_solution, inf_norm, is_covariance, lu_of};
+use crate::observer::{check_counts, innovation_parts, innovation_t, is_zero, next_counts};
+use crate::observer::{check_start_covariance, noise_fits};
+use crate::observer::{checked_cross_t, cross_is_valid, cross_riccati_start, gain_t};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
 
@@ -285,17 +286,14 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
                 Err(e) => return Err(e),
             },
         };
-        let (x, k, converged) = match doubling(start.0, start.1, start.2, STEADY_MAX_ITERATIONS) {
+        // With the cross term the doubling solved for Y: P⁻ = Y + Q.
+        let q_cross = match n {
+            None => None,
+            Some(_) => Some(q),
+        };
+        let (x, k) = match doubling_solution(start, STEADY_MAX_ITERATIONS, q_cross) {
             Some(v) => v,
             None => return Err(Error::InputNotIdentifiable),
-        };
-        if !(converged && is_covariance(&x, false)) {
-            return Err(Error::InputNotIdentifiable);
-        }
-        // With the cross term the doubling solved for Y: P⁻ = Y + Q.
-        let x = match n {
-            None => x,
-            Some(_) => symmetrize(&add_scaled(&x, 1.0, &symmetrize(q))),
         };
         let (kx, gm, pw, rt) = match step_gains(model, &x, r, n) {
             Some(v) => v,
@@ -393,27 +391,9 @@ impl<T: Real, const S: usize, const I: usize> JointEstimate<T, S, I> {
     pub fn input(&self) -> &SVector<T, I> {
         &self.w
     }
-    /// Steps taken since the start.
-    pub fn steps(&self) -> u64 {
-        self.n
-    }
-    /// Steps whose measurement was missing (a non-finite entry): predicted, not corrected,
-    /// the input estimate held.
-    pub fn missing(&self) -> u64 {
-        self.missing
-    }
 }
 
-impl<T: Real, const S: usize, const I: usize> StepState for JointEstimate<T, S, I> {
-    #[inline]
-    fn is_finite(&self) -> bool {
-        self.xi.iter().chain(self.w.iter()).all(|v| v.is_finite())
-    }
-    #[inline]
-    fn steps(&self) -> u64 {
-        self.n
-    }
-}
+crate::observer::estimate_counters!(JointEstimate, xi);
 
 /// At rest: as `JointEstimate::at_rest_f32`/`at_rest_f64`, for any `T`.
 impl<T: Real, const S: usize, const I: usize> Default for JointEstimate<T, S, I> {
@@ -463,19 +443,6 @@ pub(super) fn shift<T: Real, const S: usize, const I: usize>(
     })
 }
 
-/// The checked steps' counters: room for one more step and, if `y` is missing, one more
-/// missing sample. Errors: [`Error::StepCountOverflow`].
-pub(super) fn check_counts<T: Real, const S: usize, const I: usize, const O: usize>(
-    e: &JointEstimate<T, S, I>,
-    y: &SVector<T, O>,
-) -> Result<(), Error> {
-    if e.n == u64::MAX || (e.missing == u64::MAX && !y.iter().all(|v| v.is_finite())) {
-        Err(Error::StepCountOverflow)
-    } else {
-        Ok(())
-    }
-}
-
 /// The start of a joint estimate: `ξ̂_0 = x0 − Γ₁ w0`, `ŵ_0 = w0`, all finite.
 pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
     gamma1: &[[T; I]; S],
@@ -493,6 +460,23 @@ pub(super) fn joint_start<T: Real, const S: usize, const I: usize>(
     } else {
         Err(Error::NonFiniteInput)
     }
+}
+
+/// The start of a time-varying joint filter ([`InputStateFilter`], the dual
+/// [`DualKalmanFilter`](super::DualKalmanFilter)): [`joint_start`], and the covariances of
+/// `ξ̂_0` (`p0`, `S×S`) and `ŵ_0` (`pw0`, `I×I`) symmetric positive semidefinite.
+/// Errors: [`Error::NonFiniteInput`], [`Error::InvalidCovariance`]. Cost: `O(S³ + I³)`.
+pub(super) fn joint_start_covariances<T: Real, const S: usize, const I: usize>(
+    gamma1: &[[T; I]; S],
+    x0: &SVector<T, S>,
+    p0: &SMatrix<T, S, S>,
+    w0: &SVector<T, I>,
+    pw0: &SMatrix<T, I, I>,
+) -> Result<JointEstimate<T, S, I>, Error> {
+    let estimate = joint_start(gamma1, x0, w0)?;
+    check_start_covariance(p0)?;
+    check_start_covariance(pw0)?;
+    Ok(estimate)
 }
 
 /// The fixed-gain joint input–state filter (the steady state of Gillijns & De Moor 2007)
@@ -556,33 +540,17 @@ const fn observer_parts<const S: usize, const I: usize, const O: usize>(
     gains: &InputStateGains<S, I, O>,
     max: f64,
 ) -> Result<Mat<S, O>, Error> {
-    if !(all_finite(&gains.state_gain)
-        && all_finite(&gains.input_gain)
-        && all_finite(&model.a)
-        && all_finite(&model.b)
-        && all_finite(&model.c)
-        && all_finite(&model.d)
-        && all_finite(&model.gamma1))
-    {
-        return Err(Error::NonFiniteInput);
-    }
-    if let Err(e) = crate::kinematics::check_time_step_as(model.time_step, max) {
-        return Err(e);
-    }
+    // (`L` from unchecked gains is only compared, never kept: the checks come first in
+    // effect.)
     let kd = mul(&gains.state_gain, &model.d);
     let l = add_scaled(&gains.state_gain, -1.0, &mul(&kd, &gains.input_gain));
-    if !(finite_as(&model.a, max)
-        && finite_as(&model.b, max)
-        && finite_as(&model.c, max)
-        && finite_as(&model.gamma1, max)
-        && finite_as(&model.d, max)
-        && finite_as(&l, max)
-        && finite_as(&gains.input_gain, max))
-    {
-        return Err(Error::OperatorOverflow);
+    if let Err(e) = model.check_fixed_gains(&gains.state_gain, &l, &gains.input_gain, max) {
+        return Err(e);
     }
     Ok(l)
 }
+
+joint_accessors!(fixed InputStateObserver);
 
 impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver<T, S, I, O> {
     /// The fixed-gain filter of `model` with the steady-state `gains`, rounded once to `T`.
@@ -606,36 +574,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
         })
     }
 
-    /// The time step `h` (s).
-    pub fn time_step(&self) -> T {
-        self.time_step
-    }
-
-    /// The start from a physical state `x0` and input `w0`: `ξ̂_0 = x0 − Γ₁ w0`,
-    /// `ŵ_0 = w0`. Errors: [`Error::NonFiniteInput`].
-    pub fn start(
-        &self,
-        x0: &SVector<T, S>,
-        w0: &SVector<T, I>,
-    ) -> Result<JointEstimate<T, S, I>, Error> {
-        joint_start(&self.gamma1, x0, w0)
-    }
-
     /// The start at rest with no input (`ξ̂_0 = 0`, `ŵ_0 = 0`).
     pub fn start_at_rest(&self) -> JointEstimate<T, S, I> {
-        JointEstimate {
-            xi: SVector::zeros(),
-            w: SVector::zeros(),
-            n: 0,
-            missing: 0,
-        }
-    }
-
-    /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n` (`[u; v]` for a full model: read
-    /// drifts etc. from `(x̂_n, ŵ_n)` with a [`Readout`](crate::observer::Readout)).
-    /// Cost: `S·I` multiply-adds.
-    pub fn state(&self, e: &JointEstimate<T, S, I>) -> SVector<T, S> {
-        shift(&self.gamma1, &e.xi, &e.w, T::one())
+        JointEstimate::default()
     }
 
     /// One step with the measurement `y` (`y_n`). A non-finite entry of `y` is a missing
@@ -721,7 +662,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
     /// the unchecked [`InputStateObserver::step`] wraps after `2⁶⁴` steps). Cost: a step
     /// plus a copy and a scan.
     pub fn try_step(&self, e: &mut JointEstimate<T, S, I>, y: &SVector<T, O>) -> Result<(), Error> {
-        check_counts(e, y)?;
+        check_counts(e.n, e.missing, y)?;
         commit_if_finite(e, |next| self.step(next, y))
     }
 
@@ -735,7 +676,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateObserver
         e: &mut JointEstimate<T, S, I>,
         y: &SVector<T, O>,
     ) -> Result<SVector<T, O>, Error> {
-        check_counts(e, y)?;
+        check_counts(e.n, e.missing, y)?;
         let mut nu = SVector::zeros();
         commit_if_finite(e, |next| nu = self.step_innovation(next, y))?;
         Ok(nu)
@@ -840,6 +781,8 @@ pub struct InputStateFilter<T, const S: usize, const I: usize, const O: usize> {
     cross: Option<SMatrix<T, S, O>>,
 }
 
+joint_accessors!(varying InputStateFilter, InputStateFilterState);
+
 impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T, S, I, O> {
     /// The filter of `model`, process noise `q` (`S×S` on `ξ`, symmetric positive
     /// semidefinite), measurement noise `r` (`O×O`, symmetric positive definite), in
@@ -883,15 +826,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         }
         model.check_finite()?;
         model.weighted_feedthrough(&rr)?;
-        let zero = is_zero(n);
-        if !zero && !cross_is_valid(&qr, &rr, n) {
-            return Err(Error::InvalidCovariance);
-        }
-        let fits = model.fits(T::MAX)
-            && finite_as(&qr, T::MAX)
-            && finite_as(&rr, T::MAX)
-            && finite_as(n, T::MAX);
-        if !fits {
+        let cross = checked_cross_t(&qr, &rr, n)?;
+        if !(model.fits(T::MAX) && noise_fits(&qr, &rr, n, T::MAX)) {
             return Err(Error::OperatorOverflow);
         }
         Ok(Self {
@@ -902,7 +838,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
             gamma1: round_rows(&model.gamma1),
             q: matrix_t(&qr),
             r: matrix_t(&rr),
-            cross: if zero { None } else { Some(matrix_t(n)) },
+            cross,
         })
     }
 
@@ -918,11 +854,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         w0: &SVector<T, I>,
         pw0: &SMatrix<T, I, I>,
     ) -> Result<InputStateFilterState<T, S, I, O>, Error> {
-        let estimate = joint_start(&self.gamma1, x0, w0)?;
-        let (pr, pwr): (Mat<S, S>, Mat<I, I>) = (rows_f64(p0), rows_f64(pw0));
-        if !(is_covariance(&pr, false) && is_covariance(&pwr, false)) {
-            return Err(Error::InvalidCovariance);
-        }
+        let estimate = joint_start_covariances(&self.gamma1, x0, p0, w0, pw0)?;
         Ok(InputStateFilterState {
             estimate,
             p: *p0,
@@ -944,11 +876,6 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
             + self.q))
     }
 
-    /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I`.
-    pub fn state(&self, s: &InputStateFilterState<T, S, I, O>) -> SVector<T, S> {
-        shift(&self.gamma1, &s.estimate.xi, &s.estimate.w, T::one())
-    }
-
     /// One filter step with the measurement `y` (`y_n`; a non-finite entry: missing).
     ///
     /// Errors, `s` unchanged: [`Error::InvalidCovariance`] (`R̃ = C P⁻ Cᵀ + R` or
@@ -964,7 +891,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         let xp = self.a * e.xi + self.b * e.w;
         let pm = self.predicted_covariance(s);
         let mut next = *s;
-        if y.iter().all(|v| v.is_finite()) {
+        let present = y.iter().all(|v| v.is_finite());
+        if present {
             // R̃ and K from the one Kalman core (with N where it is set).
             let (cp, rt) = innovation_t(&pm, &self.c, &self.r, self.cross.as_ref());
             let chol = rt.cholesky().ok_or(Error::InvalidCovariance)?;
@@ -988,17 +916,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
         } else {
             next.estimate.xi = xp;
             next.p = pm;
-            next.estimate.missing = next
-                .estimate
-                .missing
-                .checked_add(1)
-                .ok_or(Error::StepCountOverflow)?;
         }
-        next.estimate.n = next
-            .estimate
-            .n
-            .checked_add(1)
-            .ok_or(Error::StepCountOverflow)?;
+        (next.estimate.n, next.estimate.missing) =
+            next_counts(e.n, e.missing, present).ok_or(Error::StepCountOverflow)?;
         let finite = next
             .estimate
             .xi
@@ -1018,19 +938,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> InputStateFilter<T
 
 #[cfg(test)]
 mod tests {
+    use super::super::roof_force_fixture as model;
     use super::*;
-    use crate::models;
-    use crate::observer::{Outputs, StateSpace};
-
-    fn model() -> InputModel<10, 1, 2> {
-        let (m, c, k) = models::five_storey_building();
-        let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02).unwrap();
-        let mut out = Outputs::<5, 1, 2>::zero();
-        out.a[0][4] = 1.0;
-        out.u[1][4] = 1.0;
-        InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap()
-    }
 
     /// Regression: the checked steps of the joint estimators wrapped their counters
     /// (`u64::MAX + 1 = 0`); they now refuse with a typed error, the state unchanged.

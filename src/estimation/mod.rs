@@ -135,6 +135,51 @@
 //! checks it against the paper's recursion with the cross term written in the test, and the
 //! residual's `χ²_{O−I}` mean by simulation. (The dual filter does not take `N`.)
 
+/// The accessors the joint input–state estimators share (each keeps `gamma1: [[T; I]; S]`
+/// and, the fixed-gain ones, `time_step: T`): for a fixed-gain estimator on
+/// [`JointEstimate`] (`fixed`) the time step, the start and the physical state; for a
+/// time-varying one (`varying`, with its state type) the physical state.
+macro_rules! joint_accessors {
+    (fixed $ty:ident) => {
+        impl<T: $crate::Real, const S: usize, const I: usize, const O: usize> $ty<T, S, I, O> {
+            /// The time step `h` (s).
+            pub fn time_step(&self) -> T {
+                self.time_step
+            }
+
+            /// The start from a physical state `x0` and input `w0`: `ξ̂_0 = x0 − Γ₁ w0`,
+            /// `ŵ_0 = w0`. Errors: [`Error::NonFiniteInput`](crate::Error::NonFiniteInput).
+            /// Cost: `S·I` multiply-adds.
+            pub fn start(
+                &self,
+                x0: &nalgebra::SVector<T, S>,
+                w0: &nalgebra::SVector<T, I>,
+            ) -> Result<$crate::estimation::JointEstimate<T, S, I>, $crate::Error> {
+                $crate::estimation::joint::joint_start(&self.gamma1, x0, w0)
+            }
+
+            /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n` (`[u; v]` for a full model:
+            /// read drifts etc. from `(x̂_n, ŵ_n)` with a
+            /// [`Readout`](crate::observer::Readout)). Cost: `S·I` multiply-adds.
+            pub fn state(
+                &self,
+                e: &$crate::estimation::JointEstimate<T, S, I>,
+            ) -> nalgebra::SVector<T, S> {
+                $crate::estimation::joint::shift(&self.gamma1, &e.xi, &e.w, T::one())
+            }
+        }
+    };
+    (varying $ty:ident, $state:ident) => {
+        impl<T: $crate::Real, const S: usize, const I: usize, const O: usize> $ty<T, S, I, O> {
+            /// The physical state estimate `x̂_n = ξ̂_n + Γ₁ ŵ_n`. Cost: `S·I` multiply-adds.
+            pub fn state(&self, s: &$state<T, S, I, O>) -> nalgebra::SVector<T, S> {
+                let e = &s.estimate;
+                $crate::estimation::joint::shift(&self.gamma1, &e.xi, &e.w, T::one())
+            }
+        }
+    };
+}
+
 pub mod augmented;
 pub mod dual;
 mod joint;
@@ -179,7 +224,7 @@ pub const RANK_TOLERANCE: f64 = 1e-10;
 impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
     /// Every matrix finite: the estimators' first check of a model (which may have been
     /// built or edited by hand). Errors: [`Error::NonFiniteInput`].
-    pub(crate) fn check_finite(&self) -> Result<(), Error> {
+    pub(crate) const fn check_finite(&self) -> Result<(), Error> {
         if all_finite(&self.a)
             && all_finite(&self.b)
             && all_finite(&self.c)
@@ -194,12 +239,43 @@ impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
 
     /// Every matrix rounds to a finite value of the scalar type whose largest finite value
     /// is `max`.
-    pub(crate) fn fits(&self, max: f64) -> bool {
+    pub(crate) const fn fits(&self, max: f64) -> bool {
         finite_as(&self.a, max)
             && finite_as(&self.b, max)
             && finite_as(&self.c, max)
             && finite_as(&self.d, max)
             && finite_as(&self.gamma1, max)
+    }
+
+    /// The checks of a fixed-gain estimator on this model (`const fn`, the run-time
+    /// constructors and the `const fn` twins alike): the model, the state gain `gx`
+    /// (`S×O`) and the input gain `gw` (`I×O`) finite, the time step a valid one of the
+    /// scalar type whose largest finite value is `max`, and the model, `stored` (the
+    /// state gain as the estimator keeps it: `gx` itself, or the joint filter's
+    /// `L = K (I − D̃ M)`) and `gw` fitting that type.
+    ///
+    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
+    /// [`Error::OperatorOverflow`]. Cost: `O(S² + S·O)` comparisons.
+    pub(crate) const fn check_fixed_gains(
+        &self,
+        gx: &Mat<S, O>,
+        stored: &Mat<S, O>,
+        gw: &Mat<I, O>,
+        max: f64,
+    ) -> Result<(), Error> {
+        if let Err(e) = self.check_finite() {
+            return Err(e);
+        }
+        if !(all_finite(gx) && all_finite(gw)) {
+            return Err(Error::NonFiniteInput);
+        }
+        if let Err(e) = crate::kinematics::check_time_step_as(self.time_step, max) {
+            return Err(e);
+        }
+        if !(self.fits(max) && finite_as(stored, max) && finite_as(gw, max)) {
+            return Err(Error::OperatorOverflow);
+        }
+        Ok(())
     }
 
     /// The standard form of `model` measured by `meas` (`const fn`): `A = Φ`,
@@ -327,6 +403,33 @@ impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
     }
 }
 
+/// A model with no known input, `x_n = Φ x_{n−1}`, `y_n = H x_n` (`S` states, `O`
+/// outputs, time step `h` in s), for [`SteadyState`](crate::observer::SteadyState): a stage
+/// of the dual filter, the augmented model. Cost: a copy.
+const fn bare_model<const S: usize, const O: usize>(
+    phi: [[f64; S]; S],
+    h: [[f64; S]; O],
+    time_step: f64,
+) -> (StateSpace<0, S, 0>, Measurement<S, 0, O>) {
+    let model = StateSpace::<0, S, 0> {
+        phi,
+        gamma0: [[0.0; 0]; S],
+        gamma1: [[0.0; 0]; S],
+        dof_u: [],
+        dof_v: [],
+        dof_a: [],
+        dof_a_input: [],
+        time_step,
+    };
+    (
+        model,
+        Measurement {
+            h,
+            d: [[0.0; 0]; O],
+        },
+    )
+}
+
 /// `f` (symmetric, `I×I`) has every Cholesky pivot at least `RANK_TOLERANCE` of its diagonal
 /// entry (and positive).
 const fn full_rank<const I: usize>(f: &Mat<I, I>) -> bool {
@@ -342,4 +445,19 @@ const fn full_rank<const I: usize>(f: &Mat<I, I>) -> bool {
         i += 1;
     }
     true
+}
+
+/// The fixture of the estimators' unit tests: the 5-storey building (AEM, `h = 0.02` s)
+/// with an unknown force at the roof, the roof's absolute acceleration and displacement
+/// measured.
+#[cfg(test)]
+fn roof_force_fixture() -> InputModel<10, 1, 2> {
+    use crate::observer::Outputs;
+    let (m, c, k) = crate::models::five_storey_building();
+    let roof = [[0.0], [0.0], [0.0], [0.0], [1.0]];
+    let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, roof, 0.02).unwrap();
+    let mut out = Outputs::<5, 1, 2>::zero();
+    out.a[0][4] = 1.0;
+    out.u[1][4] = 1.0;
+    InputModel::from_parts(&ss, &ss.outputs(&out).unwrap()).unwrap()
 }

@@ -25,10 +25,12 @@ use nalgebra::{SMatrix, SVector};
 use crate::linalg::{self, Mat, add_scaled, all_finite, finite_as, identity, mul, round_rows};
 use crate::linalg::{rows_f64, transpose};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance, lu_of, symmetrize};
-use crate::observer::{innovation_parts, is_zero};
+use crate::observer::{innovation_parts, is_zero, next_counts};
 use crate::{Error, Real, StepState};
 
-/// The gains `K_1 … K_L` (`K_0` is the filter gain), from the steady solution and `r`.
+/// The gains `K_0` (the filter gain) and `K_1 … K_L` from the steady solution and `r`,
+/// and the checks that the model and the gains fit the scalar type whose largest finite
+/// value is `max` (the run-time constructor and the `const fn` twins alike).
 #[allow(clippy::type_complexity)]
 const fn lag_gains<
     const N: usize,
@@ -41,6 +43,7 @@ const fn lag_gains<
     meas: &Measurement<S, I, O>,
     steady: &SteadyState<S, O>,
     r: &Mat<O, O>,
+    max: f64,
 ) -> Result<(Mat<S, O>, [Mat<S, O>; L]), Error> {
     if !is_covariance(r, true) {
         return Err(Error::InvalidCovariance);
@@ -101,7 +104,26 @@ const fn lag_gains<
         };
         i += 1;
     }
-    Ok((k0, ks))
+    // The model and gains fit `T`.
+    if !(all_finite(&model.gamma0) && all_finite(&model.gamma1) && all_finite(&k0)) {
+        return Err(Error::NonFiniteInput);
+    }
+    let mut ok = finite_as(&model.phi, max)
+        && finite_as(&model.gamma0, max)
+        && finite_as(&model.gamma1, max)
+        && finite_as(&meas.h, max)
+        && finite_as(&meas.d, max)
+        && finite_as(&k0, max);
+    let mut i = 0;
+    while i < L {
+        ok = ok && finite_as(&ks[i], max);
+        i += 1;
+    }
+    if ok {
+        Ok((k0, ks))
+    } else {
+        Err(Error::OperatorOverflow)
+    }
 }
 
 /// The state of a [`FixedLag`] smoother: the filtered estimate `x̂_{n|n}`, the last
@@ -170,41 +192,6 @@ pub struct FixedLag<T, const S: usize, const I: usize, const O: usize, const L: 
     ks: [[[T; O]; S]; L],
 }
 
-/// The model and gains fit `T`.
-const fn fit_checks<
-    const N: usize,
-    const S: usize,
-    const I: usize,
-    const O: usize,
-    const L: usize,
->(
-    model: &StateSpace<N, S, I>,
-    meas: &Measurement<S, I, O>,
-    k0: &Mat<S, O>,
-    ks: &[Mat<S, O>; L],
-    max: f64,
-) -> Result<(), Error> {
-    if !(all_finite(&model.gamma0) && all_finite(&model.gamma1) && all_finite(k0)) {
-        return Err(Error::NonFiniteInput);
-    }
-    let mut ok = finite_as(&model.phi, max)
-        && finite_as(&model.gamma0, max)
-        && finite_as(&model.gamma1, max)
-        && finite_as(&meas.h, max)
-        && finite_as(&meas.d, max)
-        && finite_as(k0, max);
-    let mut i = 0;
-    while i < L {
-        ok = ok && finite_as(&ks[i], max);
-        i += 1;
-    }
-    if ok {
-        Ok(())
-    } else {
-        Err(Error::OperatorOverflow)
-    }
-}
-
 impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize>
     FixedLag<T, S, I, O, L>
 {
@@ -220,8 +207,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize>
         steady: &SteadyState<S, O>,
         r: &SMatrix<f64, O, O>,
     ) -> Result<Self, Error> {
-        let (k0, ks) = lag_gains::<N, S, I, O, L>(model, meas, steady, &rows_f64(r))?;
-        fit_checks(model, meas, &k0, &ks, T::MAX)?;
+        let (k0, ks) = lag_gains::<N, S, I, O, L>(model, meas, steady, &rows_f64(r), T::MAX)?;
         Ok(Self {
             phi: round_rows(&model.phi),
             gamma0: round_rows(&model.gamma0),
@@ -324,14 +310,9 @@ impl<T: Real, const S: usize, const I: usize, const O: usize, const L: usize>
             next.past_w[head] = s.w.into();
             next.head = (head + 1) % L;
         }
-        if !measured {
-            next.missing = next
-                .missing
-                .checked_add(1)
-                .ok_or(Error::StepCountOverflow)?;
-        }
         next.w = *w;
-        next.n = next.n.checked_add(1).ok_or(Error::StepCountOverflow)?;
+        (next.n, next.missing) =
+            next_counts(s.n, s.missing, measured).ok_or(Error::StepCountOverflow)?;
         if !next.is_finite() {
             return Err(Error::NonFiniteState);
         }
@@ -355,13 +336,11 @@ macro_rules! lag_const {
                 steady: &SteadyState<S, O>,
                 r: &[[f64; O]; O],
             ) -> Result<Self, Error> {
-                let (k0, ks) = match lag_gains::<N, S, I, O, L>(model, meas, steady, r) {
+                let max = $t::MAX as f64;
+                let (k0, ks) = match lag_gains::<N, S, I, O, L>(model, meas, steady, r, max) {
                     Ok(g) => g,
                     Err(e) => return Err(e),
                 };
-                if let Err(e) = fit_checks(model, meas, &k0, &ks, $t::MAX as f64) {
-                    return Err(e);
-                }
                 let mut kt = [[[0.0 as $t; O]; S]; L];
                 let mut i = 0;
                 while i < L {
@@ -387,21 +366,13 @@ lag_const!(f64, from_parts_f64);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::{self, base_excitation};
-    use crate::observer::Outputs;
+    use crate::observer::building_fixture;
 
     /// Regression: the smoother's step wrapped its counters (`u64::MAX + 1 = 0`); it now
     /// refuses with a typed error, the state unchanged.
     #[test]
     fn smoother_refuses_to_wrap_its_counters() {
-        let (m, c, k) = models::five_storey_building();
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02).unwrap();
-        let meas = ss
-            .outputs(&Outputs::absolute_accelerations(
-                Outputs::<5, 1, 2>::select([1, 4]),
-                0,
-            ))
-            .unwrap();
+        let (ss, meas) = building_fixture();
         let q = SMatrix::<f64, 10, 10>::identity() * 1e-10;
         let r = SMatrix::<f64, 2, 2>::identity() * 0.01;
         let kf = SteadyState::new(&ss, &meas, &q, &r).unwrap();

@@ -29,39 +29,65 @@ impl<T: Real, const S: usize, const I: usize> Estimate<T, S, I> {
     pub fn last_input(&self) -> &SVector<T, I> {
         &self.w
     }
-    /// Steps taken since the start.
-    pub fn steps(&self) -> u64 {
-        self.n
-    }
-    /// Steps whose measurement was missing (a non-finite entry): predicted, not corrected.
-    pub fn missing(&self) -> u64 {
-        self.missing
-    }
 }
 
-impl<T: Real, const S: usize, const I: usize> StepState for Estimate<T, S, I> {
-    #[inline]
-    fn is_finite(&self) -> bool {
-        self.x.iter().chain(self.w.iter()).all(|v| v.is_finite())
-    }
-    #[inline]
-    fn steps(&self) -> u64 {
-        self.n
+/// The counters and the finiteness every estimate shares (the observers' [`Estimate`],
+/// the joint estimators' [`JointEstimate`](crate::estimation::JointEstimate)): a state
+/// `$x` (`S` values), the input `w` (`I` values), the step count `n` and the count of
+/// missing samples `missing`.
+macro_rules! estimate_counters {
+    ($ty:ident, $x:ident) => {
+        impl<T: $crate::Real, const S: usize, const I: usize> $ty<T, S, I> {
+            /// Steps taken since the start.
+            pub fn steps(&self) -> u64 {
+                self.n
+            }
+            /// Steps whose measurement was missing (a non-finite entry): predicted, not
+            /// corrected (a joint estimator also holds its input estimate).
+            pub fn missing(&self) -> u64 {
+                self.missing
+            }
+        }
+
+        impl<T: $crate::Real, const S: usize, const I: usize> $crate::StepState for $ty<T, S, I> {
+            #[inline]
+            fn is_finite(&self) -> bool {
+                self.$x.iter().chain(self.w.iter()).all(|v| v.is_finite())
+            }
+            #[inline]
+            fn steps(&self) -> u64 {
+                self.n
+            }
+        }
+    };
+}
+pub(crate) use estimate_counters;
+
+estimate_counters!(Estimate, x);
+
+/// The counters after one more step of every estimator: the step count `n + 1` and the
+/// count of missing samples, `missing + 1` unless the measurement is `present`; `None`
+/// where either would pass `u64::MAX` (the step is then refused, never wrapped).
+/// Cost: two checked additions.
+#[inline(always)]
+pub(crate) fn next_counts(n: u64, missing: u64, present: bool) -> Option<(u64, u64)> {
+    match (n.checked_add(1), missing.checked_add(u64::from(!present))) {
+        (Some(n), Some(missing)) => Some((n, missing)),
+        _ => None,
     }
 }
 
 /// The checked steps' counter check: the step count `n` and, if `y` is missing (a
-/// non-finite entry), the count of missing samples `missing` must have room for one more.
-/// Errors: [`Error::StepCountOverflow`].
+/// non-finite entry), the count of missing samples `missing` must have room for one more
+/// ([`next_counts`]). Errors: [`Error::StepCountOverflow`].
 pub(crate) fn check_counts<T: Real, const O: usize>(
     n: u64,
     missing: u64,
     y: &SVector<T, O>,
 ) -> Result<(), Error> {
-    if n == u64::MAX || (missing == u64::MAX && !y.iter().all(|v| v.is_finite())) {
-        Err(Error::StepCountOverflow)
-    } else {
-        Ok(())
+    match next_counts(n, missing, y.iter().all(|v| v.is_finite())) {
+        Some(_) => Ok(()),
+        None => Err(Error::StepCountOverflow),
     }
 }
 
@@ -437,21 +463,13 @@ readout_const!(f64, from_parts_f64);
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::{self, base_excitation};
-    use crate::observer::Outputs;
+    use crate::observer::building_fixture;
 
     /// Regression: the checked step wrapped its counters (`u64::MAX + 1 = 0`); it now
     /// refuses with a typed error and leaves the estimate bit-identical.
     #[test]
     fn observer_try_step_refuses_to_wrap_its_counters() {
-        let (m, c, k) = models::five_storey_building();
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02).unwrap();
-        let meas = ss
-            .outputs(&Outputs::absolute_accelerations(
-                Outputs::<5, 1, 2>::select([1, 4]),
-                0,
-            ))
-            .unwrap();
+        let (ss, meas) = building_fixture();
         let obs = Observer::<f64, 10, 1, 2>::new(&ss, &meas, &SMatrix::zeros()).unwrap();
         let w = SVector::from([0.1]);
         let mut e = obs.start_at_rest(&w).unwrap();

@@ -3,11 +3,12 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::fixed::{Estimate, initial_estimate};
+use super::fixed::{Estimate, initial_estimate, next_counts};
 use super::kalman_core::is_covariance;
-use super::kalman_core::{cross_is_valid, gain_t, innovation_t, is_zero, joseph_t};
+use super::kalman_core::{check_start_covariance, checked_cross_t, gain_t, innovation_t, joseph_t};
+use super::kalman_core::{noise_fits, predict_t};
 use super::state_space::{Measurement, StateSpace};
-use crate::linalg::{Mat, all_finite, finite_as, matrix_t, rows_f64, sym};
+use crate::linalg::{Mat, all_finite, finite_as, matrix_t, rows_f64};
 use crate::{Error, Real};
 
 /// The state of a [`Kalman`] filter: the [`Estimate`] and its a-posteriori error
@@ -109,10 +110,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         if !(is_covariance(&qr, false) && is_covariance(&rr, true)) {
             return Err(Error::InvalidCovariance);
         }
-        let zero = is_zero(n);
-        if !zero && !cross_is_valid(&qr, &rr, n) {
-            return Err(Error::InvalidCovariance);
-        }
+        let cross = checked_cross_t(&qr, &rr, n)?;
         if !(all_finite(&meas.h) && all_finite(&meas.d)) {
             return Err(Error::NonFiniteInput);
         }
@@ -121,9 +119,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
             && finite_as(&model.gamma1, T::MAX)
             && finite_as(&meas.h, T::MAX)
             && finite_as(&meas.d, T::MAX)
-            && finite_as(&qr, T::MAX)
-            && finite_as(&rr, T::MAX)
-            && finite_as(n, T::MAX);
+            && noise_fits(&qr, &rr, n, T::MAX);
         if !fits {
             return Err(Error::OperatorOverflow);
         }
@@ -135,7 +131,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
             d: matrix_t(&meas.d),
             q: matrix_t(&qr),
             r: matrix_t(&rr),
-            cross: if zero { None } else { Some(matrix_t(n)) },
+            cross,
         })
     }
 
@@ -150,17 +146,14 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         w0: &SVector<T, I>,
     ) -> Result<KalmanState<T, S, I>, Error> {
         let estimate = initial_estimate(x0, w0)?;
-        let pr: [[f64; S]; S] = rows_f64(p0);
-        if !is_covariance(&pr, false) {
-            return Err(Error::InvalidCovariance);
-        }
+        check_start_covariance(p0)?;
         Ok(KalmanState { estimate, p: *p0 })
     }
 
     /// The a-priori covariance of the next step, `P⁻ = Φ P Φᵀ + Q` (what converges to
     /// the Riccati solution). Cost: `2S³`.
     pub fn predicted_covariance(&self, s: &KalmanState<T, S, I>) -> SMatrix<T, S, S> {
-        sym(&(self.phi * s.p * self.phi.transpose() + self.q))
+        predict_t(&self.phi, &s.p, &self.q)
     }
 
     /// One filter step with input `w` (`w_n`) and measurement `y` (a non-finite entry:
@@ -203,7 +196,8 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         // Xᵀ = H P⁻ (+ Nᵀ), Σ = H P⁻ Hᵀ + R (+ H N + Nᵀ Hᵀ): the one Kalman core.
         let (xt, si) = innovation_t(&pm, &self.h, &self.r, cross);
         let innov = y - self.h * xp - self.d * w;
-        if y.iter().all(|v| v.is_finite()) {
+        let present = y.iter().all(|v| v.is_finite());
+        if present {
             let chol = si.cholesky().ok_or(Error::InvalidCovariance)?;
             // Kᵀ = Σ⁻¹ Xᵀ.
             let k = gain_t(&chol, &xt);
@@ -212,18 +206,11 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         } else {
             next.estimate.x = xp;
             next.p = pm;
-            next.estimate.missing = next
-                .estimate
-                .missing
-                .checked_add(1)
-                .ok_or(Error::StepCountOverflow)?;
         }
         next.estimate.w = *w;
-        next.estimate.n = next
-            .estimate
-            .n
-            .checked_add(1)
-            .ok_or(Error::StepCountOverflow)?;
+        (next.estimate.n, next.estimate.missing) =
+            next_counts(s.estimate.n, s.estimate.missing, present)
+                .ok_or(Error::StepCountOverflow)?;
         let finite = next
             .estimate
             .x
@@ -241,21 +228,13 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::{self, base_excitation};
-    use crate::observer::Outputs;
+    use crate::observer::building_fixture;
 
     /// Regression: the checked step wrapped its counters (`u64::MAX + 1 = 0`); it now
     /// refuses with a typed error and leaves the state bit-identical.
     #[test]
     fn kalman_step_refuses_to_wrap_its_counters() {
-        let (m, c, k) = models::five_storey_building();
-        let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, base_excitation(&m), 0.02).unwrap();
-        let meas = ss
-            .outputs(&Outputs::absolute_accelerations(
-                Outputs::<5, 1, 2>::select([1, 4]),
-                0,
-            ))
-            .unwrap();
+        let (ss, meas) = building_fixture();
         let q = SMatrix::<f64, 10, 10>::identity() * 1e-10;
         let r = SMatrix::<f64, 2, 2>::identity() * 0.01;
         let kal = Kalman::<f64, 10, 1, 2>::new(&ss, &meas, &q, &r).unwrap();

@@ -43,10 +43,11 @@
 use nalgebra::{Cholesky, SMatrix};
 
 use super::state_space::lu_of;
-use crate::Real;
 use crate::linalg::cholesky::cholesky;
 use crate::linalg::lu::Lu;
-use crate::linalg::{Mat, add_scaled, all_finite, is_symmetric, max_abs, mul, sym, transpose};
+use crate::linalg::{Mat, add_scaled, all_finite, finite_as, is_symmetric, matrix_t, max_abs};
+use crate::linalg::{mul, rows_f64, sym, transpose};
+use crate::{Error, Real};
 
 /// `a` symmetric to `64 ε max|a|` and all finite.
 const fn symmetric<const N: usize>(a: &Mat<N, N>) -> bool {
@@ -240,5 +241,71 @@ pub(crate) fn joseph_t<T: Real, const S: usize, const O: usize>(
             let c = ikh * n * k.transpose();
             sym(&(p - c - c.transpose()))
         }
+    }
+}
+
+/// The a-priori covariance `P⁻ = Φ P Φᵀ + Q`, symmetrized: the prediction of the
+/// time-varying filters whose state noise enters alone (the Kalman filter, the dual
+/// filter's state stage). Cost: `2S³` multiply-adds.
+pub(crate) fn predict_t<T: Real, const S: usize>(
+    phi: &SMatrix<T, S, S>,
+    p: &SMatrix<T, S, S>,
+    q: &SMatrix<T, S, S>,
+) -> SMatrix<T, S, S> {
+    sym(&(phi * p * phi.transpose() + q))
+}
+
+/// The a-posteriori covariance in the short form, `P⁻ − K Xᵀ` (`Xᵀ = H P⁻` of
+/// [`innovation_t`] without a cross term), symmetrized: the form of the filters that
+/// publish it (the dual filter's stages). Cost: `S²·O` multiply-adds.
+pub(crate) fn short_form_t<T: Real, const S: usize, const O: usize>(
+    pm: &SMatrix<T, S, S>,
+    k: &SMatrix<T, S, O>,
+    xt: &SMatrix<T, O, S>,
+) -> SMatrix<T, S, S> {
+    sym(&(pm - k * xt))
+}
+
+/// The cross covariance `n` (`S×O`) of a time-varying filter with noises `q` (`S×S`) and
+/// `r` (`O×O`, both checked by the caller), rounded to `T`: `None` when every entry is
+/// exactly zero (the filters' original code path, bit for bit), else `n` after
+/// [`cross_is_valid`]. Whether `n` fits `T` is [`noise_fits`]'s to say.
+/// Errors: [`Error::InvalidCovariance`]. Cost: as [`cross_is_valid`].
+pub(crate) fn checked_cross_t<T: Real, const S: usize, const O: usize>(
+    q: &Mat<S, S>,
+    r: &Mat<O, O>,
+    n: &Mat<S, O>,
+) -> Result<Option<SMatrix<T, S, O>>, Error> {
+    if is_zero(n) {
+        Ok(None)
+    } else if cross_is_valid(q, r, n) {
+        Ok(Some(matrix_t(n)))
+    } else {
+        Err(Error::InvalidCovariance)
+    }
+}
+
+/// The noise model `q` (`S×S`), `r` (`O×O`) and `n` (`S×O`) rounds to finite values of the
+/// scalar type whose largest finite value is `max`. Cost: `S² + O² + S·O` comparisons.
+pub(crate) const fn noise_fits<const S: usize, const O: usize>(
+    q: &Mat<S, S>,
+    r: &Mat<O, O>,
+    n: &Mat<S, O>,
+    max: f64,
+) -> bool {
+    finite_as(q, max) && finite_as(r, max) && finite_as(n, max)
+}
+
+/// A filter's start covariance `p` (`S×S`, in the filter's scalar type) is a covariance:
+/// finite, symmetric, positive semidefinite ([`is_covariance`] on its `f64` values).
+/// Errors: [`Error::InvalidCovariance`]. Cost: `S³/6` flops.
+pub(crate) fn check_start_covariance<T: Real, const S: usize>(
+    p: &SMatrix<T, S, S>,
+) -> Result<(), Error> {
+    let pr: Mat<S, S> = rows_f64(p);
+    if is_covariance(&pr, false) {
+        Ok(())
+    } else {
+        Err(Error::InvalidCovariance)
     }
 }

@@ -84,13 +84,27 @@ mod riccati;
 mod state_space;
 
 pub use fixed::{Estimate, Observer, Readout};
+pub(crate) use fixed::{check_counts, estimate_counters, next_counts};
 pub use kalman::{Kalman, KalmanState};
 // For the joint input–state estimators (`crate::estimation`).
 pub(crate) use kalman_core::{
-    cross_is_valid, cross_riccati_start, gain_t, innovation_parts, innovation_t, is_zero,
+    check_start_covariance, checked_cross_t, cross_is_valid, cross_riccati_start, gain_t,
+    innovation_parts, innovation_t, is_zero, noise_fits, predict_t, short_form_t,
 };
 pub(crate) use kalman_core::{is_covariance, symmetrize};
-pub(crate) use riccati::{A_SMALL, balance, doubling, inf_norm};
+pub(crate) use riccati::{A_SMALL, balance, doubling_solution, inf_norm};
 pub use riccati::{RICCATI_MAX_ITERATIONS, RICCATI_RESIDUAL_UNITS, SteadyState};
 pub(crate) use state_space::lu_of;
 pub use state_space::{Measurement, Outputs, StateSpace};
+
+/// The fixture of the filters' unit tests: the 5-storey building (AEM, `h = 0.02` s)
+/// under ground acceleration, the absolute accelerations of floors 2 and 5 measured.
+#[cfg(test)]
+pub(crate) fn building_fixture() -> (StateSpace<5, 10, 1>, Measurement<10, 1, 2>) {
+    let (m, c, k) = crate::models::five_storey_building();
+    let excitation = crate::models::base_excitation(&m);
+    let ss = StateSpace::<5, 10, 1>::from_rows_aem(m, c, k, excitation, 0.02).unwrap();
+    let outputs = Outputs::absolute_accelerations(Outputs::<5, 1, 2>::select([1, 4]), 0);
+    let meas = ss.outputs(&outputs).unwrap();
+    (ss, meas)
+}

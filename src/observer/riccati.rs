@@ -100,6 +100,34 @@ const RICCATI_RESIDUAL_REFINE: f64 = 4.0;
 /// come are quadratic in it.
 pub(crate) const A_SMALL: f64 = 1.4901161193847656e-8;
 
+/// The a-priori covariance the doubling algorithm solves for from `start = (A₀, G₀, X₀)`
+/// within `max_iterations`, and the iterations taken; `None` if it breaks down, does not
+/// converge, or stops at an iterate that is not a covariance (for a model with an
+/// unobservable marginal mode, two free masses with only their sum measured, the doubling
+/// stopped at a `P` with diagonal entries of −4e10: found by fuzzing). With the cross
+/// term's start ([`cross_riccati_start`](super::kalman_core::cross_riccati_start)) the
+/// doubling solves for `Y` and the a-priori covariance is `Y + Q`: pass `q_cross = Some(Q)`.
+/// Shared by [`SteadyState`] and the joint filter's steady state. Cost: [`doubling`]'s,
+/// plus `N³/6` flops for the check.
+pub(crate) const fn doubling_solution<const S: usize>(
+    start: (Mat<S, S>, Mat<S, S>, Mat<S, S>),
+    max_iterations: u32,
+    q_cross: Option<&Mat<S, S>>,
+) -> Option<(Mat<S, S>, u32)> {
+    let (x, k, converged) = match doubling(start.0, start.1, start.2, max_iterations) {
+        Some(v) => v,
+        None => return None,
+    };
+    if !(converged && is_covariance(&x, false)) {
+        return None;
+    }
+    let x = match q_cross {
+        None => x,
+        Some(q) => symmetrize(&add_scaled(&x, 1.0, &symmetrize(q))),
+    };
+    Some((x, k))
+}
+
 /// The doubling algorithm for the filter Riccati equation `X = Aᵀ X A − …` in the form
 /// `A₀ = Aᵀ`, `G₀ = G`, `X₀ = X`: `W = I + G X`, `X ← X + Aᵀ X W⁻¹ A`,
 /// `G ← G + A W⁻¹ G Aᵀ`, `A ← A W⁻¹ A`, at most `max` times. Returns `(X, iterations,
@@ -492,20 +520,13 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
                 cross_riccati_start(phi, h, &qy, &sy, &pi)
             }
         };
-        let (x, k, converged) = match doubling(start.0, start.1, start.2, RICCATI_MAX_ITERATIONS) {
+        let q_cross = match n {
+            None => None,
+            Some(_) => Some(q),
+        };
+        let (x, k) = match doubling_solution(start, RICCATI_MAX_ITERATIONS, q_cross) {
             Some(v) => v,
             None => return Err(Error::RiccatiNotConverged),
-        };
-        // A "converged" iterate that is not a covariance is no solution: for a model with
-        // an unobservable marginal mode (two free masses, only their sum measured) the
-        // doubling stopped at a P with diagonal entries of −4e10 (found by fuzzing).
-        if !(converged && is_covariance(&x, false)) {
-            return Err(Error::RiccatiNotConverged);
-        }
-        // With the cross term the doubling solved for Y: the a-priori covariance is Y + Q.
-        let x = match n {
-            None => x,
-            Some(_) => symmetrize(&add_scaled(&x, 1.0, &symmetrize(q))),
         };
         // The solution verified, not trusted: an iterate that stops moving is not
         // necessarily the stabilizing solution to working accuracy (found by fuzzing). Its
