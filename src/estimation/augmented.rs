@@ -25,7 +25,7 @@
 use nalgebra::SVector;
 
 use super::{InputModel, bare_model};
-use crate::linalg::{Mat, all_finite, identity};
+use crate::linalg::{Mat, all_finite, identity, put};
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
 use crate::{Error, Real};
 
@@ -46,25 +46,6 @@ pub struct AugmentedModel<const S: usize, const I: usize, const Z: usize, const 
     pub cross_noise: [[f64; O]; Z],
     /// `Γ₁` of the physical state `x = ξ + Γ₁ w`.
     pub gamma1: [[f64; I]; S],
-}
-
-/// `src` (`R₂×C₂`) copied into `dst` (`R×C`) with its first entry at `(r0, c0)` (the block
-/// must fit). Cost: `R₂·C₂` copies.
-const fn put<const R: usize, const C: usize, const R2: usize, const C2: usize>(
-    dst: &mut Mat<R, C>,
-    src: &Mat<R2, C2>,
-    r0: usize,
-    c0: usize,
-) {
-    let mut i = 0;
-    while i < R2 {
-        let mut j = 0;
-        while j < C2 {
-            dst[r0 + i][c0 + j] = src[i][j];
-            j += 1;
-        }
-        i += 1;
-    }
 }
 
 impl<const S: usize, const I: usize, const Z: usize, const O: usize> AugmentedModel<S, I, Z, O> {

@@ -381,6 +381,27 @@ pub(crate) const fn first_error<const L: usize>(
     under
 }
 
+/// Copy the `R2×C2` block `src` into `dst` at row `r0`, column `c0` (entries outside
+/// `dst` are skipped).
+pub(crate) const fn put<const R1: usize, const C1: usize, const R2: usize, const C2: usize>(
+    dst: &mut Mat<R1, C1>,
+    src: &Mat<R2, C2>,
+    r0: usize,
+    c0: usize,
+) {
+    let mut i = 0;
+    while i < R2 {
+        let mut j = 0;
+        while j < C2 {
+            if r0 + i < R1 && c0 + j < C1 {
+                dst[r0 + i][c0 + j] = src[i][j];
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -47,7 +47,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::kernel::{StartOps, input_kernel_operators, start_operators};
 use crate::linalg::lu::{Lu, row_scales};
 use crate::linalg::{
-    Mat, Rows, add_scaled, all_finite, identity, mul, rows_f64, scaled, transpose,
+    Mat, Rows, add_scaled, all_finite, identity, mul, put, rows_f64, scaled, transpose,
 };
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
@@ -289,27 +289,6 @@ const fn newmark_blocks<const N: usize, const I: usize>(
         aw,
     };
     Ok(blocks)
-}
-
-/// Copy the `R2×C2` block `src` into `dst` at row `r0`, column `c0` (entries outside
-/// `dst` are skipped).
-const fn put<const R1: usize, const C1: usize, const R2: usize, const C2: usize>(
-    dst: &mut Mat<R1, C1>,
-    src: &Mat<R2, C2>,
-    r0: usize,
-    c0: usize,
-) {
-    let mut i = 0;
-    while i < R2 {
-        let mut j = 0;
-        while j < C2 {
-            if r0 + i < R1 && c0 + j < C1 {
-                dst[r0 + i][c0 + j] = src[i][j];
-            }
-            j += 1;
-        }
-        i += 1;
-    }
 }
 
 impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
