@@ -117,6 +117,11 @@ pub enum Error {
     /// `u64::MAX`: a checked step refuses rather than wrap to zero; the estimate was left
     /// unchanged. Start a new estimate (with the old one's state) to go on.
     StepCountOverflow,
+    /// A feedback gain does not stabilize its loop: the closed-loop transition matrix
+    /// (`Φ − Γ K` of a [`control`](crate::control) design, or an observer's error dynamics
+    /// when a design certifies them) has spectral radius `≥ 1`, certified with its rounding
+    /// bounded. Nothing was built.
+    NotStabilizing,
 }
 
 /// Which parameter an [`Error::InvalidParameter`] or [`Error::InvalidMaterial`] names; its
@@ -190,6 +195,15 @@ pub enum Param {
     FrictionForce,
     /// A friction law's regularizing velocity `v_r` (finite, `> 0`).
     ReferenceVelocity,
+    /// A control design's weights: `Q` (or `Q_y`) finite, symmetric, positive
+    /// semidefinite; `R` finite, symmetric, positive definite; the cross weight such that
+    /// the joint weight `[Q S; Sᵀ R]` is positive semidefinite.
+    Weight,
+    /// A saturation limit (force, stroke, voltage, rate) finite and `> 0`.
+    Saturation,
+    /// A control device's parameters (damper, actuator, mass damper) finite and in their
+    /// documented ranges.
+    Device,
 }
 
 impl Param {
@@ -244,6 +258,11 @@ impl Param {
             Param::BoucWenShape => "Bouc-Wen needs beta > 0, |gamma| <= beta, n >= 1, all finite",
             Param::FrictionForce => "the friction slip force must be finite and > 0",
             Param::ReferenceVelocity => "the friction reference velocity must be finite and > 0",
+            Param::Weight => {
+                "control weights: Q symmetric >= 0, R symmetric > 0, [Q S; S' R] >= 0, all finite"
+            }
+            Param::Saturation => "a saturation limit must be finite and > 0",
+            Param::Device => "a control device's parameter is not finite or out of its range",
         }
     }
 }
@@ -318,6 +337,9 @@ impl Error {
             }
             Error::StepCountOverflow => {
                 "an estimator's step or missing-sample count would pass u64::MAX; state unchanged"
+            }
+            Error::NotStabilizing => {
+                "the feedback gain does not stabilize: closed-loop spectral radius >= 1"
             }
         }
     }

@@ -252,6 +252,7 @@ pub mod detection;
 
 // Modal reduction, stability analysis, ready-made models.
 pub mod analysis;
+pub mod control;
 pub mod estimation;
 pub mod hybrid;
 pub mod hysteresis;

@@ -61,6 +61,7 @@ from ._aemstep import (  # noqa: F401  (re-exported)
     NonFiniteInput,
     NonFiniteState,
     NotConverged,
+    NotStabilizing,
     OperatorOverflow,
     OperatorUnderflow,
     RiccatiNotConverged,

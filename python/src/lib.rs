@@ -132,6 +132,7 @@ variants!(
     MalformedRecord,
     StiffnessIndefinite,
     StepCountOverflow,
+    NotStabilizing,
 );
 
 /// Why a run stopped: a library error (at a step, if a step failed) or a bad argument.
