@@ -6,3 +6,11 @@
 //! magnetorheological damper, passive baselines) and the semi-active laws that command
 //! them. Fixed size, `no_std`, `f32`/`f64`; every gain can be computed in `const fn` into
 //! flash, and a failed step changes nothing.
+
+pub mod devices;
+
+pub use devices::{
+    ActuatorHistory, Coupled, Device, ForceActuator, LinearStructure, Link, MassDamper, MrDamper,
+    MrHistory, MrParameters, MrPhenomenological, PhenomenologicalHistory,
+    PhenomenologicalParameters, Viscous, mass_damper,
+};
