@@ -75,6 +75,10 @@ impl<T: Real> MrCore<T> {
     fn new(p: &MrParameters, extra: &[f64]) -> Result<Self, Error> {
         let device = Error::InvalidMaterial(Param::Device);
         let nonneg = |x: f64| x.is_finite() && x >= 0.0;
+        // The saturation first: the extra coefficients may be formed with it.
+        if !positive(p.v_max) {
+            return Err(Error::InvalidParameter(Param::Saturation));
+        }
         if !(positive(p.c0a)
             && nonneg(p.c0b)
             && positive(p.alpha_a)
@@ -89,9 +93,6 @@ impl<T: Real> MrCore<T> {
             && extra.iter().all(|&x| nonneg(x)))
         {
             return Err(device);
-        }
-        if !positive(p.v_max) {
-            return Err(Error::InvalidParameter(Param::Saturation));
         }
         // dz/dx = A (1 − |z|ⁿ ((γ/A) sgn(ẋ z) + β/A)): the crate's law with u_y = 1/A.
         let z = BoucWen::new(p.a, 1.0, 0.0, p.gamma / p.a, p.beta / p.a, p.n).map_err(|e| {
