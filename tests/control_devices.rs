@@ -421,7 +421,8 @@ fn a_failed_step_changes_nothing() {
 fn bad_input_gives_typed_errors() {
     let device = Some(Error::InvalidMaterial(Param::Device));
     let sat = Some(Error::InvalidParameter(Param::Saturation));
-    let bad: [(fn(&mut MrParameters), Option<Error>); 14] = [
+    type Mutation = fn(&mut MrParameters);
+    let bad: [(Mutation, Option<Error>); 14] = [
         (|p| p.c0a = 0.0, device),
         (|p| p.c0b = -1.0, device),
         (|p| p.alpha_a = f64::NAN, device),

@@ -396,10 +396,10 @@ impl<T: Real, S: HistoryModel<T, N>, D: Device<T>, const N: usize> HistoryModel<
 
     fn trial(
         &self,
-        committed: &Self::History,
+        committed: &(S::History, D::History),
         u: &SVector<T, N>,
         v: &SVector<T, N>,
-    ) -> Trial<T, N, Self::History> {
+    ) -> Trial<T, N, (S::History, D::History)> {
         let st = self.structure.trial(&committed.0, u, v);
         let dt = self.device_trial(&committed.1, u, v);
         self.combine(st, &dt)
@@ -409,7 +409,7 @@ impl<T: Real, S: HistoryModel<T, N>, D: Device<T>, const N: usize> HistoryModel<
     /// the structure gives none (finite differences of the whole trial).
     fn tangent(
         &self,
-        committed: &Self::History,
+        committed: &(S::History, D::History),
         u: &SVector<T, N>,
         v: &SVector<T, N>,
     ) -> Option<Tangent<T, N>> {
@@ -435,11 +435,11 @@ impl<T: Real, S: HistoryModel<T, N>, D: Device<T>, const N: usize> HistoryModel<
     /// otherwise or when the structure's is `None`.
     fn trial_tridiagonal(
         &self,
-        committed: &Self::History,
+        committed: &(S::History, D::History),
         u: &SVector<T, N>,
         v: &SVector<T, N>,
         tangent: &mut TridiagonalTangent<T, N>,
-    ) -> Option<Trial<T, N, Self::History>> {
+    ) -> Option<Trial<T, N, (S::History, D::History)>> {
         let (i, j) = self.link.ends();
         let banded = match j {
             None => i == 0,

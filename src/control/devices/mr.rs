@@ -209,18 +209,11 @@ impl<T: Real> Device<T> for MrDamper<T> {
         self.core.limits()
     }
 
-    fn trial(
-        &self,
-        committed: &MrHistory<T>,
-        d: T,
-        rate: T,
-        command: T,
-        h: T,
-    ) -> LawTrial<T, MrHistory<T>> {
-        let u = self.core.voltage(committed.voltage, command, h);
+    fn trial(&self, old: &Self::History, d: T, r: T, v: T, h: T) -> LawTrial<T, Self::History> {
+        let u = self.core.voltage(old.voltage, v, h);
         let (alpha, c0) = self.core.coefficients(u);
-        let z = self.core.z.trial(&committed.z, d, rate);
-        let force = c0 * rate + alpha * z.force;
+        let z = self.core.z.trial(&old.z, d, r);
+        let force = c0 * r + alpha * z.force;
         LawTrial {
             force,
             stiffness: alpha * z.stiffness,
@@ -349,6 +342,11 @@ impl<T: Real> MrPhenomenological<T> {
 impl<T: Real> Device<T> for MrPhenomenological<T> {
     type History = PhenomenologicalHistory<T>;
 
+    fn command_limits(&self) -> (T, T) {
+        self.core.limits()
+    }
+
+    /// At rest: `y = ẏ = z = 0` at `x = 0`, 0 V, the accumulator's force `−k₁ x₀`.
     fn initial_history(&self) -> PhenomenologicalHistory<T> {
         PhenomenologicalHistory {
             z: self.core.z.initial_history(),
@@ -359,33 +357,22 @@ impl<T: Real> Device<T> for MrPhenomenological<T> {
         }
     }
 
-    fn command_limits(&self) -> (T, T) {
-        self.core.limits()
-    }
-
-    fn trial(
-        &self,
-        committed: &PhenomenologicalHistory<T>,
-        d: T,
-        rate: T,
-        command: T,
-        h: T,
-    ) -> LawTrial<T, PhenomenologicalHistory<T>> {
+    fn trial(&self, old: &Self::History, d: T, r: T, v: T, h: T) -> LawTrial<T, Self::History> {
         let one = T::one();
         let half_h = h * T::from_f64_rounded(0.5);
-        let u = self.core.voltage(committed.voltage, command, h);
+        let u = self.core.voltage(old.voltage, v, h);
         let (alpha, c0) = self.core.coefficients(u);
         let c1 = self.c1a + self.c1b * u;
         let total = c0 + c1;
-        let (y0, yd0) = (committed.y, committed.y_rate);
+        let (y0, yd0) = (old.y, old.y_rate);
         let tol = T::from_f64_rounded(64.0) * T::default_epsilon();
         let nan = T::from_f64_rounded(f64::NAN);
         // Newton on R(y) = y − y₀ − (h/2)(ẏ₀ + ẏ(y)), from the explicit predictor.
         let mut y = y0 + h * yd0;
         let mut done = None;
         for _ in 0..MAX_ITERATIONS {
-            let z = self.core.z.trial(&committed.z, d - y, rate);
-            let y_rate = (alpha * z.force + c0 * rate + self.k0 * (d - y)) / total;
+            let z = self.core.z.trial(&old.z, d - y, r);
+            let y_rate = (alpha * z.force + c0 * r + self.k0 * (d - y)) / total;
             let p = (alpha * z.stiffness + self.k0) / total;
             let slope = one + half_h * p;
             let step = (y - y0 - half_h * (yd0 + y_rate)) / slope;
@@ -400,7 +387,7 @@ impl<T: Real> Device<T> for MrPhenomenological<T> {
         }
         let Some((z, y_rate, p, slope)) = done else {
             let history = PhenomenologicalHistory {
-                z: committed.z,
+                z: old.z,
                 y: nan,
                 y_rate: nan,
                 voltage: u,

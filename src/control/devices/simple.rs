@@ -69,9 +69,10 @@ impl<T: Real> Device<T> for ForceActuator<T> {
     type History = ActuatorHistory<T>;
 
     fn initial_history(&self) -> ActuatorHistory<T> {
+        let zero = T::zero();
         ActuatorHistory {
-            output: T::zero(),
-            deformation: T::zero(),
+            output: zero,
+            deformation: zero,
         }
     }
 
@@ -80,28 +81,21 @@ impl<T: Real> Device<T> for ForceActuator<T> {
         (-self.f_max, self.f_max)
     }
 
-    fn trial(
-        &self,
-        committed: &ActuatorHistory<T>,
-        d: T,
-        _rate: T,
-        command: T,
-        h: T,
-    ) -> LawTrial<T, ActuatorHistory<T>> {
+    fn trial(&self, old: &Self::History, d: T, _r: T, v: T, h: T) -> LawTrial<T, Self::History> {
         let zero = T::zero();
-        let v = if command > self.f_max {
+        let held = if v > self.f_max {
             self.f_max
-        } else if command < -self.f_max {
+        } else if v < -self.f_max {
             -self.f_max
         } else {
-            command // (NaN stays NaN)
+            v // (NaN stays NaN)
         };
-        let clipped = v != command;
+        let clipped = held != v;
         let mut output = match self.rate {
-            Some(r) => v + (committed.output - v) * <T as ComplexField>::exp(-(h * r)),
-            None => v,
+            Some(rate) => held + (old.output - held) * <T as ComplexField>::exp(-(h * rate)),
+            None => held,
         };
-        let d0 = committed.deformation;
+        let d0 = old.deformation;
         let stopped = d0.abs() >= self.stroke && output * d0 > zero;
         if stopped {
             output = zero;
