@@ -53,7 +53,7 @@
 //!     if n == 250 {
 //!         model.set_command(2.25)?; // volts, held from the next step on
 //!     }
-//!     let ag = 3.0 * (2.0 * 3.14159 * 4.0 * 0.002 * n as f64).sin(); // m/s²
+//!     let ag = 3.0 * (2.0 * std::f64::consts::PI * 4.0 * 0.002 * n as f64).sin(); // m/s²
 //!     stepper.try_step_with_history(&model, &mut s, &mut history, &SVector::from([-1000.0 * ag]))?;
 //! }
 //! assert!(model.delivered_force(&history).is_finite());
