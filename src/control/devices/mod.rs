@@ -8,7 +8,7 @@
 //! between two degrees of freedom (or one and the ground) of a structure (a
 //! [`LinearStructure`], or any [`HistoryModel`], e.g. the hysteretic
 //! [`ShearBuilding`](crate::hysteresis::ShearBuilding)) and is itself a [`HistoryModel`]:
-//! the crate's [`Nonlinear`](crate::Nonlinear) stepper advances structure and device
+//! the crate's [`Nonlinear`] stepper advances structure and device
 //! together, and a failed step changes neither state, history nor command. The command is
 //! set by the caller between steps ([`Coupled::set_command`]), clipped into the device's
 //! range.
