@@ -267,8 +267,11 @@ pub struct PhenomenologicalParameters {
 /// `y_n = y_{n−1} + (h/2) (ẏ_{n−1} + ẏ_n)`, with `ẏ_n` the model's at the step's end and
 /// `z_n` by the crate's [`BoucWen`] law (trapezoidal in the internal deformation `x − y`):
 /// an implicit, A-stable, second-order scheme — the equation for `ẏ` is stiff, its rate
-/// `(α ∂z/∂x + k₀)/(c₀ + c₁)` reaching `A α/(c₀ + c₁)`, above 10³ s⁻¹ at full voltage for
-/// the paper's damper. `y_n` is solved by a scalar Newton from the explicit predictor (2–4
+/// `p = (α ∂z/∂x + k₀)/(c₀ + c₁)` reaching `A α/(c₀ + c₁)`, 1.6e3 s⁻¹ at full voltage with
+/// the values of `tests/control_devices.rs`. (A-stable, not L-stable: a stiff transient is
+/// multiplied by `(1 − h p/2)/(1 + h p/2)` a step, 0.11 at `h p = 1.6` but −0.6 at
+/// `h p = 8`, where it alternates and decays slowly; keep `h p` below about 2.) `y_n` is
+/// solved by a scalar Newton from the explicit predictor (2–4
 /// iterations, at most 50, to `64 ε` relative), each iteration one Bouc–Wen trial. The
 /// consistent tangents, with `p = (α ∂z/∂(x − y) + k₀)/(c₀ + c₁)`,
 ///
