@@ -63,6 +63,28 @@ fn all_finite<T: Real, const D: usize>(x: &SVector<T, D>) -> bool {
     x.iter().all(|v| v.is_finite())
 }
 
+/// The input check of every law's command: both vectors finite, else
+/// [`Error::NonFiniteInput`].
+fn finite_inputs<T: Real, const A: usize, const D: usize>(
+    a: &SVector<T, A>,
+    measured: &SVector<T, D>,
+) -> Result<(), Error> {
+    if all_finite(a) && all_finite(measured) {
+        Ok(())
+    } else {
+        Err(Error::NonFiniteInput)
+    }
+}
+
+/// `v_i = V_max H(a_i f_i)` for every damper, by signs ([`on_if_same_sign`]).
+fn same_sign_commands<T: Real, const D: usize>(
+    a: &SVector<T, D>,
+    measured: &SVector<T, D>,
+    v_max: T,
+) -> SVector<T, D> {
+    a.zip_map(measured, |x, f| on_if_same_sign(x, f, v_max))
+}
+
 /// Clipped-optimal control of `D` MR dampers (Dyke, Spencer, Sain & Carlson 1996):
 ///
 /// ```text
@@ -125,13 +147,11 @@ impl<T: Real, const D: usize> ClippedOptimal<T, D> {
         desired: &SVector<T, D>,
         measured: &SVector<T, D>,
     ) -> Result<SVector<T, D>, Error> {
-        if !all_finite(desired) || !all_finite(measured) {
-            return Err(Error::NonFiniteInput);
-        }
-        // `f_c − f` may overflow to `±∞` for huge finite forces: its sign stays right.
-        Ok(SVector::from_fn(|i, _| {
-            on_if_same_sign(desired[i] - measured[i], measured[i], self.v_max)
-        }))
+        // `f_c − f`, formed before the check (no panic on any input: NaN or `±∞` here is
+        // refused next); it may overflow to `±∞` for huge finite forces, its sign right.
+        let lag = desired - measured;
+        finite_inputs(desired, measured)?;
+        Ok(same_sign_commands(&lag, measured, self.v_max))
     }
 }
 
@@ -235,17 +255,13 @@ impl<T: Real, const S: usize, const D: usize> Lyapunov<T, S, D> {
         z: &SVector<T, S>,
         measured: &SVector<T, D>,
     ) -> Result<SVector<T, D>, Error> {
-        if !all_finite(z) || !all_finite(measured) {
-            return Err(Error::NonFiniteInput);
-        }
-        let s = self.pb.tr_mul(z);
+        finite_inputs(z, measured)?;
+        // −zᵀ P B_i, whose sign with f_i's decides.
+        let s = -self.pb.tr_mul(z);
         if !all_finite(&s) {
             return Err(Error::NonFiniteState);
         }
-        // −s f > 0 ⇔ s and f of opposite signs ⇔ (−s) and f of one sign.
-        Ok(SVector::from_fn(|i, _| {
-            on_if_same_sign(-s[i], measured[i], self.v_max)
-        }))
+        Ok(same_sign_commands(&s, measured, self.v_max))
     }
 }
 
@@ -346,9 +362,7 @@ impl<T: Real, const D: usize> ModulatedFriction<T, D> {
         deformation: &SVector<T, D>,
         measured: &SVector<T, D>,
     ) -> Result<SVector<T, D>, Error> {
-        if !all_finite(deformation) || !all_finite(measured) {
-            return Err(Error::NonFiniteInput);
-        }
+        finite_inputs(deformation, measured)?;
         let zero = T::zero();
         let mut direction = self.direction;
         let mut extremum = self.extremum;
