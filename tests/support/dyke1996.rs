@@ -249,3 +249,171 @@ pub fn simulate(
     }
     p
 }
+
+/// The clipped-optimal controller of the benchmark's kind, built independently: a
+/// continuous LQR gain on the linear structure with the damper force as its input (CARE by
+/// Newton–Kleinman, each Lyapunov equation solved through its Kronecker form), a
+/// steady-state Kalman–Bucy filter on the absolute floor accelerations with the measured
+/// damper force as a known input and the ground acceleration as the process noise (the
+/// dual CARE), and the switching law `v = V_max H((f_c − f) f)` written out here.
+///
+/// The WEIGHTS AND NOISE INTENSITIES ARE NOT THE PAPER'S (not obtained, see
+/// `docs/control-benchmark-data.md`): they are the caller's.
+pub mod lqg {
+    use nalgebra::{DMatrix, DVector};
+
+    /// `Acᵀ P + P Ac = −Qc` for `P`, through `(I ⊗ Acᵀ + Acᵀ ⊗ I) vec P = −vec Qc`.
+    pub fn lyapunov(ac: &DMatrix<f64>, qc: &DMatrix<f64>) -> DMatrix<f64> {
+        let n = ac.nrows();
+        let at = ac.transpose();
+        let eye = DMatrix::<f64>::identity(n, n);
+        let big = eye.kronecker(&at) + at.kronecker(&eye);
+        let rhs = -DVector::from_column_slice(qc.as_slice());
+        let x = big
+            .lu()
+            .solve(&rhs)
+            .expect("a stable Ac: the Kronecker sum is regular");
+        let p = DMatrix::from_column_slice(n, n, x.as_slice());
+        (&p + p.transpose()) * 0.5
+    }
+
+    /// The stabilizing solution `P` of `Aᵀ P + P A − P B R⁻¹ Bᵀ P + Q = 0` and the gain
+    /// `K = R⁻¹ Bᵀ P`, by Newton–Kleinman from `K₀ = 0` (`A` must be stable), to a relative
+    /// change of `P` below `1e-13`.
+    pub fn care(
+        a: &DMatrix<f64>,
+        b: &DMatrix<f64>,
+        q: &DMatrix<f64>,
+        r: &DMatrix<f64>,
+    ) -> (DMatrix<f64>, DMatrix<f64>) {
+        let rinv = r.clone().try_inverse().expect("R positive definite");
+        let mut k = DMatrix::<f64>::zeros(b.ncols(), a.nrows());
+        let mut p = DMatrix::<f64>::zeros(a.nrows(), a.nrows());
+        for _ in 0..100 {
+            let ac = a - b * &k;
+            let qc = q + k.transpose() * r * &k;
+            let next = lyapunov(&ac, &qc);
+            let change = (&next - &p).abs().max() / next.abs().max();
+            p = next;
+            k = &rinv * b.transpose() * &p;
+            if change < 1e-13 {
+                break;
+            }
+        }
+        (p, k)
+    }
+}
+
+/// The design of [`clipped_optimal`]: the LQR gain `K` (1×6) on `x = [x₁ x₂ x₃ ẋ₁ ẋ₂ ẋ₃]`
+/// and the Kalman gain `L` (6×3), with the model they were built on.
+pub struct Design {
+    pub a: nalgebra::DMatrix<f64>,
+    pub b: nalgebra::DMatrix<f64>,
+    pub c: nalgebra::DMatrix<f64>,
+    pub d: nalgebra::DMatrix<f64>,
+    pub k: nalgebra::DMatrix<f64>,
+    pub l: nalgebra::DMatrix<f64>,
+    pub p: nalgebra::DMatrix<f64>,
+    pub sigma: nalgebra::DMatrix<f64>,
+}
+
+/// Designs the controller on the linear structure (the damper force `f` its input, entering
+/// as `Γ f`): LQR with `Q = q_disp · diag(1, 1, 1, 0, 0, 0)` (N²/m², on the floor
+/// displacements) and `R = r` (1/N² scale); Kalman–Bucy with the ground acceleration as
+/// white process noise of intensity `ground` ((m/s²)²·s) through `E = [0; −Λ]` and the
+/// three absolute accelerations measured with noise intensity `sensor` each.
+pub fn design(s: &Structure, q_disp: f64, r: f64, ground: f64, sensor: f64) -> Design {
+    use nalgebra::DMatrix;
+    let mut a = DMatrix::<f64>::zeros(6, 6);
+    let mut b = DMatrix::<f64>::zeros(6, 1);
+    let mut e = DMatrix::<f64>::zeros(6, 1);
+    let mut c = DMatrix::<f64>::zeros(3, 6);
+    let mut d = DMatrix::<f64>::zeros(3, 1);
+    for i in 0..3 {
+        a[(i, 3 + i)] = 1.0;
+        for j in 0..3 {
+            a[(3 + i, j)] = -s.k[i][j] / s.m[i];
+            a[(3 + i, 3 + j)] = -s.c[i][j] / s.m[i];
+            c[(i, j)] = a[(3 + i, j)];
+            c[(i, 3 + j)] = a[(3 + i, 3 + j)];
+        }
+        e[(3 + i, 0)] = -1.0;
+    }
+    b[(3, 0)] = -1.0 / s.m[0];
+    d[(0, 0)] = b[(3, 0)];
+    let mut q = DMatrix::<f64>::zeros(6, 6);
+    for i in 0..3 {
+        q[(i, i)] = q_disp;
+    }
+    let (p, k) = lqg::care(&a, &b, &q, &DMatrix::from_element(1, 1, r));
+    let w = &e * ground * e.transpose();
+    let rv = DMatrix::<f64>::identity(3, 3) * sensor;
+    let (sigma, lt) = lqg::care(&a.transpose(), &c.transpose(), &w, &rv);
+    Design {
+        a,
+        b,
+        c,
+        d,
+        k,
+        l: lt.transpose(),
+        p,
+        sigma,
+    }
+}
+
+/// The benchmark under clipped-optimal control: every `tc` seconds (a multiple of `h`) the
+/// controller reads the three absolute floor accelerations and the damper force, forms
+/// `f_c = −K x̂`, commands `v = V_max H((f_c − f) f)` (strict `H`: 0 V at `f = f_c` and at
+/// `f = 0`), and advances its estimate `x̂̇ = A x̂ + B f + L (y − C x̂ − D f)` over `tc` with
+/// the readings held (one RK4 step). The plant as in [`simulate`].
+pub fn clipped_optimal(
+    s: &Structure,
+    d: &Damper,
+    rec: &Record,
+    h: f64,
+    tc: f64,
+    g: &Design,
+) -> Peaks {
+    let every = (tc / h).round() as usize;
+    assert!(every >= 1 && ((every as f64) * h - tc).abs() < 1e-12 * tc);
+    let mut xhat = [0.0_f64; 6];
+    let mut calls = 0usize;
+    let mut v = 0.0;
+    simulate(s, d, rec, Attached::Yes, h, 1.0, |t, y, f| {
+        let n = calls;
+        calls += 1;
+        if !n.is_multiple_of(every) {
+            return v;
+        }
+        let ag = rec.at(t);
+        let acc = rates(s, d, Attached::Yes, ag, y, v).2;
+        let meas = [acc[0] + ag, acc[1] + ag, acc[2] + ag];
+        let mut fc = 0.0;
+        for j in 0..6 {
+            fc -= g.k[(0, j)] * xhat[j];
+        }
+        let lag = fc - f;
+        v = if lag * f > 0.0 { d.v_max } else { 0.0 };
+        xhat = rk4(t, &xhat, tc, |_, xh| {
+            let mut out = [0.0; 6];
+            let mut innov = [0.0; 3];
+            for i in 0..3 {
+                innov[i] = meas[i] - g.d[(i, 0)] * f;
+                for j in 0..6 {
+                    innov[i] -= g.c[(i, j)] * xh[j];
+                }
+            }
+            for i in 0..6 {
+                out[i] = g.b[(i, 0)] * f;
+                for j in 0..6 {
+                    out[i] += g.a[(i, j)] * xh[j];
+                }
+                for m in 0..3 {
+                    out[i] += g.l[(i, m)] * innov[m];
+                }
+            }
+            out
+        });
+        v
+    })
+}
