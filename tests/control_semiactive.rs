@@ -383,3 +383,50 @@ fn modulated_friction_refuses_bad_input_and_keeps_its_history() {
         .unwrap();
     assert_eq!(v, Vector2::new(VMAX, VMAX)); // peaks ±0.02 m: f_c = 2 N > 1 N
 }
+
+/// The laws in `f32` take the same decisions as the `f64` formulas on values exact in both
+/// (powers of two and small integers, so no rounding can move a sign or an equality).
+#[test]
+fn laws_in_f32_decide_like_the_formulas() {
+    let clipped = ClippedOptimal::<f32, 1>::new(VMAX).unwrap();
+    for (fc, f) in [
+        (8.0, 2.0),
+        (8.0, 16.0),
+        (-8.0, -2.0),
+        (8.0, 8.0),
+        (8.0, 0.0),
+    ] {
+        let got = clipped
+            .command(&Vector1::new(fc as f32), &Vector1::new(f as f32))
+            .unwrap()[0];
+        assert_eq!(got, clipped_reference(fc, f) as f32, "{fc} {f}");
+    }
+    let p = Matrix2::new(2.0, 0.5, 0.5, 1.0);
+    let b = Matrix2x1::new(0.0, -1.0);
+    let lyap = Lyapunov::<f32, 2, 1>::new(VMAX, &p, &b).unwrap();
+    for (z, f) in [
+        ((1.0, 1.0), 4.0),
+        ((1.0, 1.0), -4.0),
+        ((-2.0, 0.0), 4.0),
+        ((0.0, 0.0), 1.0),
+    ] {
+        let zf = Vector2::new(z.0 as f32, z.1 as f32);
+        let got = lyap.command(&zf, &Vector1::new(f as f32)).unwrap()[0];
+        let want = lyapunov_reference(&p, &b, &Vector2::new(z.0, z.1), &Vector1::new(f))[0];
+        assert_eq!(got, want as f32, "{z:?} {f}");
+    }
+    let mut friction = ModulatedFriction::<f32, 1>::new(VMAX, 4.0).unwrap();
+    let history = [0.5, 1.0, 0.75, 0.25];
+    let forces = [1.0, 1.0, 3.0, 4.0];
+    for k in 0..4 {
+        let got = friction
+            .command(
+                &Vector1::new(history[k] as f32),
+                &Vector1::new(forces[k] as f32),
+            )
+            .unwrap()[0];
+        let want = friction_reference(&history[..=k], 4.0, forces[k]) as f32;
+        assert_eq!(got, want, "sample {k}");
+    }
+    assert_eq!(friction.extremum()[0], 1.0);
+}
