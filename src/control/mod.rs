@@ -8,9 +8,11 @@
 //! flash, and a failed step changes nothing.
 
 pub mod devices;
+pub mod semiactive;
 
 pub use devices::{
     ActuatorHistory, Coupled, Device, ForceActuator, LinearStructure, Link, MassDamper, MrDamper,
     MrHistory, MrParameters, MrPhenomenological, PhenomenologicalHistory,
     PhenomenologicalParameters, Viscous, mass_damper,
 };
+pub use semiactive::{ClippedOptimal, Lyapunov, ModulatedFriction};
