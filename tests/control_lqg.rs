@@ -212,8 +212,8 @@ fn lqg_reduces_drift_and_is_robust_to_stiffness() {
         assert!(closed.drift < 0.6 * open.drift);
         assert!(closed.force <= LIMIT);
         // f32 against f64: the same loop to single-precision rounding amplified by the
-        // lightly damped plant (measured below 1e-4 relative).
-        assert!((closed32.drift - closed.drift).abs() <= 1e-3 * closed.drift);
+        // lightly damped plant (measured 2.6e-7 to 4.8e-7 relative: a few f32 ulps; bound 1e-5).
+        assert!((closed32.drift - closed.drift).abs() <= 1e-5 * closed.drift);
     }
 }
 
@@ -402,5 +402,5 @@ fn static_controller_is_built_at_compile_time() {
     let obs = Observer::<f32, 6, 1, 2>::new(&SS, &MEAS, &kf.gain_matrix()).unwrap();
     let run = Controller::new(obs, &lqr.gain_matrix(), &[LIMIT]).unwrap();
     assert_eq!(run, CONTROLLER);
-    assert!(LQR.radius_bound < 1.0);
+    const { assert!(LQR.radius_bound < 1.0) };
 }

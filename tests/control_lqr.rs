@@ -6,7 +6,7 @@
 
 use aemstep::control::{DesignModel, Lqr, Weights};
 use aemstep::models::{self, storey_drifts};
-use aemstep::nalgebra::{SMatrix, SVector};
+use aemstep::nalgebra::{DMatrix, SMatrix, SVector};
 use aemstep::observer::{Outputs, StateSpace};
 use aemstep::{Error, Param};
 
@@ -148,12 +148,27 @@ fn building_gain_matches_the_riccati_recursion() {
         );
         assert!((w.r[0][0] - rt).abs() <= 1e-15 * rt);
         let (p, k, its, _) = riccati_recursion(&phi, &g, &q, rt, &s);
-        let rho = lqr
-            .poles()
-            .unwrap()
-            .iter()
-            .map(|z| z.norm())
-            .fold(0.0, f64::max);
+        // The closed loop of the recursion's gain, its eigenvalues by nalgebra.
+        let moduli = |a: &M6| {
+            let mut m: Vec<f64> = DMatrix::from_fn(6, 6, |i, j| a[(i, j)])
+                .complex_eigenvalues()
+                .iter()
+                .map(|z| z.norm())
+                .collect();
+            m.sort_by(f64::total_cmp);
+            m
+        };
+        let reference = moduli(&(phi - g * k));
+        let rho = reference[5];
+        // The host-only poles of the crate: the same moduli.
+        #[cfg(feature = "std")]
+        {
+            let mut poles: Vec<f64> = lqr.poles().unwrap().iter().map(|z| z.norm()).collect();
+            poles.sort_by(f64::total_cmp);
+            for (a, b) in poles.iter().zip(&reference) {
+                assert!((a - b).abs() <= 1e-9, "{a} {b}");
+            }
+        }
         let tol = 64.0 * f64::EPSILON / (1.0 - rho * rho);
         let ep = (lqr.cost_matrix() - p).amax() / p.amax();
         let ek = (lqr.gain_matrix() - k).amax() / k.amax();

@@ -63,8 +63,8 @@ use nalgebra::SMatrix;
 use crate::linalg::cholesky::cholesky;
 use crate::linalg::{Mat, add_scaled, all_finite, identity, mul, put, rows_f64, sqrt, transpose};
 use crate::observer::{
-    Measurement, StateSpace, SteadyState, abs_of, definite_lu, inf_norm, is_covariance, stein,
-    symmetrize,
+    Measurement, StateSpace, SteadyState, abs_of, bare_model, definite_lu, inf_norm, is_covariance,
+    stein, symmetrize,
 };
 use crate::{Error, Param};
 
@@ -132,6 +132,11 @@ pub struct Weights<const S: usize, const I: usize> {
 }
 
 impl<const S: usize, const I: usize> Weights<S, I> {
+    /// Every weight is finite. Cost: `S² + I² + S·I` comparisons.
+    pub const fn is_finite(&self) -> bool {
+        all_finite(&self.q) && all_finite(&self.r) && all_finite(&self.cross)
+    }
+
     /// State and input weights, no cross weight. `const fn`, no check (see [`Weights`]).
     pub const fn new(q: &[[f64; S]; S], r: &[[f64; I]; I]) -> Self {
         Self {
@@ -198,6 +203,11 @@ impl<const S: usize, const I: usize> Weights<S, I> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Lqr<const S: usize, const I: usize> {
+    /// A certified upper bound on the spectral radius of `Φ − Γ K` (`< 1`), from the
+    /// Lyapunov certificate ([`Lqr::from_parts`]).
+    pub radius_bound: f64,
+    /// Doubling iterations the Riccati solver took.
+    pub iterations: u32,
     /// `K` (`I×S`): the control `u = −K x` (input units per state unit).
     pub gain: [[f64; S]; I],
     /// `P` (`S×S`): the stabilizing solution of the Riccati equation, the optimal
@@ -205,11 +215,6 @@ pub struct Lqr<const S: usize, const I: usize> {
     pub cost: [[f64; S]; S],
     /// `Φ − Γ K` (`S×S`), the closed loop.
     pub closed_loop: [[f64; S]; S],
-    /// A certified upper bound on the spectral radius of `Φ − Γ K` (`< 1`), from the
-    /// Lyapunov certificate ([`Lqr::from_parts`]).
-    pub radius_bound: f64,
-    /// Doubling iterations the Riccati solver took.
-    pub iterations: u32,
 }
 
 impl<const S: usize, const I: usize> Lqr<S, I> {
@@ -248,12 +253,7 @@ impl<const S: usize, const I: usize> Lqr<S, I> {
     ) -> Result<Self, Error> {
         let (phi, gamma) = (&model.phi, &model.gamma);
         let (q, r, s) = (&weights.q, &weights.r, &weights.cross);
-        if !(all_finite(phi)
-            && all_finite(gamma)
-            && all_finite(q)
-            && all_finite(r)
-            && all_finite(s))
-        {
+        if !(all_finite(phi) && all_finite(gamma) && weights.is_finite()) {
             return Err(Error::NonFiniteInput);
         }
         if !is_covariance(q, false) {
@@ -276,20 +276,7 @@ impl<const S: usize, const I: usize> Lqr<S, I> {
         }
         // The dual filter problem: Φ_f = Φ̄ᵀ, H_f = Γᵀ, process noise Q̄, measurement
         // noise R. Its a-priori covariance is the regulator's P.
-        let dual: StateSpace<0, S, 0> = StateSpace {
-            phi: transpose(&phi_bar),
-            gamma0: [[0.0; 0]; S],
-            gamma1: [[0.0; 0]; S],
-            dof_u: [],
-            dof_v: [],
-            dof_a: [],
-            dof_a_input: [],
-            time_step: 1.0,
-        };
-        let meas: Measurement<S, 0, I> = Measurement {
-            h: transpose(gamma),
-            d: [[0.0; 0]; I],
-        };
+        let (dual, meas) = bare_model(transpose(&phi_bar), transpose(gamma), 1.0);
         let ss = match SteadyState::<S, I>::from_parts(&dual, &meas, &q_bar, r) {
             Ok(ss) => ss,
             Err(Error::InvalidCovariance) => return Err(Error::InvalidParameter(Param::Weight)),
@@ -313,11 +300,11 @@ impl<const S: usize, const I: usize> Lqr<S, I> {
             None => return Err(Error::NotStabilizing),
         };
         Ok(Self {
+            radius_bound,
+            iterations: ss.iterations,
             gain,
             cost: p,
             closed_loop,
-            radius_bound,
-            iterations: ss.iterations,
         })
     }
 
@@ -400,7 +387,7 @@ pub(crate) const fn certified_radius<const N: usize>(a: &Mat<N, N>) -> Option<f6
     let unit = (2 * N + 4) as f64 * eps;
     let bound =
         (frobenius(&e) + unit * frobenius(&size)) * (1.0 + 4.0 * ((N * N + 2) as f64) * eps);
-    if !(bound < 1.0) {
+    if bound.is_nan() || bound >= 1.0 {
         return None;
     }
     // |λ|² ≤ 1 − (1 − e)/λ_max(X), λ_max(X) ≤ ‖X‖∞ (rounded up by its own sum's error).
