@@ -7,8 +7,8 @@
 //! them. Fixed size, `no_std`, `f32`/`f64`; every gain can be computed in `const fn` into
 //! flash, and a failed step changes nothing.
 
-mod lqg;
-mod lqr;
+pub mod lqg;
+pub mod lqr;
 
 pub use lqg::{Command, ControlState, Controller, Status};
 pub use lqr::{DesignModel, Lqr, Weights};
