@@ -11,7 +11,6 @@ use aemstep::observer::{Outputs, StateSpace};
 use aemstep::{Error, Param};
 
 type M6 = SMatrix<f64, 6, 6>;
-type G6 = SMatrix<f64, 6, 1>;
 
 /// The 3-storey shear building (1000 kg floors, 1 MN/m storeys, Rayleigh 2 % at its first
 /// and third modes), an actuator force on floor 1, zero-order hold at `h`.
@@ -30,14 +29,14 @@ fn building(h: f64) -> StateSpace<3, 6, 1> {
 /// finite-horizon cost-to-go, backwards) until the update is below `4ε ‖P‖` for 20
 /// iterations in a row. Returns `P`, its gain `(R + Γᵀ P Γ)⁻¹(Γᵀ P Φ + Sᵀ)`, the iterations
 /// and the last relative update.
-fn riccati_recursion(
-    phi: &M6,
-    g: &G6,
-    q: &M6,
+fn riccati_recursion<const S: usize>(
+    phi: &SMatrix<f64, S, S>,
+    g: &SMatrix<f64, S, 1>,
+    q: &SMatrix<f64, S, S>,
     r: f64,
-    s: &G6,
-) -> (M6, SMatrix<f64, 1, 6>, usize, f64) {
-    let mut p = M6::zeros();
+    s: &SMatrix<f64, S, 1>,
+) -> (SMatrix<f64, S, S>, SMatrix<f64, 1, S>, usize, f64) {
+    let mut p = SMatrix::<f64, S, S>::zeros();
     let mut calm = 0;
     let mut last = 0.0;
     for it in 0..400_000 {
@@ -439,4 +438,47 @@ fn sampled_design_converges_to_the_continuous_regulator() {
         }
         last = Some((e1, e2));
     }
+}
+
+/// A modal design: the 5-storey building's two lowest modes (`StateSpace::from_rows_modal`,
+/// `x = [η; η']`, 4 states; the AEM's two-ended input held over the step, `Γ₀ + Γ₁`), an
+/// actuator on floor 1, the roof drift weighted through the modal `H`. Against the Riccati
+/// recursion's limit as for the full model (same tolerance, from conditioning).
+#[test]
+fn modal_design_matches_the_riccati_recursion() {
+    let (m, _, k) = models::five_storey_building();
+    let ss = StateSpace::<5, 4, 1>::from_rows_modal(
+        m,
+        k,
+        aemstep::Damping::Ratios([0.02; 5]),
+        [[1.0], [0.0], [0.0], [0.0], [0.0]],
+        [0, 1],
+        0.01,
+    )
+    .unwrap();
+    let design = DesignModel::from_state_space(&ss);
+    let roof = ss
+        .outputs(&Outputs::displacements([[0.0, 0.0, 0.0, -1.0, 1.0]]))
+        .unwrap();
+    let w = Weights::outputs(&roof, &[[1.0e6]], &[[1.0e-9]]);
+    let lqr = Lqr::from_parts(&design, &w).unwrap();
+    let phi = SMatrix::<f64, 4, 4>::from_fn(|i, j| design.phi[i][j]);
+    let g = SMatrix::<f64, 4, 1>::from_fn(|i, _| design.gamma[i][0]);
+    let q = SMatrix::<f64, 4, 4>::from_fn(|i, j| w.q[i][j]);
+    let (p, kr, its, _) = riccati_recursion(&phi, &g, &q, w.r[0][0], &SMatrix::zeros());
+    let rho = DMatrix::from_fn(4, 4, |i, j| (phi - g * kr)[(i, j)])
+        .complex_eigenvalues()
+        .iter()
+        .map(|z| z.norm())
+        .fold(0.0, f64::max);
+    let tol = 64.0 * f64::EPSILON / (1.0 - rho * rho);
+    let ep = (lqr.cost_matrix() - p).amax() / p.amax();
+    let ek = (lqr.gain_matrix() - kr).amax() / kr.amax();
+    println!(
+        "modal: recursion {its} iterations; rho {rho:.6} (bound {:.6}); P error {ep:.1e}, \
+         K error {ek:.1e} (tolerance {tol:.1e})",
+        lqr.radius_bound
+    );
+    assert!(ep <= tol && ek <= tol);
+    assert!(rho <= lqr.radius_bound && lqr.radius_bound < 1.0);
 }
