@@ -287,6 +287,33 @@ macro_rules! const_ctor {
             /// `const fn` twin of [`Controller::new`] with the gain as row-major `f64`
             /// (`I×Z`, e.g. [`Lqr::gain`](super::Lqr::gain)); bit-identical to it.
             ///
+            /// ```
+            /// use aemstep::control::Controller;
+            /// use aemstep::models;
+            /// use aemstep::observer::{Observer, Outputs, StateSpace};
+            /// const B: (models::Rows<1>, models::Rows<1>) = models::shear_building([1.0e3], [4.0e4]);
+            /// const SS: StateSpace<1, 2, 1> =
+            ///     match StateSpace::from_rows_aem(B.0, [[40.0]], B.1, [[1.0]], 0.01) {
+            ///         Ok(s) => s,
+            ///         Err(e) => panic!("{}", e.as_str()),
+            ///     };
+            /// // The velocity measured, an open-loop observer, velocity feedback of 400 N·s/m.
+            /// static CTL: Controller<f32, 2, 1, 1> = match SS.outputs(&Outputs::velocities([[1.0]])) {
+            ///     Ok(meas) => match Observer::<f32, 2, 1, 1>::from_parts_f32(&SS, &meas, &[[0.0]; 2]) {
+            ///         Ok(obs) => match Controller::from_parts_f32(obs, &[[0.0, 400.0]], &[1.0e3]) {
+            ///             Ok(c) => c,
+            ///             Err(e) => panic!("{}", e.as_str()),
+            ///         },
+            ///         Err(e) => panic!("{}", e.as_str()),
+            ///     },
+            ///     Err(e) => panic!("{}", e.as_str()),
+            /// };
+            /// let mut st = CTL.start_at_rest();
+            /// let cmd = CTL.try_step(&mut st, &aemstep::vector![0.0], &aemstep::vector![0.0], false)?;
+            /// assert_eq!(cmd.force, [0.0]);
+            /// # Ok::<(), aemstep::Error>(())
+            /// ```
+            ///
             /// Errors: as [`Controller::new`].
             pub const fn $from_parts<const Z: usize>(
                 observer: Observer<$t, S, I, O>,

@@ -323,6 +323,22 @@ impl<const S: usize, const I: usize> Lqr<S, I> {
     /// `K = (R + Γᵀ P Γ)⁻¹ (Γᵀ P Φ + Sᵀ)` (`const fn`: in a `static` the compiler computes
     /// it).
     ///
+    /// ```
+    /// use aemstep::control::{DesignModel, Lqr, Weights};
+    /// // A lightly damped oscillator (ω = 2π rad/s) sampled at h = 0.01 s: Φ, Γ of its
+    /// // zero-order hold, rounded.
+    /// const PLANT: DesignModel<2, 1> = DesignModel {
+    ///     phi: [[0.998, 0.00999], [-0.3944, 0.9960]],
+    ///     gamma: [[5.0e-5], [0.00999]],
+    /// };
+    /// static LQR: Lqr<2, 1> = match Lqr::from_parts(
+    ///     &PLANT, &Weights::new(&[[40.0, 0.0], [0.0, 1.0]], &[[0.01]])) {
+    ///     Ok(l) => l,
+    ///     Err(e) => panic!("{}", e.as_str()),
+    /// };
+    /// assert!(LQR.radius_bound < 1.0 && LQR.gain[0][1] > 0.0);
+    /// ```
+    ///
     /// The cross weight is taken out (`Φ̄ = Φ − Γ R⁻¹ Sᵀ`, `Q̄ = Q − S R⁻¹ Sᵀ`) and the
     /// equation handed, as the dual of the filter's, to the observer's doubling solver
     /// [`SteadyState::from_parts`] (which refines and verifies its solution). The closed
