@@ -8,6 +8,8 @@
 //! flash, and a failed step changes nothing.
 
 pub mod devices;
+pub mod lqg;
+pub mod lqr;
 pub mod semiactive;
 
 pub use devices::{
@@ -15,4 +17,6 @@ pub use devices::{
     MrHistory, MrParameters, MrPhenomenological, PhenomenologicalHistory,
     PhenomenologicalParameters, Viscous, mass_damper,
 };
+pub use lqg::{Command, ControlState, Controller, Status};
+pub use lqr::{DesignModel, Lqr, Weights};
 pub use semiactive::{ClippedOptimal, Lyapunov, ModulatedFriction};

@@ -24,8 +24,9 @@
 
 use nalgebra::SVector;
 
-use super::{InputModel, bare_model};
+use super::InputModel;
 use crate::linalg::{Mat, all_finite, identity, put};
+use crate::observer::bare_model;
 use crate::observer::{Measurement, StateSpace, SteadyState, is_covariance};
 use crate::{Error, Real};
 

@@ -46,9 +46,10 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use super::InputModel;
 use super::joint::{JointEstimate, joint_start_covariances};
-use super::{InputModel, bare_model};
 use crate::linalg::{self, finite_as, identity, matrix_t, round_rows, sym};
+use crate::observer::bare_model;
 use crate::observer::{SteadyState, is_covariance};
 use crate::observer::{check_counts, next_counts};
 use crate::observer::{gain_t, innovation_t, predict_t, short_form_t};

@@ -403,33 +403,6 @@ impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
     }
 }
 
-/// A model with no known input, `x_n = Φ x_{n−1}`, `y_n = H x_n` (`S` states, `O`
-/// outputs, time step `h` in s), for [`SteadyState`](crate::observer::SteadyState): a stage
-/// of the dual filter, the augmented model. Cost: a copy.
-const fn bare_model<const S: usize, const O: usize>(
-    phi: [[f64; S]; S],
-    h: [[f64; S]; O],
-    time_step: f64,
-) -> (StateSpace<0, S, 0>, Measurement<S, 0, O>) {
-    let model = StateSpace::<0, S, 0> {
-        phi,
-        gamma0: [[0.0; 0]; S],
-        gamma1: [[0.0; 0]; S],
-        dof_u: [],
-        dof_v: [],
-        dof_a: [],
-        dof_a_input: [],
-        time_step,
-    };
-    (
-        model,
-        Measurement {
-            h,
-            d: [[0.0; 0]; O],
-        },
-    )
-}
-
 /// `f` (symmetric, `I×I`) has every Cholesky pivot at least `RANK_TOLERANCE` of its diagonal
 /// entry (and positive).
 const fn full_rank<const I: usize>(f: &Mat<I, I>) -> bool {

@@ -91,11 +91,11 @@ pub(crate) use kalman_core::{
     check_start_covariance, checked_cross_t, cross_is_valid, cross_riccati_start, gain_t,
     innovation_parts, innovation_t, is_zero, noise_fits, predict_t, short_form_t,
 };
-pub(crate) use kalman_core::{is_covariance, symmetrize};
-pub(crate) use riccati::{A_SMALL, balance, doubling_solution, inf_norm};
+pub(crate) use kalman_core::{definite_lu, is_covariance, symmetrize};
+pub(crate) use riccati::{A_SMALL, abs_of, balance, doubling_solution, inf_norm, stein};
 pub use riccati::{RICCATI_MAX_ITERATIONS, RICCATI_RESIDUAL_UNITS, SteadyState};
-pub(crate) use state_space::lu_of;
 pub use state_space::{Measurement, Outputs, StateSpace};
+pub(crate) use state_space::{bare_model, lu_of};
 
 /// The fixture of the filters' unit tests: the 5-storey building (AEM, `h = 0.02` s)
 /// under ground acceleration, the absolute accelerations of floors 2 and 5 measured.

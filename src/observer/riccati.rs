@@ -176,7 +176,7 @@ pub(crate) const fn doubling<const S: usize>(
 }
 
 /// `|a|` entry by entry.
-const fn abs_of<const R: usize, const C: usize>(a: &Mat<R, C>) -> Mat<R, C> {
+pub(crate) const fn abs_of<const R: usize, const C: usize>(a: &Mat<R, C>) -> Mat<R, C> {
     let mut b = *a;
     let mut i = 0;
     while i < R {
@@ -363,7 +363,7 @@ pub(crate) const fn balance<const N: usize>(a: &Mat<N, N>) -> (Mat<N, N>, [f64; 
 /// `2^(−26/2^k) < 1`; the terms still to come are then below `ε ‖X‖`), or else `None` — a
 /// spectral radius ≥ 1, within rounding of the squarings of 1, or a power that is not
 /// finite. Cost: `3 S³` flops a squaring, about `log₂(1/(1 − ρ))` of them.
-const fn stein<const N: usize>(a: &Mat<N, N>, w: &Mat<N, N>) -> Option<Mat<N, N>> {
+pub(crate) const fn stein<const N: usize>(a: &Mat<N, N>, w: &Mat<N, N>) -> Option<Mat<N, N>> {
     let (mut b, d) = balance(a);
     // W in the balanced coordinates, D⁻¹ W D⁻¹ (exact: powers of two).
     let mut x = *w;

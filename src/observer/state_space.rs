@@ -973,6 +973,34 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     }
 }
 
+/// A model with no known input, `x_n = Φ x_{n−1}`, `y_n = H x_n` (`S` states, `O`
+/// outputs, time step `h` in s), for [`SteadyState`](crate::observer::SteadyState): a stage
+/// of the dual filter, the augmented model, the regulator's dual problem
+/// ([`control::Lqr`](crate::control::Lqr)). Cost: a copy.
+pub(crate) const fn bare_model<const S: usize, const O: usize>(
+    phi: [[f64; S]; S],
+    h: [[f64; S]; O],
+    time_step: f64,
+) -> (StateSpace<0, S, 0>, Measurement<S, 0, O>) {
+    let model = StateSpace::<0, S, 0> {
+        phi,
+        gamma0: [[0.0; 0]; S],
+        gamma1: [[0.0; 0]; S],
+        dof_u: [],
+        dof_v: [],
+        dof_a: [],
+        dof_a_input: [],
+        time_step,
+    };
+    (
+        model,
+        Measurement {
+            h,
+            d: [[0.0; 0]; O],
+        },
+    )
+}
+
 /// Factorize a matrix for a solve, each row judged against its own size (`None` if
 /// singular to working precision).
 pub(crate) const fn lu_of<const N: usize>(a: &Mat<N, N>) -> Option<Lu<N>> {
