@@ -126,8 +126,16 @@ pub enum Error {
 
 /// Which parameter an [`Error::InvalidParameter`] or [`Error::InvalidMaterial`] names; its
 /// [`as_str`](Param::as_str) states the rule it broke (the limits live in the message).
-/// One byte, `Copy`, usable in `const` contexts.
+/// `Copy`, usable in `const` contexts.
+///
+/// Four bytes (`repr(u32)`), so that in [`Error`] it sits where
+/// [`Error::MalformedRecord`]'s `line: u32` does (offset 4): every payload of `Error` is then
+/// an aligned word and the compiler moves an `Error` as whole words. As one byte at offset 1
+/// it made the Cortex-M4F code of `Result<_, Error>` shift bytes in the Newton loop
+/// (`Nonlinear::try_step_with_history`: 3336 instead of 3293 instructions a step of the
+/// yielding 3-storey building, `docs/cortex-m4-cost.md`). `Error` stays 16 bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u32)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum Param {
@@ -362,3 +370,19 @@ impl fmt::Display for Error {
 }
 
 impl core::error::Error for Error {}
+
+#[cfg(test)]
+mod tests {
+    use super::{Error, Param};
+    use core::mem::{align_of, size_of};
+
+    /// Regression pin of the layout `Param`'s `repr(u32)` chooses (see its docs): `Param`
+    /// one word, `Error` still 16 bytes, so every payload of `Error` is an aligned word and
+    /// the M4F Newton loop costs what it cost before the payload (`docs/cortex-m4-cost.md`).
+    #[test]
+    fn param_is_a_word_and_error_stays_16_bytes() {
+        assert_eq!((size_of::<Param>(), align_of::<Param>()), (4, 4));
+        assert_eq!(size_of::<Error>(), 16);
+        assert_eq!(size_of::<Result<(), Error>>(), 16);
+    }
+}

@@ -23,6 +23,26 @@
 //! each with its tangent, plus `8N` for `M q` and the residual a trial. Stack: about three
 //! `N×N` matrices of `T`.
 
+/// `start_with_acceleration` of the nonlinear steppers (`Nonlinear`, `Varying`): the
+/// state at `t = 0` from the given `u0, v0, a0`, checked finite
+/// (`State::initial_given`), documented by the doc lines passed in and the shared
+/// errors and cost. Expands inside an `impl` block with `T: Real` and `N` in scope.
+macro_rules! start_with_acceleration {
+    ($(#[doc = $doc:expr])*) => {
+        $(#[doc = $doc])*
+        ///
+        /// Errors: [`Error::NonFiniteInput`]. Cost: O(N).
+        pub fn start_with_acceleration(
+            &self,
+            u0: &SVector<T, N>,
+            v0: &SVector<T, N>,
+            a0: &SVector<T, N>,
+        ) -> Result<State<T, N>, Error> {
+            State::initial_given(u0, v0, a0)
+        }
+    };
+}
+
 pub(crate) mod varying;
 
 use core::marker::PhantomData;
@@ -330,18 +350,10 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         Ok((state, trial.history))
     }
 
-    /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M`).
-    /// A model with history starts from its history as given (e.g.
-    /// [`HistoryModel::initial_history`]).
-    ///
-    /// Errors: [`Error::NonFiniteInput`]. Cost: O(N).
-    pub fn start_with_acceleration(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        a0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        State::initial_given(u0, v0, a0)
+    start_with_acceleration! {
+        /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M`).
+        /// A model with history starts from its history as given (e.g.
+        /// [`HistoryModel::initial_history`]).
     }
 
     /// Advance `state` from `t_{n−1}` to `t_n` under the load `p_n = p(t_n)`, committing
@@ -634,7 +646,8 @@ impl<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>
 }
 
 /// `r ← J⁻¹ r` with the dense tangent (the model's, or finite differences of its trials)
-/// and LU with partial pivoting. Cost: `N³/3 + 3N²` and one tangent evaluation.
+/// and LU with partial pivoting. Cost: `N³/3 + 3N²` and one tangent evaluation (without
+/// one, `N` trial evaluations).
 #[allow(clippy::too_many_arguments)]
 fn dense_solve<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>(
     model: &Mo,
@@ -668,7 +681,39 @@ fn dense_solve<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>(
                 });
             (j, scale)
         }
-        None => finite_difference_jacobian(model, committed, m, u, v, f, b, c)?,
+        // No tangent: `J = M + ∂F(û + c q, v̂ + b q)/∂q` by one forward difference per
+        // column (`N` trial evaluations), scale `max |M_ij| + |(J − M)_ij|`.
+        None => {
+            let sqrt_eps = T::default_epsilon().sqrt();
+            let one = T::one();
+            let mut j = *m;
+            let mut scale = T::zero();
+            // Column-major arrays: plain array indexing with loop-bounded indices, which the
+            // compiler proves in bounds (no panic path in the binary).
+            let (u_a, v_a, f_a) = (&u.data.0[0], &v.data.0[0], &f.data.0[0]);
+            for col in 0..N {
+                let (uj, vj) = (u_a[col], v_a[col]);
+                // u_j moves by √ε·max(|u_j|, 1), rounded so the step is exact in floating point;
+                // v_j moves along the same q_j direction, by (b/c) times that.
+                let shifted = uj + sqrt_eps * uj.abs().max(one);
+                let delta = (shifted - uj) / c;
+                let (mut up, mut vp) = (*u, *v);
+                up.data.0[0][col] = shifted;
+                vp.data.0[0][col] = vj + b * delta;
+                let fp = model.trial(committed, &up, &vp).force;
+                if !all_finite(&fp) {
+                    return Err(Error::NonFiniteForce);
+                }
+                let fp_a = &fp.data.0[0];
+                let j_col = &mut j.data.0[col];
+                for row in 0..N {
+                    let d = (fp_a[row] - f_a[row]) / delta;
+                    scale = scale.max(j_col[row].abs() + d.abs());
+                    j_col[row] += d;
+                }
+            }
+            (j, scale)
+        }
     };
     if !solve_in_place(&mut j, r, scale) {
         return Err(Error::SingularJacobian);
@@ -736,50 +781,6 @@ fn relative_residual<T: Real, const N: usize>(
     } else {
         T::zero()
     }
-}
-
-/// `J = M + ∂F(û + c q, v̂ + b q)/∂q` by one forward difference per column (`N` force
-/// evaluations), and the entry scale `max |M_ij| + |(J − M)_ij|` for the pivot test.
-#[allow(clippy::too_many_arguments)]
-fn finite_difference_jacobian<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>(
-    model: &Mo,
-    committed: &Mo::History,
-    m: &SMatrix<T, N, N>,
-    u: &SVector<T, N>,
-    v: &SVector<T, N>,
-    f: &SVector<T, N>,
-    b: T,
-    c: T,
-) -> Result<(SMatrix<T, N, N>, T), Error> {
-    let sqrt_eps = T::default_epsilon().sqrt();
-    let one = T::one();
-    let mut j = *m;
-    let mut scale = T::zero();
-    // Column-major arrays: plain array indexing with loop-bounded indices, which the
-    // compiler proves in bounds (no panic path in the binary).
-    let (u_a, v_a, f_a) = (&u.data.0[0], &v.data.0[0], &f.data.0[0]);
-    for col in 0..N {
-        let (uj, vj) = (u_a[col], v_a[col]);
-        // u_j moves by √ε·max(|u_j|, 1), rounded so the step is exact in floating point;
-        // v_j moves along the same q_j direction, by (b/c) times that.
-        let shifted = uj + sqrt_eps * uj.abs().max(one);
-        let delta = (shifted - uj) / c;
-        let (mut up, mut vp) = (*u, *v);
-        up.data.0[0][col] = shifted;
-        vp.data.0[0][col] = vj + b * delta;
-        let fp = model.trial(committed, &up, &vp).force;
-        if !all_finite(&fp) {
-            return Err(Error::NonFiniteForce);
-        }
-        let fp_a = &fp.data.0[0];
-        let j_col = &mut j.data.0[col];
-        for row in 0..N {
-            let d = (fp_a[row] - f_a[row]) / delta;
-            scale = scale.max(j_col[row].abs() + d.abs());
-            j_col[row] += d;
-        }
-    }
-    Ok((j, scale))
 }
 
 /// The state at step 0 with the acceleration from the equation of motion,

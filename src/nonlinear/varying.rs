@@ -130,16 +130,8 @@ impl<T: Real, const N: usize> Varying<T, N> {
         initial_from_equation(u0, v0, &k.mass, p0 - k.damping * v0 - k.stiffness * u0)
     }
 
-    /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M(0)`).
-    ///
-    /// Errors: [`Error::NonFiniteInput`]. Cost: O(N).
-    pub fn start_with_acceleration(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        a0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        State::initial_given(u0, v0, a0)
+    start_with_acceleration! {
+        /// The state at `t = 0` with a known initial acceleration `a0` (for singular `M(0)`).
     }
 
     /// Advance `state` from `t_{n−1}` to `t_n = n·h` under the load `p_n = p(t_n)`, with
