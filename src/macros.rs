@@ -77,17 +77,7 @@ pub(crate) use const_try;
 pub const fn rows_to_columns<T: Copy, const R: usize, const C: usize>(
     rows: [[T; C]; R],
 ) -> [[T; R]; C] {
-    let mut columns = [[rows[0][0]; R]; C];
-    let mut i = 0;
-    while i < R {
-        let mut j = 0;
-        while j < C {
-            columns[j][i] = rows[i][j];
-            j += 1;
-        }
-        i += 1;
-    }
-    columns
+    crate::linalg::transpose_filled(&rows, rows[0][0])
 }
 
 #[cfg(test)]

@@ -30,6 +30,7 @@ use crate::linalg::{
     self, Rows, all_finite, first_error, fits_alone, is_symmetric, max_abs, mul, rows_f64, sqrt,
     transpose,
 };
+use crate::observer::symmetrize;
 use crate::{Error, Real, State, StepState, Stepper};
 
 /// Relative tolerance below which `M`, `K` count as symmetric: `|a_ij − a_ji| ≤
@@ -201,18 +202,7 @@ pub(crate) const fn modes_of<const N: usize>(
     };
     // A = L⁻¹ K L⁻ᵀ = L⁻¹ (L⁻¹ K)ᵀ for symmetric K; symmetrized against rounding.
     let x = lower_solve(&l, k);
-    let mut a = lower_solve(&l, &transpose(&x));
-    let mut i = 0;
-    while i < N {
-        let mut j = 0;
-        while j < i {
-            let s = 0.5 * (a[i][j] + a[j][i]);
-            a[i][j] = s;
-            a[j][i] = s;
-            j += 1;
-        }
-        i += 1;
-    }
+    let a = symmetrize(&lower_solve(&l, &transpose(&x)));
     let (lam, q) = match jacobi_eigen(a, JACOBI_MAX_SWEEPS) {
         Ok(e) => e,
         Err(e) => return Err(e),

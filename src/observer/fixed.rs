@@ -241,16 +241,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
 
     /// The predicted measurement `H x + D w` of a state. Cost: `O·(S + I)`.
     pub fn predicted_output(&self, x: &SVector<T, S>, w: &SVector<T, I>) -> SVector<T, O> {
-        SVector::from_fn(|o, _| {
-            let mut s = T::zero();
-            for j in 0..S {
-                s += self.h[o][j] * x[j];
-            }
-            for j in 0..I {
-                s += self.d[o][j] * w[j];
-            }
-            s
-        })
+        h_x_plus_d_w(&self.h, &self.d, x, w)
     }
 
     /// One step: predict with the input `w` (`w_n`; `w_{n−1}` is kept in the estimate),
@@ -423,17 +414,30 @@ impl<T: Real, const S: usize, const I: usize, const P: usize> Readout<T, S, I, P
 
     /// `z = H x + D w`. Cost: `P·(S + I)` multiply-adds.
     pub fn read(&self, x: &SVector<T, S>, w: &SVector<T, I>) -> SVector<T, P> {
-        SVector::from_fn(|p, _| {
-            let mut s = T::zero();
-            for j in 0..S {
-                s += self.h[p][j] * x[j];
-            }
-            for j in 0..I {
-                s += self.d[p][j] * w[j];
-            }
-            s
-        })
+        h_x_plus_d_w(&self.h, &self.d, x, w)
     }
+}
+
+/// `H x + D w` row by row (`H` `R×S`, `D` `R×I`), each row's sum over `x` then `w`: the
+/// one output of [`Observer::predicted_output`] and [`Readout::read`]. Cost: `R·(S + I)`
+/// multiply-adds.
+#[inline]
+fn h_x_plus_d_w<T: Real, const S: usize, const I: usize, const R: usize>(
+    h: &[[T; S]; R],
+    d: &[[T; I]; R],
+    x: &SVector<T, S>,
+    w: &SVector<T, I>,
+) -> SVector<T, R> {
+    SVector::from_fn(|r, _| {
+        let mut s = T::zero();
+        for j in 0..S {
+            s += h[r][j] * x[j];
+        }
+        for j in 0..I {
+            s += d[r][j] * w[j];
+        }
+        s
+    })
 }
 
 macro_rules! readout_const {
