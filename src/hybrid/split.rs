@@ -3,6 +3,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::macros::mck_fn;
 use crate::schemes::kr_alpha::CHEN_RICLES;
 use crate::{AlphaParameters, Error, KrAlpha, Param, Real, State, StepInput, Stepper};
 
@@ -121,39 +122,30 @@ impl<T: Real, const N: usize> SplitState<T, N> {
 }
 
 impl<T: Real, const N: usize> Split<T, N> {
-    /// The split KR-α step with high-frequency spectral radius `rho_inf ∈ [0, 1]`, for
-    /// `M u'' + C u' + K_num u + r(t) = p(t)` with step `h` (s). `k` is the stiffness the
-    /// operators assume for the whole structure (numerical part plus the specimen's initial
-    /// stiffness), `k_num` the linear numerical part the step computes itself (zero when
-    /// every spring is given through `r`). Units as [`KrAlpha::new`]; computed in `f64`,
-    /// rounded once to `T`, bit-identical to [`Split::from_rows_f32`] / `from_rows_f64`.
-    ///
-    /// Errors: as [`KrAlpha::new`] (`k_num` checked for finiteness with `M, C, K`; its
-    /// operator `G K_num` must fit `T`).
-    ///
-    /// Cost: about `10N³` flops in `f64`.
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        k_num: &SMatrix<f64, N, N>,
-        h: f64,
-        rho_inf: f64,
-    ) -> Result<Self, Error> {
-        let p = AlphaParameters::chung_hulbert(rho_inf)?;
-        KrAlpha::with_rest(m, c, k, k_num, h, p).map(|kr| Self { kr })
+    mck_fn! {
+        /// The split KR-α step with high-frequency spectral radius `rho_inf ∈ [0, 1]`, for
+        /// `M u'' + C u' + K_num u + r(t) = p(t)` with step `h` (s). `k` is the stiffness the
+        /// operators assume for the whole structure (numerical part plus the specimen's initial
+        /// stiffness), `k_num` the linear numerical part the step computes itself (zero when
+        /// every spring is given through `r`). Units as [`KrAlpha::new`]; computed in `f64`,
+        /// rounded once to `T`, bit-identical to [`Split::from_rows_f32`] / `from_rows_f64`.
+        ///
+        /// Errors: as [`KrAlpha::new`] (`k_num` checked for finiteness with `M, C, K`; its
+        /// operator `G K_num` must fit `T`).
+        ///
+        /// Cost: about `10N³` flops in `f64`.
+        pub fn new(m, c, k, k_num: &SMatrix<f64, N, N>, h: f64, rho_inf: f64) {
+            let p = AlphaParameters::chung_hulbert(rho_inf)?;
+            KrAlpha::with_rest(m, c, k, k_num, h, p).map(|kr| Self { kr })
+        }
     }
 
-    /// The split Chen–Ricles step (`α_m = α_f = 0`, `γ = 1/2`, `β = 1/4`). Arguments,
-    /// errors and cost as [`Split::new`] without `rho_inf`.
-    pub fn chen_ricles(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        k_num: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        KrAlpha::with_rest(m, c, k, k_num, h, CHEN_RICLES).map(|kr| Self { kr })
+    mck_fn! {
+        /// The split Chen–Ricles step (`α_m = α_f = 0`, `γ = 1/2`, `β = 1/4`). Arguments,
+        /// errors and cost as [`Split::new`] without `rho_inf`.
+        pub fn chen_ricles(m, c, k, k_num: &SMatrix<f64, N, N>, h: f64) {
+            KrAlpha::with_rest(m, c, k, k_num, h, CHEN_RICLES).map(|kr| Self { kr })
+        }
     }
 
     /// The scheme's parameters `(α_m, α_f, β, γ)`. Cost: O(1).

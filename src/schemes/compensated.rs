@@ -11,6 +11,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::kernel::{Kernel, Lows, aem_const_ctors, initial_state, newmark_step_compensated};
 use crate::kinematics::{AemKinematics, Kinematics};
+use crate::macros::mck_fn;
 use crate::{Error, Real, State, StepState, Stepper};
 
 /// The state of a [`CompensatedLinear`]: the working-precision [`State`] and the rounding
@@ -98,17 +99,14 @@ pub struct CompensatedLinear<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> CompensatedLinear<T, N> {
-    /// Precompute the operators of [`Linear::new`](crate::Linear::new) (same arguments:
-    /// `M, C, K` `N×N` in `f64`, step `h` in s; computed in `f64`, rounded once to `T`).
-    ///
-    /// Errors: as [`Linear::new`](crate::Linear::new). Cost: about `4N³` flops in `f64`.
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
+    mck_fn! {
+        /// Precompute the operators of [`Linear::new`](crate::Linear::new) (same arguments:
+        /// `M, C, K` `N×N` in `f64`, step `h` in s; computed in `f64`, rounded once to `T`).
+        ///
+        /// Errors: as [`Linear::new`](crate::Linear::new). Cost: about `4N³` flops in `f64`.
+        pub fn new(m, c, k, h: f64) {
+            Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
+        }
     }
 
     /// `κ₁` of the row-equilibrated effective matrix, as
