@@ -5,6 +5,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::macros::mck_fn;
 use crate::schemes::kr_alpha::CHEN_RICLES;
+use crate::stepper::start_fn;
 use crate::{AlphaParameters, Error, KrAlpha, Param, Real, State, StepInput, Stepper};
 
 /// A KR-α step split in two for real-time hybrid simulation: the displacement command of
@@ -153,64 +154,57 @@ impl<T: Real, const N: usize> Split<T, N> {
         self.kr.parameters()
     }
 
-    /// The state at `t = 0` from `u0, v0` (m, m/s), the given restoring force `r0`
-    /// measured at `u0` and the load `p0` (force units): `a0 = M⁻¹ (p0 − r0 − C v0 −
-    /// K_num u0)` and the velocity variable `v0 − γh α1 a0` (second order from any state,
-    /// as [`KrAlpha`]'s start).
-    ///
-    /// Errors: [`Error::NonFiniteInput`] (`u0, v0` or `p0`), [`Error::NonFiniteForce`]
-    /// (`r0`), [`Error::NonFiniteState`] (`a0` overflows). Cost: `4N²` multiply-adds.
-    pub fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        r0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<SplitState<T, N>, Error> {
-        if !(u0.is_finite() && v0.is_finite() && p0.is_finite()) {
-            return Err(Error::NonFiniteInput);
+    start_fn! {
+        /// The state at `t = 0` from `u0, v0` (m, m/s), the given restoring force `r0`
+        /// measured at `u0` and the load `p0` (force units): `a0 = M⁻¹ (p0 − r0 − C v0 −
+        /// K_num u0)` and the velocity variable `v0 − γh α1 a0` (second order from any state,
+        /// as [`KrAlpha`]'s start).
+        ///
+        /// Errors: [`Error::NonFiniteInput`] (`u0, v0` or `p0`), [`Error::NonFiniteForce`]
+        /// (`r0`), [`Error::NonFiniteState`] (`a0` overflows). Cost: `4N²` multiply-adds.
+        pub fn start(&self, u0, v0, r0: &SVector<T, N>, p0: &SVector<T, N>) -> SplitState<T, N> {
+            if !(u0.is_finite() && v0.is_finite() && p0.is_finite()) {
+                return Err(Error::NonFiniteInput);
+            }
+            if !r0.is_finite() {
+                return Err(Error::NonFiniteForce);
+            }
+            let net = p0 - r0;
+            if !net.is_finite() {
+                return Err(Error::NonFiniteState);
+            }
+            let state = self.kr.start(u0, v0, &net)?;
+            Ok(SplitState {
+                state,
+                r: *r0,
+                p: *p0,
+            })
         }
-        if !r0.is_finite() {
-            return Err(Error::NonFiniteForce);
-        }
-        let net = p0 - r0;
-        if !net.is_finite() {
-            return Err(Error::NonFiniteState);
-        }
-        let state = self.kr.start(u0, v0, &net)?;
-        Ok(SplitState {
-            state,
-            r: *r0,
-            p: *p0,
-        })
     }
 
-    /// The state at `t = 0` with a known acceleration `a0` and velocity variable `v0` (the
-    /// papers' start; right for a state saved from this scheme), the given force `r0` and
-    /// load `p0`.
-    ///
-    /// Errors: [`Error::NonFiniteInput`] (`u0, v0, a0, p0`), [`Error::NonFiniteForce`]
-    /// (`r0`). Cost: O(N).
-    pub fn start_with_acceleration(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        a0: &SVector<T, N>,
-        r0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<SplitState<T, N>, Error> {
-        if !p0.is_finite() {
-            return Err(Error::NonFiniteInput);
+    start_fn! {
+        /// The state at `t = 0` with a known acceleration `a0` and velocity variable `v0` (the
+        /// papers' start; right for a state saved from this scheme), the given force `r0` and
+        /// load `p0`.
+        ///
+        /// Errors: [`Error::NonFiniteInput`] (`u0, v0, a0, p0`), [`Error::NonFiniteForce`]
+        /// (`r0`). Cost: O(N).
+        pub fn start_with_acceleration(&self, u0, v0, a0: &SVector<T, N>, r0: &SVector<T, N>, p0: &SVector<T, N>)
+            -> SplitState<T, N>
+        {
+            if !p0.is_finite() {
+                return Err(Error::NonFiniteInput);
+            }
+            let state = self.kr.start_with_acceleration(u0, v0, a0)?;
+            if !r0.is_finite() {
+                return Err(Error::NonFiniteForce);
+            }
+            Ok(SplitState {
+                state,
+                r: *r0,
+                p: *p0,
+            })
         }
-        let state = self.kr.start_with_acceleration(u0, v0, a0)?;
-        if !r0.is_finite() {
-            return Err(Error::NonFiniteForce);
-        }
-        Ok(SplitState {
-            state,
-            r: *r0,
-            p: *p0,
-        })
     }
 
     /// The displacement command `u_{n+1} = u_n + h v_n + h² α2 a_n` (m) for the next

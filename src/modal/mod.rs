@@ -31,6 +31,7 @@ use crate::linalg::{
     transpose,
 };
 use crate::observer::symmetrize;
+use crate::stepper::start_fn;
 use crate::{Error, Real, State, StepState, Stepper};
 
 /// Relative tolerance below which `M`, `K` count as symmetric: `|a_ij − a_ji| ≤
@@ -769,63 +770,57 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> St
         self.kin.h
     }
 
-    /// The state at `t = 0` from `u0`, `v0` (projected on the kept modes:
-    /// `η0 = Φ_Rᵀ M u0`, exact when `u0` lies in their span) and `w0`, with
-    /// `η0'' = Γ w0 − 2ξω η0' − ω² η0`.
-    ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::NonFiniteState`]. Cost: `2R·N + R·I`.
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        w0: &SVector<T, I>,
-    ) -> Result<ModalState<T, R>, Error> {
-        if !crate::scalar::initial_inputs_finite(u0, v0, w0) {
-            return Err(Error::NonFiniteInput);
-        }
-        let (eta, deta) = (self.project(u0), self.project(v0));
-        let ddeta = core::array::from_fn(|r| {
-            let mut f = T::zero();
-            for j in 0..I {
-                f += self.gamma[r][j] * w0[j];
+    start_fn! {
+        /// The state at `t = 0` from `u0`, `v0` (projected on the kept modes:
+        /// `η0 = Φ_Rᵀ M u0`, exact when `u0` lies in their span) and `w0`, with
+        /// `η0'' = Γ w0 − 2ξω η0' − ω² η0`.
+        ///
+        /// Errors: [`Error::NonFiniteInput`], [`Error::NonFiniteState`]. Cost: `2R·N + R·I`.
+        fn start(&self, u0, v0, w0: &SVector<T, I>) -> ModalState<T, R> {
+            if !crate::scalar::initial_inputs_finite(u0, v0, w0) {
+                return Err(Error::NonFiniteInput);
             }
-            f - self.c[r] * deta[r] - self.k[r] * eta[r]
-        });
-        let s = ModalState {
-            eta,
-            deta,
-            ddeta,
-            n: 0,
-        };
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteState)
+            let (eta, deta) = (self.project(u0), self.project(v0));
+            let ddeta = core::array::from_fn(|r| {
+                let mut f = T::zero();
+                for j in 0..I {
+                    f += self.gamma[r][j] * w0[j];
+                }
+                f - self.c[r] * deta[r] - self.k[r] * eta[r]
+            });
+            let s = ModalState {
+                eta,
+                deta,
+                ddeta,
+                n: 0,
+            };
+            if s.is_finite() {
+                Ok(s)
+            } else {
+                Err(Error::NonFiniteState)
+            }
         }
     }
 
-    /// The state at `t = 0` from `u0, v0, a0`, each projected on the kept modes
-    /// (`η = Φ_Rᵀ M x`). Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if a
-    /// projection overflows (large `M` in `f32`). Cost: `3R·N`.
-    fn start_with_acceleration(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        a0: &SVector<T, N>,
-    ) -> Result<ModalState<T, R>, Error> {
-        if !crate::scalar::initial_inputs_finite(u0, v0, a0) {
-            return Err(Error::NonFiniteInput);
-        }
-        let s = ModalState {
-            eta: self.project(u0),
-            deta: self.project(v0),
-            ddeta: self.project(a0),
-            n: 0,
-        };
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteState)
+    start_fn! {
+        /// The state at `t = 0` from `u0, v0, a0`, each projected on the kept modes
+        /// (`η = Φ_Rᵀ M x`). Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if a
+        /// projection overflows (large `M` in `f32`). Cost: `3R·N`.
+        fn start_with_acceleration(&self, u0, v0, a0: &SVector<T, N>) -> ModalState<T, R> {
+            if !crate::scalar::initial_inputs_finite(u0, v0, a0) {
+                return Err(Error::NonFiniteInput);
+            }
+            let s = ModalState {
+                eta: self.project(u0),
+                deta: self.project(v0),
+                ddeta: self.project(a0),
+                n: 0,
+            };
+            if s.is_finite() {
+                Ok(s)
+            } else {
+                Err(Error::NonFiniteState)
+            }
         }
     }
 

@@ -12,6 +12,7 @@ use nalgebra::{SMatrix, SVector};
 use crate::kernel::{Kernel, Lows, aem_const_ctors, initial_state, newmark_step_compensated};
 use crate::kinematics::{AemKinematics, Kinematics};
 use crate::macros::mck_fn;
+use crate::stepper::start_fn;
 use crate::{Error, Real, State, StepState, Stepper};
 
 /// The state of a [`CompensatedLinear`]: the working-precision [`State`] and the rounding
@@ -145,23 +146,18 @@ impl<T: Real, const N: usize> Stepper<T, N> for CompensatedLinear<T, N> {
         self.kernel.kin.h()
     }
 
-    /// As [`Stepper::start`]; the carried errors start at zero.
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<CompensatedState<T, N>, Error> {
-        initial_state(self.kernel.start.as_ref(), u0, v0, p0).map(CompensatedState::from_state)
+    start_fn! {
+        /// As [`Stepper::start`]; the carried errors start at zero.
+        fn start(&self, u0, v0, p0: &SVector<T, N>) -> CompensatedState<T, N> {
+            initial_state(self.kernel.start.as_ref(), u0, v0, p0)
+                .map(CompensatedState::from_state)
+        }
     }
 
-    fn start_with_acceleration(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        a0: &SVector<T, N>,
-    ) -> Result<CompensatedState<T, N>, Error> {
-        State::initial_given(u0, v0, a0).map(CompensatedState::from_state)
+    start_fn! {
+        fn start_with_acceleration(&self, u0, v0, a0: &SVector<T, N>) -> CompensatedState<T, N> {
+            State::initial_given(u0, v0, a0).map(CompensatedState::from_state)
+        }
     }
 
     /// Cost: `5N²` multiply-adds + about `34N` (see the type's docs).

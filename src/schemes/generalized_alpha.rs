@@ -311,27 +311,16 @@ impl<T: Real, const N: usize> Stepper<T, N> for GeneralizedAlpha<T, N> {
         self.kin.h
     }
 
-    /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration and
-    /// constant loads, but FIRST order for a time-varying load (the weighted load
-    /// `(1 − α_f) p_n + α_f p_{n−1}` needs the previous sample, which the shared [`State`]
-    /// does not carry). Drive it with `step_with_previous_input` for second order.
-    /// Cost: `4N²` multiply-adds + `10N`.
-    #[inline]
-    fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
-        self.step_inner(s, p, p);
-    }
-
-    /// The textbook step: the load taken as `(1 − α_f) p + α_f p_prev`, with
-    /// `p_prev = p(t_{n−1})`, `p = p(t_n)`. Second order for any smooth load.
-    ///
-    /// Cost: `4N²` multiply-adds + `10N`. No allocation, no panic.
-    #[inline]
-    fn step_with_previous_input(
-        &self,
-        s: &mut State<T, N>,
-        p_prev: &SVector<T, N>,
-        p: &SVector<T, N>,
-    ) {
-        self.step_inner(s, p_prev, p);
-    }
+    crate::stepper::steps_through_inner!(
+        /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration and
+        /// constant loads, but FIRST order for a time-varying load (the weighted load
+        /// `(1 − α_f) p_n + α_f p_{n−1}` needs the previous sample, which the shared [`State`]
+        /// does not carry). Drive it with `step_with_previous_input` for second order.
+        /// Cost: `4N²` multiply-adds + `10N`.
+        ;
+        /// The textbook step: the load taken as `(1 − α_f) p + α_f p_prev`, with
+        /// `p_prev = p(t_{n−1})`, `p = p(t_n)`. Second order for any smooth load.
+        ///
+        /// Cost: `4N²` multiply-adds + `10N`. No allocation, no panic.
+    );
 }

@@ -21,6 +21,7 @@ use crate::linalg::op_rows::OpRows;
 use crate::linalg::{self, Mat, Rows, finite_as, rows_f64};
 use crate::macros::mck_fn;
 use crate::scalar::initial_inputs_finite;
+use crate::stepper::start_fn;
 use crate::{Error, Real, State, Stepper};
 
 /// The linear AEM stepper for loads `p(t) = B w(t)` entering through an influence matrix
@@ -241,24 +242,21 @@ impl<T: Real, const N: usize, const I: usize> Stepper<T, N> for LinearInput<T, N
         self.kin.h
     }
 
-    /// The state at `t = 0` with `q0 = M⁻¹ (B w0 − C v0 − K u0)` (paper eq. 40).
-    /// Cost: `2N² + N·I` multiply-adds.
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        w0: &SVector<T, I>,
-    ) -> Result<State<T, N>, Error> {
-        // A non-finite input first, as every start in the crate (found by fuzzing).
-        if !initial_inputs_finite(u0, v0, w0) {
-            return Err(Error::NonFiniteInput);
+    start_fn! {
+        /// The state at `t = 0` with `q0 = M⁻¹ (B w0 − C v0 − K u0)` (paper eq. 40).
+        /// Cost: `2N² + N·I` multiply-adds.
+        fn start(&self, u0, v0, w0: &SVector<T, I>) -> State<T, N> {
+            // A non-finite input first, as every start in the crate (found by fuzzing).
+            if !initial_inputs_finite(u0, v0, w0) {
+                return Err(Error::NonFiniteInput);
+            }
+            let st = self.start.as_ref().ok_or(Error::SingularMass)?;
+            let mv = |a: &[[T; N]; N], x: &SVector<T, N>| crate::kernel::mat_vec(a, x);
+            let a0 = crate::kernel::mat_vec(&st.minv_b, w0)
+                - mv(&st.ops.minv_c, v0)
+                - mv(&st.ops.minv_k, u0);
+            State::initial_computed(u0, v0, a0)
         }
-        let st = self.start.as_ref().ok_or(Error::SingularMass)?;
-        let mv = |a: &[[T; N]; N], x: &SVector<T, N>| crate::kernel::mat_vec(a, x);
-        let a0 = crate::kernel::mat_vec(&st.minv_b, w0)
-            - mv(&st.ops.minv_c, v0)
-            - mv(&st.ops.minv_k, u0);
-        State::initial_computed(u0, v0, a0)
     }
 
     crate::stepper::full_order_state!();

@@ -84,6 +84,7 @@ use crate::linalg::lu::Lu;
 use crate::linalg::{Mat, Rows, add_scaled, all_finite, all_fit, fits, mul};
 use crate::linalg::{round_rows, rows_f64, scaled};
 use crate::macros::mck_fn;
+use crate::stepper::start_fn;
 use crate::{AlphaParameters, Error, Real, State, Stepper};
 
 /// The parameters of the CR algorithm: `α_m = α_f = 0`, `β = 1/4`, `γ = 1/2`.
@@ -498,22 +499,19 @@ impl<T: Real, const N: usize> Stepper<T, N> for KrAlpha<T, N> {
     type Input = SVector<T, N>;
     type State = State<T, N>;
 
-    /// The state at `t = 0` for a second-order run from any initial condition: `u0`,
-    /// `a0 = M⁻¹ (p0 − C v0 − K u0)`, and the scheme's velocity variable
-    /// `v0 − γh α1 a0` in place of `v0` (see the type's docs, "The start").
-    ///
-    /// Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if `a0` or the
-    /// velocity variable overflows. Cost: `4N²` multiply-adds.
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        let s = crate::kernel::initial_state(self.start.as_ref(), u0, v0, p0)?;
-        let w = self.alpha1_times(s.a());
-        let v = SVector::from_fn(|i, _| v0[i] - self.gamma_h * w[i]);
-        State::initial_computed(u0, &v, *s.a())
+    start_fn! {
+        /// The state at `t = 0` for a second-order run from any initial condition: `u0`,
+        /// `a0 = M⁻¹ (p0 − C v0 − K u0)`, and the scheme's velocity variable
+        /// `v0 − γh α1 a0` in place of `v0` (see the type's docs, "The start").
+        ///
+        /// Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if `a0` or the
+        /// velocity variable overflows. Cost: `4N²` multiply-adds.
+        fn start(&self, u0, v0, p0: &SVector<T, N>) -> State<T, N> {
+            let s = crate::kernel::initial_state(self.start.as_ref(), u0, v0, p0)?;
+            let w = self.alpha1_times(s.a());
+            let v = SVector::from_fn(|i, _| v0[i] - self.gamma_h * w[i]);
+            State::initial_computed(u0, &v, *s.a())
+        }
     }
 
     crate::stepper::full_order_state!();
@@ -523,25 +521,14 @@ impl<T: Real, const N: usize> Stepper<T, N> for KrAlpha<T, N> {
         self.h
     }
 
-    /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration
-    /// and constant loads, first order for a time-varying load when `α_f ≠ 0` (KR-α); the
-    /// same as the two-sample step for CR (`α_f = 0`). Cost: `5N²` multiply-adds + `12N`.
-    #[inline]
-    fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
-        self.step_inner(s, p, p);
-    }
-
-    /// The textbook step: the load taken as `(1 − α_f) p + α_f p_prev`, with
-    /// `p_prev = p(t_n)`, `p = p(t_{n+1})`. Second order for any smooth load.
-    ///
-    /// Cost: `5N²` multiply-adds + `12N`. No allocation, no panic.
-    #[inline]
-    fn step_with_previous_input(
-        &self,
-        s: &mut State<T, N>,
-        p_prev: &SVector<T, N>,
-        p: &SVector<T, N>,
-    ) {
-        self.step_inner(s, p_prev, p);
-    }
+    crate::stepper::steps_through_inner!(
+        /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration
+        /// and constant loads, first order for a time-varying load when `α_f ≠ 0` (KR-α); the
+        /// same as the two-sample step for CR (`α_f = 0`). Cost: `5N²` multiply-adds + `12N`.
+        ;
+        /// The textbook step: the load taken as `(1 − α_f) p + α_f p_prev`, with
+        /// `p_prev = p(t_n)`, `p = p(t_{n+1})`. Second order for any smooth load.
+        ///
+        /// Cost: `5N²` multiply-adds + `12N`. No allocation, no panic.
+    );
 }
