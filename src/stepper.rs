@@ -186,7 +186,7 @@ pub(crate) fn commit_if_finite<S: StepState>(
 }
 
 /// A start of a stepper from `u0`, `v0` (`&SVector<T, N>`, the `T`, `N` of the surrounding
-/// `impl`) and further arguments, returning `Result<$state, Error>`: the one signature of
+/// `impl`; `&SVector<f64, N>` after a leading `f64;`) and further arguments, returning `Result<$state, Error>`: the one signature of
 /// [`Stepper::start`], [`Stepper::start_with_acceleration`] and the starts of the same
 /// form. The call names `self` and the two vectors (so that its body can use them) and
 /// gives the further arguments with their types, e.g.
@@ -194,6 +194,7 @@ pub(crate) fn commit_if_finite<S: StepState>(
 /// attributes and docs go through unchanged. Cost: none.
 macro_rules! start_fn {
     (
+        @with $scalar:ty;
         $(#[$attr:meta])*
         $vis:vis fn $name:ident(&$this:ident, $u0:ident, $v0:ident, $($arg:ident: $ty:ty),+ $(,)?)
             -> $state:ty
@@ -202,10 +203,17 @@ macro_rules! start_fn {
         $(#[$attr])*
         $vis fn $name(
             &$this,
-            $u0: &nalgebra::SVector<T, N>,
-            $v0: &nalgebra::SVector<T, N>,
+            $u0: &nalgebra::SVector<$scalar, N>,
+            $v0: &nalgebra::SVector<$scalar, N>,
             $($arg: $ty),+
         ) -> Result<$state, $crate::Error> $body
+    };
+    // The start of a model in `f64` (no `T` in scope): `start_fn! { f64; fn … }`.
+    (f64; $($rest:tt)*) => {
+        $crate::stepper::start_fn!(@with f64; $($rest)*);
+    };
+    ($($rest:tt)*) => {
+        $crate::stepper::start_fn!(@with T; $($rest)*);
     };
 }
 pub(crate) use start_fn;

@@ -53,6 +53,7 @@ use crate::macros::mck_fn;
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
 use crate::schemes::{Exponential, exponential};
+use crate::stepper::start_fn;
 use crate::{AlphaParameters, Error, Exact};
 
 /// The discrete state-space model of a linear scheme with `N` degrees of freedom, state
@@ -521,56 +522,54 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         }
     }
 
-    /// The state at the start of a full-state model (every builder but the modal one) from
-    /// displacements `u0` (m), velocities `v0` (m/s) and input `w0`: `[u0; v0]`, and for
-    /// [`StateSpace::generalized_alpha`] (`S = 3N`) `[u0; v0; a0]` with
-    /// `a0 = M⁻¹ (B w0 − C v0 − K u0)` — what the steppers' `start` computes. For a modal
-    /// model use [`StateSpace::modal_coordinates`].
-    ///
-    /// Errors: [`Error::NonFiniteInput`]; [`Error::StateSizeMismatch`] for a model whose
-    /// state does not begin with `[u; v]` (a modal model, `U ≠ [I 0 …]`).
-    ///
-    /// Cost: `N·(S + I)` flops and a scan of `U`, `V`.
-    pub fn initial_state(
-        &self,
-        u0: &SVector<f64, N>,
-        v0: &SVector<f64, N>,
-        w0: &SVector<f64, I>,
-    ) -> Result<SVector<f64, S>, Error> {
-        if !u0
-            .iter()
-            .chain(v0.iter())
-            .chain(w0.iter())
-            .all(|x| x.is_finite())
-        {
-            return Err(Error::NonFiniteInput);
-        }
-        let one = |c: bool| if c { 1.0 } else { 0.0 };
-        let full = (0..N).all(|i| {
-            (0..S).all(|j| self.dof_u[i][j] == one(j == i) && self.dof_v[i][j] == one(j == N + i))
-        });
-        if !full {
-            return Err(Error::StateSizeMismatch);
-        }
-        let mut x = SVector::<f64, S>::zeros();
-        for i in 0..N {
-            x[i] = u0[i];
-            x[N + i] = v0[i];
-        }
-        if S == 3 * N {
-            // a0 = A_x x + A_w w0 (the a-block of A_x is zero, and so is that of x).
-            for i in 0..N {
-                let mut a = 0.0;
-                for j in 0..S {
-                    a += self.dof_a[i][j] * x[j];
-                }
-                for j in 0..I {
-                    a += self.dof_a_input[i][j] * w0[j];
-                }
-                x[2 * N + i] = a;
+    start_fn! {
+        f64;
+        /// The state at the start of a full-state model (every builder but the modal one) from
+        /// displacements `u0` (m), velocities `v0` (m/s) and input `w0`: `[u0; v0]`, and for
+        /// [`StateSpace::generalized_alpha`] (`S = 3N`) `[u0; v0; a0]` with
+        /// `a0 = M⁻¹ (B w0 − C v0 − K u0)` — what the steppers' `start` computes. For a modal
+        /// model use [`StateSpace::modal_coordinates`].
+        ///
+        /// Errors: [`Error::NonFiniteInput`]; [`Error::StateSizeMismatch`] for a model whose
+        /// state does not begin with `[u; v]` (a modal model, `U ≠ [I 0 …]`).
+        ///
+        /// Cost: `N·(S + I)` flops and a scan of `U`, `V`.
+        pub fn initial_state(&self, u0, v0, w0: &SVector<f64, I>) -> SVector<f64, S> {
+            if !u0
+                .iter()
+                .chain(v0.iter())
+                .chain(w0.iter())
+                .all(|x| x.is_finite())
+            {
+                return Err(Error::NonFiniteInput);
             }
+            let one = |c: bool| if c { 1.0 } else { 0.0 };
+            let full = (0..N).all(|i| {
+                (0..S).all(|j| self.dof_u[i][j] == one(j == i) && self.dof_v[i][j] == one(j == N + i))
+            });
+            if !full {
+                return Err(Error::StateSizeMismatch);
+            }
+            let mut x = SVector::<f64, S>::zeros();
+            for i in 0..N {
+                x[i] = u0[i];
+                x[N + i] = v0[i];
+            }
+            if S == 3 * N {
+                // a0 = A_x x + A_w w0 (the a-block of A_x is zero, and so is that of x).
+                for i in 0..N {
+                    let mut a = 0.0;
+                    for j in 0..S {
+                        a += self.dof_a[i][j] * x[j];
+                    }
+                    for j in 0..I {
+                        a += self.dof_a_input[i][j] * w0[j];
+                    }
+                    x[2 * N + i] = a;
+                }
+            }
+            Ok(x)
         }
-        Ok(x)
     }
 
     mck_fn! {
