@@ -32,7 +32,7 @@ use crate::linalg::{
 };
 use crate::observer::symmetrize;
 use crate::stepper::start_fn;
-use crate::{Error, Real, State, StepState, Stepper};
+use crate::{Error, Real, State, Stepper};
 
 /// Relative tolerance below which `M`, `K` count as symmetric: `|a_ij − a_ji| ≤
 /// 64 ε max|a|` (rounding of a matrix assembled in `f64`).
@@ -748,16 +748,7 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
     }
 }
 
-impl<T: Real, const R: usize> StepState for ModalState<T, R> {
-    #[inline]
-    fn is_finite(&self) -> bool {
-        ModalState::is_finite(self)
-    }
-    #[inline]
-    fn steps(&self) -> u64 {
-        self.n
-    }
-}
+crate::state::step_state!(ModalState<R>, |self| ModalState::is_finite(self), n);
 
 impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Stepper<T, N>
     for Modal<T, N, R, I, O>

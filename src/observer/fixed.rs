@@ -49,16 +49,11 @@ macro_rules! estimate_counters {
             }
         }
 
-        impl<T: $crate::Real, const S: usize, const I: usize> $crate::StepState for $ty<T, S, I> {
-            #[inline]
-            fn is_finite(&self) -> bool {
-                self.$x.iter().chain(self.w.iter()).all(|v| v.is_finite())
-            }
-            #[inline]
-            fn steps(&self) -> u64 {
-                self.n
-            }
-        }
+        $crate::state::step_state!(
+            $ty<S, I>,
+            |self| self.$x.iter().chain(self.w.iter()).all(|v| v.is_finite()),
+            n
+        );
     };
 }
 pub(crate) use estimate_counters;

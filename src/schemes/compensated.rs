@@ -13,7 +13,7 @@ use crate::kernel::{Kernel, Lows, aem_const_ctors, initial_state, newmark_step_c
 use crate::kinematics::{AemKinematics, Kinematics};
 use crate::macros::mck_fn;
 use crate::stepper::start_fn;
-use crate::{Error, Real, State, StepState, Stepper};
+use crate::{Error, Real, State, Stepper};
 
 /// The state of a [`CompensatedLinear`]: the working-precision [`State`] and the rounding
 /// errors of its `u` and `v` (`u + du` is the displacement to about twice the working
@@ -50,22 +50,17 @@ impl<T: Real, const N: usize> CompensatedState<T, N> {
     }
 }
 
-impl<T: Real, const N: usize> StepState for CompensatedState<T, N> {
-    #[inline]
-    fn is_finite(&self) -> bool {
-        self.state.is_finite()
-            && self
-                .lo
-                .du
-                .iter()
-                .chain(self.lo.dv.iter())
-                .all(|x| x.is_finite())
-    }
-    #[inline]
-    fn steps(&self) -> u64 {
-        self.state.n
-    }
-}
+crate::state::step_state!(
+    CompensatedState<N>,
+    |self| self.state.is_finite()
+        && self
+            .lo
+            .du
+            .iter()
+            .chain(self.lo.dv.iter())
+            .all(|x| x.is_finite()),
+    state.n
+);
 
 /// The AEM ([`Linear`](crate::Linear)'s operators, bit-identical) with the state update
 /// compensated: for long undamped runs in `f32`, where the plain update's rounding drifts
