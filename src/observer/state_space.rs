@@ -157,15 +157,11 @@ impl<const N: usize, const I: usize, const O: usize> Outputs<N, I, O> {
     pub const fn absolute_accelerations(y: [[f64; N]; O], input: usize) -> Self {
         let mut o = Self::accelerations(y);
         if input < I {
+            // `Y ι`: each row's sum, in the order of the columns (`ι` is exact).
+            let y_iota = mul(&y, &[[1.0]; N]);
             let mut r = 0;
             while r < O {
-                let mut s = 0.0;
-                let mut j = 0;
-                while j < N {
-                    s += y[r][j];
-                    j += 1;
-                }
-                o.w[r][input] = s;
+                o.w[r][input] = y_iota[r][0];
                 r += 1;
             }
         }
@@ -201,11 +197,11 @@ pub struct Measurement<const S: usize, const I: usize, const O: usize> {
 impl<const S: usize, const I: usize, const O: usize> Measurement<S, I, O> {
     /// `H` as a `nalgebra` matrix.
     pub fn h_matrix(&self) -> SMatrix<f64, O, S> {
-        SMatrix::from_fn(|i, j| self.h[i][j])
+        crate::linalg::matrix_t(&self.h)
     }
     /// `D` as a `nalgebra` matrix.
     pub fn d_matrix(&self) -> SMatrix<f64, O, I> {
-        SMatrix::from_fn(|i, j| self.d[i][j])
+        crate::linalg::matrix_t(&self.d)
     }
 }
 
@@ -938,15 +934,15 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
 
     /// `Φ` as a `nalgebra` matrix.
     pub fn phi_matrix(&self) -> SMatrix<f64, S, S> {
-        SMatrix::from_fn(|i, j| self.phi[i][j])
+        crate::linalg::matrix_t(&self.phi)
     }
     /// `Γ₀` as a `nalgebra` matrix.
     pub fn gamma0_matrix(&self) -> SMatrix<f64, S, I> {
-        SMatrix::from_fn(|i, j| self.gamma0[i][j])
+        crate::linalg::matrix_t(&self.gamma0)
     }
     /// `Γ₁` as a `nalgebra` matrix.
     pub fn gamma1_matrix(&self) -> SMatrix<f64, S, I> {
-        SMatrix::from_fn(|i, j| self.gamma1[i][j])
+        crate::linalg::matrix_t(&self.gamma1)
     }
 }
 
