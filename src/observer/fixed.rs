@@ -236,7 +236,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
 
     /// The predicted measurement `H x + D w` of a state. Cost: `O·(S + I)`.
     pub fn predicted_output(&self, x: &SVector<T, S>, w: &SVector<T, I>) -> SVector<T, O> {
-        h_x_plus_d_w(&self.h, &self.d, x, w)
+        mul2(&self.h, &self.d, x, w)
     }
 
     /// One step: predict with the input `w` (`w_n`; `w_{n−1}` is kept in the estimate),
@@ -409,27 +409,28 @@ impl<T: Real, const S: usize, const I: usize, const P: usize> Readout<T, S, I, P
 
     /// `z = H x + D w`. Cost: `P·(S + I)` multiply-adds.
     pub fn read(&self, x: &SVector<T, S>, w: &SVector<T, I>) -> SVector<T, P> {
-        h_x_plus_d_w(&self.h, &self.d, x, w)
+        mul2(&self.h, &self.d, x, w)
     }
 }
 
-/// `H x + D w` row by row (`H` `R×S`, `D` `R×I`), each row's sum over `x` then `w`: the
-/// one output of [`Observer::predicted_output`] and [`Readout::read`]. Cost: `R·(S + I)`
+/// `M₁ x + M₂ w` row by row (`M₁` `R×S`, `M₂` `R×I`; from `+0`, `M₁`'s terms first): the
+/// one sum of [`Observer::predicted_output`] and [`Readout::read`] (`H x + D w`) and of
+/// the dual filter's error dynamics (`A e_ξ + B e_w`, `C e_ξ + D̃ e_w`). Cost: `R·(S + I)`
 /// multiply-adds.
 #[inline]
-fn h_x_plus_d_w<T: Real, const S: usize, const I: usize, const R: usize>(
-    h: &[[T; S]; R],
-    d: &[[T; I]; R],
+pub(crate) fn mul2<T: Real, const R: usize, const S: usize, const I: usize>(
+    m1: &[[T; S]; R],
+    m2: &[[T; I]; R],
     x: &SVector<T, S>,
     w: &SVector<T, I>,
 ) -> SVector<T, R> {
     SVector::from_fn(|r, _| {
         let mut s = T::zero();
         for j in 0..S {
-            s += h[r][j] * x[j];
+            s += m1[r][j] * x[j];
         }
         for j in 0..I {
-            s += d[r][j] * w[j];
+            s += m2[r][j] * w[j];
         }
         s
     })
