@@ -68,6 +68,30 @@ macro_rules! const_try {
 }
 pub(crate) use const_try;
 
+/// A constructor from the model `M, C, K` (`N×N` matrices in `f64`, the `N` of the
+/// surrounding `impl`) and further arguments, returning `Result<Self, Error>`: the one
+/// signature of the schemes', the hybrid split's and the state-space models' constructors.
+/// The call names the three matrices (so that its body can use them) and gives the further
+/// arguments with their types, e.g. `mck_fn! { /// … pub fn new(m, c, k, h: f64) { … } }`;
+/// attributes and docs go through unchanged. `SMatrix` and `Error` are those in scope at
+/// the call (the module's imports, which its docs' links use too). Cost: none.
+macro_rules! mck_fn {
+    (
+        $(#[$attr:meta])*
+        $vis:vis fn $name:ident($m:ident, $c:ident, $k:ident, $($arg:ident: $ty:ty),+ $(,)?)
+        $body:block
+    ) => {
+        $(#[$attr])*
+        $vis fn $name(
+            $m: &SMatrix<f64, N, N>,
+            $c: &SMatrix<f64, N, N>,
+            $k: &SMatrix<f64, N, N>,
+            $($arg: $ty),+
+        ) -> Result<Self, Error> $body
+    };
+}
+pub(crate) use mck_fn;
+
 /// The columns of a matrix given by its rows (`out[j][i] = rows[i][j]`): nalgebra stores
 /// matrices column by column. Used by [`matrix!`]; not part of the API.
 ///
@@ -77,17 +101,7 @@ pub(crate) use const_try;
 pub const fn rows_to_columns<T: Copy, const R: usize, const C: usize>(
     rows: [[T; C]; R],
 ) -> [[T; R]; C] {
-    let mut columns = [[rows[0][0]; R]; C];
-    let mut i = 0;
-    while i < R {
-        let mut j = 0;
-        while j < C {
-            columns[j][i] = rows[i][j];
-            j += 1;
-        }
-        i += 1;
-    }
-    columns
+    crate::linalg::transpose_filled(&rows, rows[0][0])
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 use nalgebra::SVector;
 
 use crate::observer::Estimate;
-use crate::{Error, Real, StepState};
+use crate::{Error, Real};
 
 /// The state at step `n`: displacement `u`, velocity `v`, acceleration `a` (the paper's
 /// fictitious load `q`) and the step count. Time is `n·h`, computed from the count
@@ -231,13 +231,24 @@ impl<T: Real + defmt::Format, const N: usize> defmt::Format for State<T, N> {
     }
 }
 
-impl<T: Real, const N: usize> StepState for State<T, N> {
-    #[inline]
-    fn is_finite(&self) -> bool {
-        State::is_finite(self)
-    }
-    #[inline]
-    fn steps(&self) -> u64 {
-        self.n
-    }
+/// The [`StepState`](crate::StepState) impl of a state type `$ty<T, $n…>` (`T: Real`, the sizes
+/// `const $n: usize`), both methods `#[inline]`: `is_finite` is the expression
+/// `$finite` of `$this` (written `self` at the call), `steps` the field path `$steps`
+/// (e.g. `n`). The one impl of the crate's states and estimates. Cost: none.
+macro_rules! step_state {
+    ($ty:ident<$($n:ident),+>, |$this:ident| $finite:expr, $($steps:ident).+) => {
+        impl<T: $crate::Real, $(const $n: usize),+> $crate::StepState for $ty<T, $($n),+> {
+            #[inline]
+            fn is_finite(&$this) -> bool {
+                $finite
+            }
+            #[inline]
+            fn steps(&self) -> u64 {
+                self.$($steps).+
+            }
+        }
+    };
 }
+pub(crate) use step_state;
+
+step_state!(State<N>, |self| State::is_finite(self), n);

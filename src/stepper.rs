@@ -185,6 +185,39 @@ pub(crate) fn commit_if_finite<S: StepState>(
     }
 }
 
+/// A start of a stepper from `u0`, `v0` (`&SVector<T, N>`, the `T`, `N` of the surrounding
+/// `impl`; `&SVector<f64, N>` after a leading `f64;`) and further arguments, returning `Result<$state, Error>`: the one signature of
+/// [`Stepper::start`], [`Stepper::start_with_acceleration`] and the starts of the same
+/// form. The call names `self` and the two vectors (so that its body can use them) and
+/// gives the further arguments with their types, e.g.
+/// `start_fn! { fn start(&self, u0, v0, p0: &SVector<T, N>) -> State<T, N> { … } }`;
+/// attributes and docs go through unchanged. Cost: none.
+macro_rules! start_fn {
+    (
+        @with $scalar:ty;
+        $(#[$attr:meta])*
+        $vis:vis fn $name:ident(&$this:ident, $u0:ident, $v0:ident, $($arg:ident: $ty:ty),+ $(,)?)
+            -> $state:ty
+        $body:block
+    ) => {
+        $(#[$attr])*
+        $vis fn $name(
+            &$this,
+            $u0: &nalgebra::SVector<$scalar, N>,
+            $v0: &nalgebra::SVector<$scalar, N>,
+            $($arg: $ty),+
+        ) -> Result<$state, $crate::Error> $body
+    };
+    // The start of a model in `f64` (no `T` in scope): `start_fn! { f64; fn … }`.
+    (f64; $($rest:tt)*) => {
+        $crate::stepper::start_fn!(@with f64; $($rest)*);
+    };
+    ($($rest:tt)*) => {
+        $crate::stepper::start_fn!(@with T; $($rest)*);
+    };
+}
+pub(crate) use start_fn;
+
 /// The [`Stepper`] methods every full-order scheme (state [`State<T, N>`]) shares, for a
 /// scheme whose start-up operators are in the field (path) `$start` (an
 /// `Option<StartOps<T, N>>`): `start` (`a0` from the equation of motion),
@@ -192,25 +225,21 @@ pub(crate) fn commit_if_finite<S: StepState>(
 /// copy). Expands inside an `impl Stepper<T, N> for …` block.
 macro_rules! full_order_state {
     ($($start:ident).+) => {
-        fn start(
-            &self,
-            u0: &nalgebra::SVector<T, N>,
-            v0: &nalgebra::SVector<T, N>,
-            p0: &nalgebra::SVector<T, N>,
-        ) -> Result<$crate::State<T, N>, $crate::Error> {
-            $crate::kernel::initial_state(self.$($start).+.as_ref(), u0, v0, p0)
+        $crate::stepper::start_fn! {
+            fn start(&self, u0, v0, p0: &nalgebra::SVector<T, N>) -> $crate::State<T, N> {
+                $crate::kernel::initial_state(self.$($start).+.as_ref(), u0, v0, p0)
+            }
         }
 
         $crate::stepper::full_order_state!();
     };
     () => {
-        fn start_with_acceleration(
-            &self,
-            u0: &nalgebra::SVector<T, N>,
-            v0: &nalgebra::SVector<T, N>,
-            a0: &nalgebra::SVector<T, N>,
-        ) -> Result<$crate::State<T, N>, $crate::Error> {
-            $crate::State::initial_given(u0, v0, a0)
+        $crate::stepper::start_fn! {
+            fn start_with_acceleration(&self, u0, v0, a0: &nalgebra::SVector<T, N>)
+                -> $crate::State<T, N>
+            {
+                $crate::State::initial_given(u0, v0, a0)
+            }
         }
 
         #[inline]
@@ -220,3 +249,30 @@ macro_rules! full_order_state {
     };
 }
 pub(crate) use full_order_state;
+
+/// [`Stepper::step`] and [`Stepper::step_with_previous_input`] of a scheme whose step is
+/// `self.step_inner(s, p_prev, p)` (state [`State<T, N>`]): `step` takes `p_prev = p`. The
+/// two groups of attributes (docs) are those of `step` and of `step_with_previous_input`,
+/// separated by `;`. Expands inside an `impl Stepper<T, N> for …` block. Cost: none (both
+/// `#[inline]`, as written by hand).
+macro_rules! steps_through_inner {
+    ($(#[$step:meta])* ; $(#[$prev:meta])*) => {
+        $(#[$step])*
+        #[inline]
+        fn step(&self, s: &mut $crate::State<T, N>, p: &nalgebra::SVector<T, N>) {
+            self.step_inner(s, p, p);
+        }
+
+        $(#[$prev])*
+        #[inline]
+        fn step_with_previous_input(
+            &self,
+            s: &mut $crate::State<T, N>,
+            p_prev: &nalgebra::SVector<T, N>,
+            p: &nalgebra::SVector<T, N>,
+        ) {
+            self.step_inner(s, p_prev, p);
+        }
+    };
+}
+pub(crate) use steps_through_inner;

@@ -51,7 +51,7 @@ use super::joint::{JointEstimate, joint_start_covariances};
 use crate::linalg::{self, finite_as, identity, matrix_t, round_rows, sym};
 use crate::observer::bare_model;
 use crate::observer::{SteadyState, is_covariance};
-use crate::observer::{check_counts, next_counts};
+use crate::observer::{check_counts, mul2, next_counts};
 use crate::observer::{gain_t, innovation_t, predict_t, short_form_t};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real};
@@ -336,26 +336,6 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> DualFilter<T, S, I
         check_counts(e.n, e.missing, y)?;
         commit_if_finite(e, |next| self.step(next, y))
     }
-}
-
-/// `M₁ e_ξ + M₂ e_w` (from `+0`, `M₁`'s terms first): the error dynamics' prediction
-/// (`A`, `B`) and output (`C`, `D̃`). Cost: `R·(S + I)` multiply-adds.
-fn mul2<T: Real, const R: usize, const S: usize, const I: usize>(
-    m1: &[[T; S]; R],
-    m2: &[[T; I]; R],
-    ex: &SVector<T, S>,
-    ew: &SVector<T, I>,
-) -> SVector<T, R> {
-    SVector::from_fn(|i, _| {
-        let mut s = T::zero();
-        for j in 0..S {
-            s += m1[i][j] * ex[j];
-        }
-        for j in 0..I {
-            s += m2[i][j] * ew[j];
-        }
-        s
-    })
 }
 
 /// `e − G ν`: an error after a stage's correction with gain `G`. Cost: `R·O`

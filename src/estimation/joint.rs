@@ -355,19 +355,19 @@ impl<const S: usize, const I: usize, const O: usize> InputStateGains<S, I, O> {
 
     /// `K` as a `nalgebra` matrix.
     pub fn state_gain_matrix(&self) -> SMatrix<f64, S, O> {
-        SMatrix::from_fn(|i, j| self.state_gain[i][j])
+        crate::linalg::matrix_t(&self.state_gain)
     }
     /// `M` as a `nalgebra` matrix.
     pub fn input_gain_matrix(&self) -> SMatrix<f64, I, O> {
-        SMatrix::from_fn(|i, j| self.input_gain[i][j])
+        crate::linalg::matrix_t(&self.input_gain)
     }
     /// `P⁻` as a `nalgebra` matrix.
     pub fn covariance_matrix(&self) -> SMatrix<f64, S, S> {
-        SMatrix::from_fn(|i, j| self.covariance[i][j])
+        crate::linalg::matrix_t(&self.covariance)
     }
     /// `Pʷ` as a `nalgebra` matrix.
     pub fn input_covariance_matrix(&self) -> SMatrix<f64, I, I> {
-        SMatrix::from_fn(|i, j| self.input_covariance[i][j])
+        crate::linalg::matrix_t(&self.input_covariance)
     }
 }
 

@@ -387,19 +387,19 @@ impl<const S: usize, const I: usize, const O: usize> InputModel<S, I, O> {
 
     /// `A` as a `nalgebra` matrix.
     pub fn a_matrix(&self) -> SMatrix<f64, S, S> {
-        SMatrix::from_fn(|i, j| self.a[i][j])
+        crate::linalg::matrix_t(&self.a)
     }
     /// `B` as a `nalgebra` matrix.
     pub fn b_matrix(&self) -> SMatrix<f64, S, I> {
-        SMatrix::from_fn(|i, j| self.b[i][j])
+        crate::linalg::matrix_t(&self.b)
     }
     /// `C` as a `nalgebra` matrix.
     pub fn c_matrix(&self) -> SMatrix<f64, O, S> {
-        SMatrix::from_fn(|i, j| self.c[i][j])
+        crate::linalg::matrix_t(&self.c)
     }
     /// `D̃` as a `nalgebra` matrix.
     pub fn d_matrix(&self) -> SMatrix<f64, O, I> {
-        SMatrix::from_fn(|i, j| self.d[i][j])
+        crate::linalg::matrix_t(&self.d)
     }
 }
 

@@ -3,7 +3,9 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::macros::mck_fn;
 use crate::schemes::kr_alpha::CHEN_RICLES;
+use crate::stepper::start_fn;
 use crate::{AlphaParameters, Error, KrAlpha, Param, Real, State, StepInput, Stepper};
 
 /// A KR-α step split in two for real-time hybrid simulation: the displacement command of
@@ -121,39 +123,30 @@ impl<T: Real, const N: usize> SplitState<T, N> {
 }
 
 impl<T: Real, const N: usize> Split<T, N> {
-    /// The split KR-α step with high-frequency spectral radius `rho_inf ∈ [0, 1]`, for
-    /// `M u'' + C u' + K_num u + r(t) = p(t)` with step `h` (s). `k` is the stiffness the
-    /// operators assume for the whole structure (numerical part plus the specimen's initial
-    /// stiffness), `k_num` the linear numerical part the step computes itself (zero when
-    /// every spring is given through `r`). Units as [`KrAlpha::new`]; computed in `f64`,
-    /// rounded once to `T`, bit-identical to [`Split::from_rows_f32`] / `from_rows_f64`.
-    ///
-    /// Errors: as [`KrAlpha::new`] (`k_num` checked for finiteness with `M, C, K`; its
-    /// operator `G K_num` must fit `T`).
-    ///
-    /// Cost: about `10N³` flops in `f64`.
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        k_num: &SMatrix<f64, N, N>,
-        h: f64,
-        rho_inf: f64,
-    ) -> Result<Self, Error> {
-        let p = AlphaParameters::chung_hulbert(rho_inf)?;
-        KrAlpha::with_rest(m, c, k, k_num, h, p).map(|kr| Self { kr })
+    mck_fn! {
+        /// The split KR-α step with high-frequency spectral radius `rho_inf ∈ [0, 1]`, for
+        /// `M u'' + C u' + K_num u + r(t) = p(t)` with step `h` (s). `k` is the stiffness the
+        /// operators assume for the whole structure (numerical part plus the specimen's initial
+        /// stiffness), `k_num` the linear numerical part the step computes itself (zero when
+        /// every spring is given through `r`). Units as [`KrAlpha::new`]; computed in `f64`,
+        /// rounded once to `T`, bit-identical to [`Split::from_rows_f32`] / `from_rows_f64`.
+        ///
+        /// Errors: as [`KrAlpha::new`] (`k_num` checked for finiteness with `M, C, K`; its
+        /// operator `G K_num` must fit `T`).
+        ///
+        /// Cost: about `10N³` flops in `f64`.
+        pub fn new(m, c, k, k_num: &SMatrix<f64, N, N>, h: f64, rho_inf: f64) {
+            let p = AlphaParameters::chung_hulbert(rho_inf)?;
+            KrAlpha::with_rest(m, c, k, k_num, h, p).map(|kr| Self { kr })
+        }
     }
 
-    /// The split Chen–Ricles step (`α_m = α_f = 0`, `γ = 1/2`, `β = 1/4`). Arguments,
-    /// errors and cost as [`Split::new`] without `rho_inf`.
-    pub fn chen_ricles(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        k_num: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        KrAlpha::with_rest(m, c, k, k_num, h, CHEN_RICLES).map(|kr| Self { kr })
+    mck_fn! {
+        /// The split Chen–Ricles step (`α_m = α_f = 0`, `γ = 1/2`, `β = 1/4`). Arguments,
+        /// errors and cost as [`Split::new`] without `rho_inf`.
+        pub fn chen_ricles(m, c, k, k_num: &SMatrix<f64, N, N>, h: f64) {
+            KrAlpha::with_rest(m, c, k, k_num, h, CHEN_RICLES).map(|kr| Self { kr })
+        }
     }
 
     /// The scheme's parameters `(α_m, α_f, β, γ)`. Cost: O(1).
@@ -161,64 +154,57 @@ impl<T: Real, const N: usize> Split<T, N> {
         self.kr.parameters()
     }
 
-    /// The state at `t = 0` from `u0, v0` (m, m/s), the given restoring force `r0`
-    /// measured at `u0` and the load `p0` (force units): `a0 = M⁻¹ (p0 − r0 − C v0 −
-    /// K_num u0)` and the velocity variable `v0 − γh α1 a0` (second order from any state,
-    /// as [`KrAlpha`]'s start).
-    ///
-    /// Errors: [`Error::NonFiniteInput`] (`u0, v0` or `p0`), [`Error::NonFiniteForce`]
-    /// (`r0`), [`Error::NonFiniteState`] (`a0` overflows). Cost: `4N²` multiply-adds.
-    pub fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        r0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<SplitState<T, N>, Error> {
-        if !(u0.is_finite() && v0.is_finite() && p0.is_finite()) {
-            return Err(Error::NonFiniteInput);
+    start_fn! {
+        /// The state at `t = 0` from `u0, v0` (m, m/s), the given restoring force `r0`
+        /// measured at `u0` and the load `p0` (force units): `a0 = M⁻¹ (p0 − r0 − C v0 −
+        /// K_num u0)` and the velocity variable `v0 − γh α1 a0` (second order from any state,
+        /// as [`KrAlpha`]'s start).
+        ///
+        /// Errors: [`Error::NonFiniteInput`] (`u0, v0` or `p0`), [`Error::NonFiniteForce`]
+        /// (`r0`), [`Error::NonFiniteState`] (`a0` overflows). Cost: `4N²` multiply-adds.
+        pub fn start(&self, u0, v0, r0: &SVector<T, N>, p0: &SVector<T, N>) -> SplitState<T, N> {
+            if !(u0.is_finite() && v0.is_finite() && p0.is_finite()) {
+                return Err(Error::NonFiniteInput);
+            }
+            if !r0.is_finite() {
+                return Err(Error::NonFiniteForce);
+            }
+            let net = p0 - r0;
+            if !net.is_finite() {
+                return Err(Error::NonFiniteState);
+            }
+            let state = self.kr.start(u0, v0, &net)?;
+            Ok(SplitState {
+                state,
+                r: *r0,
+                p: *p0,
+            })
         }
-        if !r0.is_finite() {
-            return Err(Error::NonFiniteForce);
-        }
-        let net = p0 - r0;
-        if !net.is_finite() {
-            return Err(Error::NonFiniteState);
-        }
-        let state = self.kr.start(u0, v0, &net)?;
-        Ok(SplitState {
-            state,
-            r: *r0,
-            p: *p0,
-        })
     }
 
-    /// The state at `t = 0` with a known acceleration `a0` and velocity variable `v0` (the
-    /// papers' start; right for a state saved from this scheme), the given force `r0` and
-    /// load `p0`.
-    ///
-    /// Errors: [`Error::NonFiniteInput`] (`u0, v0, a0, p0`), [`Error::NonFiniteForce`]
-    /// (`r0`). Cost: O(N).
-    pub fn start_with_acceleration(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        a0: &SVector<T, N>,
-        r0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<SplitState<T, N>, Error> {
-        if !p0.is_finite() {
-            return Err(Error::NonFiniteInput);
+    start_fn! {
+        /// The state at `t = 0` with a known acceleration `a0` and velocity variable `v0` (the
+        /// papers' start; right for a state saved from this scheme), the given force `r0` and
+        /// load `p0`.
+        ///
+        /// Errors: [`Error::NonFiniteInput`] (`u0, v0, a0, p0`), [`Error::NonFiniteForce`]
+        /// (`r0`). Cost: O(N).
+        pub fn start_with_acceleration(&self, u0, v0, a0: &SVector<T, N>, r0: &SVector<T, N>, p0: &SVector<T, N>)
+            -> SplitState<T, N>
+        {
+            if !p0.is_finite() {
+                return Err(Error::NonFiniteInput);
+            }
+            let state = self.kr.start_with_acceleration(u0, v0, a0)?;
+            if !r0.is_finite() {
+                return Err(Error::NonFiniteForce);
+            }
+            Ok(SplitState {
+                state,
+                r: *r0,
+                p: *p0,
+            })
         }
-        let state = self.kr.start_with_acceleration(u0, v0, a0)?;
-        if !r0.is_finite() {
-            return Err(Error::NonFiniteForce);
-        }
-        Ok(SplitState {
-            state,
-            r: *r0,
-            p: *p0,
-        })
     }
 
     /// The displacement command `u_{n+1} = u_n + h v_n + h² α2 a_n` (m) for the next

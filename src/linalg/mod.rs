@@ -148,7 +148,17 @@ pub(crate) const fn mul<const R: usize, const K: usize, const C: usize>(
 
 /// `aᵀ`.
 pub(crate) const fn transpose<const R: usize, const C: usize>(a: &Mat<R, C>) -> Mat<C, R> {
-    let mut t = [[0.0; R]; C];
+    transpose_filled(a, 0.0)
+}
+
+/// `aᵀ` of any `Copy` entries, the result first filled with `fill` (a value of the type,
+/// as a `const fn` cannot make a default one): the one transpose of [`transpose`] and of
+/// [`matrix!`](crate::matrix)'s row-to-column copy. Cost: `R·C` copies.
+pub(crate) const fn transpose_filled<T: Copy, const R: usize, const C: usize>(
+    a: &[[T; C]; R],
+    fill: T,
+) -> [[T; R]; C] {
+    let mut t = [[fill; R]; C];
     let mut i = 0;
     while i < R {
         let mut j = 0;

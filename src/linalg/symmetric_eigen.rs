@@ -80,11 +80,16 @@ pub(crate) const fn jacobi_eigen<const N: usize>(
                 };
                 let c = 1.0 / sqrt(t * t + 1.0);
                 let s = t * c;
+                // Columns p, q of A and of V in one pass (V does not enter A's update),
+                // then rows p, q of A.
                 let mut k = 0;
                 while k < N {
                     let (akp, akq) = (a[k][p], a[k][q]);
                     a[k][p] = c * akp - s * akq;
                     a[k][q] = s * akp + c * akq;
+                    let (vkp, vkq) = (v[k][p], v[k][q]);
+                    v[k][p] = c * vkp - s * vkq;
+                    v[k][q] = s * vkp + c * vkq;
                     k += 1;
                 }
                 k = 0;
@@ -92,13 +97,6 @@ pub(crate) const fn jacobi_eigen<const N: usize>(
                     let (apk, aqk) = (a[p][k], a[q][k]);
                     a[p][k] = c * apk - s * aqk;
                     a[q][k] = s * apk + c * aqk;
-                    k += 1;
-                }
-                k = 0;
-                while k < N {
-                    let (vkp, vkq) = (v[k][p], v[k][q]);
-                    v[k][p] = c * vkp - s * vkq;
-                    v[k][q] = s * vkp + c * vkq;
                     k += 1;
                 }
                 // Zeroed by construction; store the exact zero, not its rounding.

@@ -30,7 +30,9 @@ use crate::linalg::{
     self, Rows, all_finite, first_error, fits_alone, is_symmetric, max_abs, mul, rows_f64, sqrt,
     transpose,
 };
-use crate::{Error, Real, State, StepState, Stepper};
+use crate::observer::symmetrize;
+use crate::stepper::start_fn;
+use crate::{Error, Real, State, Stepper};
 
 /// Relative tolerance below which `M`, `K` count as symmetric: `|a_ij − a_ji| ≤
 /// 64 ε max|a|` (rounding of a matrix assembled in `f64`).
@@ -201,18 +203,7 @@ pub(crate) const fn modes_of<const N: usize>(
     };
     // A = L⁻¹ K L⁻ᵀ = L⁻¹ (L⁻¹ K)ᵀ for symmetric K; symmetrized against rounding.
     let x = lower_solve(&l, k);
-    let mut a = lower_solve(&l, &transpose(&x));
-    let mut i = 0;
-    while i < N {
-        let mut j = 0;
-        while j < i {
-            let s = 0.5 * (a[i][j] + a[j][i]);
-            a[i][j] = s;
-            a[j][i] = s;
-            j += 1;
-        }
-        i += 1;
-    }
+    let a = symmetrize(&lower_solve(&l, &transpose(&x)));
     let (lam, q) = match jacobi_eigen(a, JACOBI_MAX_SWEEPS) {
         Ok(e) => e,
         Err(e) => return Err(e),
@@ -757,16 +748,7 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Mo
     }
 }
 
-impl<T: Real, const R: usize> StepState for ModalState<T, R> {
-    #[inline]
-    fn is_finite(&self) -> bool {
-        ModalState::is_finite(self)
-    }
-    #[inline]
-    fn steps(&self) -> u64 {
-        self.n
-    }
-}
+crate::state::step_state!(ModalState<R>, |self| ModalState::is_finite(self), n);
 
 impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> Stepper<T, N>
     for Modal<T, N, R, I, O>
@@ -779,63 +761,57 @@ impl<T: Real, const N: usize, const R: usize, const I: usize, const O: usize> St
         self.kin.h
     }
 
-    /// The state at `t = 0` from `u0`, `v0` (projected on the kept modes:
-    /// `η0 = Φ_Rᵀ M u0`, exact when `u0` lies in their span) and `w0`, with
-    /// `η0'' = Γ w0 − 2ξω η0' − ω² η0`.
-    ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::NonFiniteState`]. Cost: `2R·N + R·I`.
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        w0: &SVector<T, I>,
-    ) -> Result<ModalState<T, R>, Error> {
-        if !crate::scalar::initial_inputs_finite(u0, v0, w0) {
-            return Err(Error::NonFiniteInput);
-        }
-        let (eta, deta) = (self.project(u0), self.project(v0));
-        let ddeta = core::array::from_fn(|r| {
-            let mut f = T::zero();
-            for j in 0..I {
-                f += self.gamma[r][j] * w0[j];
+    start_fn! {
+        /// The state at `t = 0` from `u0`, `v0` (projected on the kept modes:
+        /// `η0 = Φ_Rᵀ M u0`, exact when `u0` lies in their span) and `w0`, with
+        /// `η0'' = Γ w0 − 2ξω η0' − ω² η0`.
+        ///
+        /// Errors: [`Error::NonFiniteInput`], [`Error::NonFiniteState`]. Cost: `2R·N + R·I`.
+        fn start(&self, u0, v0, w0: &SVector<T, I>) -> ModalState<T, R> {
+            if !crate::scalar::initial_inputs_finite(u0, v0, w0) {
+                return Err(Error::NonFiniteInput);
             }
-            f - self.c[r] * deta[r] - self.k[r] * eta[r]
-        });
-        let s = ModalState {
-            eta,
-            deta,
-            ddeta,
-            n: 0,
-        };
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteState)
+            let (eta, deta) = (self.project(u0), self.project(v0));
+            let ddeta = core::array::from_fn(|r| {
+                let mut f = T::zero();
+                for j in 0..I {
+                    f += self.gamma[r][j] * w0[j];
+                }
+                f - self.c[r] * deta[r] - self.k[r] * eta[r]
+            });
+            let s = ModalState {
+                eta,
+                deta,
+                ddeta,
+                n: 0,
+            };
+            if s.is_finite() {
+                Ok(s)
+            } else {
+                Err(Error::NonFiniteState)
+            }
         }
     }
 
-    /// The state at `t = 0` from `u0, v0, a0`, each projected on the kept modes
-    /// (`η = Φ_Rᵀ M x`). Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if a
-    /// projection overflows (large `M` in `f32`). Cost: `3R·N`.
-    fn start_with_acceleration(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        a0: &SVector<T, N>,
-    ) -> Result<ModalState<T, R>, Error> {
-        if !crate::scalar::initial_inputs_finite(u0, v0, a0) {
-            return Err(Error::NonFiniteInput);
-        }
-        let s = ModalState {
-            eta: self.project(u0),
-            deta: self.project(v0),
-            ddeta: self.project(a0),
-            n: 0,
-        };
-        if s.is_finite() {
-            Ok(s)
-        } else {
-            Err(Error::NonFiniteState)
+    start_fn! {
+        /// The state at `t = 0` from `u0, v0, a0`, each projected on the kept modes
+        /// (`η = Φ_Rᵀ M x`). Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if a
+        /// projection overflows (large `M` in `f32`). Cost: `3R·N`.
+        fn start_with_acceleration(&self, u0, v0, a0: &SVector<T, N>) -> ModalState<T, R> {
+            if !crate::scalar::initial_inputs_finite(u0, v0, a0) {
+                return Err(Error::NonFiniteInput);
+            }
+            let s = ModalState {
+                eta: self.project(u0),
+                deta: self.project(v0),
+                ddeta: self.project(a0),
+                n: 0,
+            };
+            if s.is_finite() {
+                Ok(s)
+            } else {
+                Err(Error::NonFiniteState)
+            }
         }
     }
 

@@ -49,16 +49,11 @@ macro_rules! estimate_counters {
             }
         }
 
-        impl<T: $crate::Real, const S: usize, const I: usize> $crate::StepState for $ty<T, S, I> {
-            #[inline]
-            fn is_finite(&self) -> bool {
-                self.$x.iter().chain(self.w.iter()).all(|v| v.is_finite())
-            }
-            #[inline]
-            fn steps(&self) -> u64 {
-                self.n
-            }
-        }
+        $crate::state::step_state!(
+            $ty<S, I>,
+            |self| self.$x.iter().chain(self.w.iter()).all(|v| v.is_finite()),
+            n
+        );
     };
 }
 pub(crate) use estimate_counters;
@@ -241,16 +236,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
 
     /// The predicted measurement `H x + D w` of a state. Cost: `O·(S + I)`.
     pub fn predicted_output(&self, x: &SVector<T, S>, w: &SVector<T, I>) -> SVector<T, O> {
-        SVector::from_fn(|o, _| {
-            let mut s = T::zero();
-            for j in 0..S {
-                s += self.h[o][j] * x[j];
-            }
-            for j in 0..I {
-                s += self.d[o][j] * w[j];
-            }
-            s
-        })
+        mul2(&self.h, &self.d, x, w)
     }
 
     /// One step: predict with the input `w` (`w_n`; `w_{n−1}` is kept in the estimate),
@@ -423,17 +409,31 @@ impl<T: Real, const S: usize, const I: usize, const P: usize> Readout<T, S, I, P
 
     /// `z = H x + D w`. Cost: `P·(S + I)` multiply-adds.
     pub fn read(&self, x: &SVector<T, S>, w: &SVector<T, I>) -> SVector<T, P> {
-        SVector::from_fn(|p, _| {
-            let mut s = T::zero();
-            for j in 0..S {
-                s += self.h[p][j] * x[j];
-            }
-            for j in 0..I {
-                s += self.d[p][j] * w[j];
-            }
-            s
-        })
+        mul2(&self.h, &self.d, x, w)
     }
+}
+
+/// `M₁ x + M₂ w` row by row (`M₁` `R×S`, `M₂` `R×I`; from `+0`, `M₁`'s terms first): the
+/// one sum of [`Observer::predicted_output`] and [`Readout::read`] (`H x + D w`) and of
+/// the dual filter's error dynamics (`A e_ξ + B e_w`, `C e_ξ + D̃ e_w`). Cost: `R·(S + I)`
+/// multiply-adds.
+#[inline]
+pub(crate) fn mul2<T: Real, const R: usize, const S: usize, const I: usize>(
+    m1: &[[T; S]; R],
+    m2: &[[T; I]; R],
+    x: &SVector<T, S>,
+    w: &SVector<T, I>,
+) -> SVector<T, R> {
+    SVector::from_fn(|r, _| {
+        let mut s = T::zero();
+        for j in 0..S {
+            s += m1[r][j] * x[j];
+        }
+        for j in 0..I {
+            s += m2[r][j] * w[j];
+        }
+        s
+    })
 }
 
 macro_rules! readout_const {

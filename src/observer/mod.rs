@@ -84,7 +84,7 @@ mod riccati;
 mod state_space;
 
 pub use fixed::{Estimate, Observer, Readout};
-pub(crate) use fixed::{check_counts, estimate_counters, next_counts};
+pub(crate) use fixed::{check_counts, estimate_counters, mul2, next_counts};
 pub use kalman::{Kalman, KalmanState};
 // For the joint input–state estimators (`crate::estimation`).
 pub(crate) use kalman_core::{

@@ -49,9 +49,11 @@ use crate::linalg::lu::{Lu, row_scales};
 use crate::linalg::{
     Mat, Rows, add_scaled, all_finite, identity, mul, put, rows_f64, scaled, transpose,
 };
+use crate::macros::mck_fn;
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
 use crate::schemes::{Exponential, exponential};
+use crate::stepper::start_fn;
 use crate::{AlphaParameters, Error, Exact};
 
 /// The discrete state-space model of a linear scheme with `N` degrees of freedom, state
@@ -155,15 +157,11 @@ impl<const N: usize, const I: usize, const O: usize> Outputs<N, I, O> {
     pub const fn absolute_accelerations(y: [[f64; N]; O], input: usize) -> Self {
         let mut o = Self::accelerations(y);
         if input < I {
+            // `Y ι`: each row's sum, in the order of the columns (`ι` is exact).
+            let y_iota = mul(&y, &[[1.0]; N]);
             let mut r = 0;
             while r < O {
-                let mut s = 0.0;
-                let mut j = 0;
-                while j < N {
-                    s += y[r][j];
-                    j += 1;
-                }
-                o.w[r][input] = s;
+                o.w[r][input] = y_iota[r][0];
                 r += 1;
             }
         }
@@ -199,11 +197,11 @@ pub struct Measurement<const S: usize, const I: usize, const O: usize> {
 impl<const S: usize, const I: usize, const O: usize> Measurement<S, I, O> {
     /// `H` as a `nalgebra` matrix.
     pub fn h_matrix(&self) -> SMatrix<f64, O, S> {
-        SMatrix::from_fn(|i, j| self.h[i][j])
+        crate::linalg::matrix_t(&self.h)
     }
     /// `D` as a `nalgebra` matrix.
     pub fn d_matrix(&self) -> SMatrix<f64, O, I> {
-        SMatrix::from_fn(|i, j| self.d[i][j])
+        crate::linalg::matrix_t(&self.d)
     }
 }
 
@@ -333,17 +331,13 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         Self::from_rows_newmark(m, c, k, b, h, 0.25, 0.5)
     }
 
-    /// [`StateSpace::from_rows_aem`] from `nalgebra` matrices (run time; same numbers).
-    ///
-    /// Errors and cost: as [`StateSpace::from_rows_aem`].
-    pub fn aem(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        b: &SMatrix<f64, N, I>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        Self::from_rows_aem(rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(b), h)
+    mck_fn! {
+        /// [`StateSpace::from_rows_aem`] from `nalgebra` matrices (run time; same numbers).
+        ///
+        /// Errors and cost: as [`StateSpace::from_rows_aem`].
+        pub fn aem(m, c, k, b: &SMatrix<f64, N, I>, h: f64) {
+            Self::from_rows_aem(rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(b), h)
+        }
     }
 
     /// The full-state form of [`Newmark`](crate::Newmark) with parameters `beta` (β ≥ 0) and
@@ -386,28 +380,22 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         ss.full_outputs(&bl.au, &bl.av, bl.aw)
     }
 
-    /// [`StateSpace::from_rows_newmark`] from `nalgebra` matrices (run time; same numbers).
-    ///
-    /// Errors and cost: as [`StateSpace::from_rows_newmark`].
-    #[allow(clippy::too_many_arguments)] // the stepper's arguments, plus B
-    pub fn newmark(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        b: &SMatrix<f64, N, I>,
-        h: f64,
-        beta: f64,
-        gamma: f64,
-    ) -> Result<Self, Error> {
-        Self::from_rows_newmark(
-            rows_f64(m),
-            rows_f64(c),
-            rows_f64(k),
-            rows_f64(b),
-            h,
-            beta,
-            gamma,
-        )
+    mck_fn! {
+        /// [`StateSpace::from_rows_newmark`] from `nalgebra` matrices (run time; same numbers).
+        ///
+        /// Errors and cost: as [`StateSpace::from_rows_newmark`].
+        #[allow(clippy::too_many_arguments)] // the stepper's arguments, plus B
+        pub fn newmark(m, c, k, b: &SMatrix<f64, N, I>, h: f64, beta: f64, gamma: f64) {
+            Self::from_rows_newmark(
+                rows_f64(m),
+                rows_f64(c),
+                rows_f64(k),
+                rows_f64(b),
+                h,
+                beta,
+                gamma,
+            )
+        }
     }
 
     /// The form of [`GeneralizedAlpha`](crate::GeneralizedAlpha) (and HHT-α) with
@@ -492,191 +480,176 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         ss.physical_outputs(&lu_m, &st, &b)
     }
 
-    /// [`StateSpace::from_rows_generalized_alpha`] from `nalgebra` matrices (run time; same
-    /// numbers). `params` from [`AlphaParameters::chung_hulbert`] (the
-    /// [`GeneralizedAlpha::new`](crate::GeneralizedAlpha::new) of `ρ∞`),
-    /// [`AlphaParameters::hht`] or written out.
-    ///
-    /// ```
-    /// use aemstep::observer::StateSpace;
-    /// use aemstep::{matrix, vector};
-    /// use aemstep::{AlphaParameters, GeneralizedAlpha, Stepper};
-    /// let (m, c, k, b, h) = (matrix![2.0], matrix![0.3], matrix![50.0], matrix![1.0], 0.01);
-    /// let p = AlphaParameters::chung_hulbert(0.8)?;
-    /// let ss = StateSpace::<1, 3, 1>::generalized_alpha(&m, &c, &k, &b, h, p)?;
-    /// let sys = GeneralizedAlpha::<f64, 1>::with_parameters(&m, &c, &k, h, p)?;
-    /// // x = [u; v; a] with the stepper's start-up acceleration.
-    /// let (u0, v0, w0, w1) = (vector![0.1], vector![0.0], vector![1.0], vector![2.0]);
-    /// let mut x = ss.initial_state(&u0, &v0, &w0)?;
-    /// let mut s = sys.start(&u0, &v0, &(b * w0))?;
-    /// assert!((x[2] - s.a()[0]).abs() <= 1e-14); // a0 = −2 m/s², to rounding
-    /// x = ss.phi_matrix() * x + ss.gamma0_matrix() * w0 + ss.gamma1_matrix() * w1;
-    /// sys.step_with_previous_input(&mut s, &(b * w0), &(b * w1));
-    /// assert!((x[0] - s.u()[0]).abs() <= 1e-15 && (x[2] - s.a()[0]).abs() <= 1e-14);
-    /// # Ok::<(), aemstep::Error>(())
-    /// ```
-    ///
-    /// Errors and cost: as [`StateSpace::from_rows_generalized_alpha`].
-    pub fn generalized_alpha(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        b: &SMatrix<f64, N, I>,
-        h: f64,
-        params: AlphaParameters,
-    ) -> Result<Self, Error> {
-        Self::from_rows_generalized_alpha(
-            rows_f64(m),
-            rows_f64(c),
-            rows_f64(k),
-            rows_f64(b),
-            h,
-            params,
-        )
+    mck_fn! {
+        /// [`StateSpace::from_rows_generalized_alpha`] from `nalgebra` matrices (run time; same
+        /// numbers). `params` from [`AlphaParameters::chung_hulbert`] (the
+        /// [`GeneralizedAlpha::new`](crate::GeneralizedAlpha::new) of `ρ∞`),
+        /// [`AlphaParameters::hht`] or written out.
+        ///
+        /// ```
+        /// use aemstep::observer::StateSpace;
+        /// use aemstep::{matrix, vector};
+        /// use aemstep::{AlphaParameters, GeneralizedAlpha, Stepper};
+        /// let (m, c, k, b, h) = (matrix![2.0], matrix![0.3], matrix![50.0], matrix![1.0], 0.01);
+        /// let p = AlphaParameters::chung_hulbert(0.8)?;
+        /// let ss = StateSpace::<1, 3, 1>::generalized_alpha(&m, &c, &k, &b, h, p)?;
+        /// let sys = GeneralizedAlpha::<f64, 1>::with_parameters(&m, &c, &k, h, p)?;
+        /// // x = [u; v; a] with the stepper's start-up acceleration.
+        /// let (u0, v0, w0, w1) = (vector![0.1], vector![0.0], vector![1.0], vector![2.0]);
+        /// let mut x = ss.initial_state(&u0, &v0, &w0)?;
+        /// let mut s = sys.start(&u0, &v0, &(b * w0))?;
+        /// assert!((x[2] - s.a()[0]).abs() <= 1e-14); // a0 = −2 m/s², to rounding
+        /// x = ss.phi_matrix() * x + ss.gamma0_matrix() * w0 + ss.gamma1_matrix() * w1;
+        /// sys.step_with_previous_input(&mut s, &(b * w0), &(b * w1));
+        /// assert!((x[0] - s.u()[0]).abs() <= 1e-15 && (x[2] - s.a()[0]).abs() <= 1e-14);
+        /// # Ok::<(), aemstep::Error>(())
+        /// ```
+        ///
+        /// Errors and cost: as [`StateSpace::from_rows_generalized_alpha`].
+        pub fn generalized_alpha(m, c, k, b: &SMatrix<f64, N, I>, h: f64, params: AlphaParameters) {
+            Self::from_rows_generalized_alpha(
+                rows_f64(m),
+                rows_f64(c),
+                rows_f64(k),
+                rows_f64(b),
+                h,
+                params,
+            )
+        }
     }
 
-    /// The state at the start of a full-state model (every builder but the modal one) from
-    /// displacements `u0` (m), velocities `v0` (m/s) and input `w0`: `[u0; v0]`, and for
-    /// [`StateSpace::generalized_alpha`] (`S = 3N`) `[u0; v0; a0]` with
-    /// `a0 = M⁻¹ (B w0 − C v0 − K u0)` — what the steppers' `start` computes. For a modal
-    /// model use [`StateSpace::modal_coordinates`].
-    ///
-    /// Errors: [`Error::NonFiniteInput`]; [`Error::StateSizeMismatch`] for a model whose
-    /// state does not begin with `[u; v]` (a modal model, `U ≠ [I 0 …]`).
-    ///
-    /// Cost: `N·(S + I)` flops and a scan of `U`, `V`.
-    pub fn initial_state(
-        &self,
-        u0: &SVector<f64, N>,
-        v0: &SVector<f64, N>,
-        w0: &SVector<f64, I>,
-    ) -> Result<SVector<f64, S>, Error> {
-        if !u0
-            .iter()
-            .chain(v0.iter())
-            .chain(w0.iter())
-            .all(|x| x.is_finite())
-        {
-            return Err(Error::NonFiniteInput);
-        }
-        let one = |c: bool| if c { 1.0 } else { 0.0 };
-        let full = (0..N).all(|i| {
-            (0..S).all(|j| self.dof_u[i][j] == one(j == i) && self.dof_v[i][j] == one(j == N + i))
-        });
-        if !full {
-            return Err(Error::StateSizeMismatch);
-        }
-        let mut x = SVector::<f64, S>::zeros();
-        for i in 0..N {
-            x[i] = u0[i];
-            x[N + i] = v0[i];
-        }
-        if S == 3 * N {
-            // a0 = A_x x + A_w w0 (the a-block of A_x is zero, and so is that of x).
-            for i in 0..N {
-                let mut a = 0.0;
-                for j in 0..S {
-                    a += self.dof_a[i][j] * x[j];
-                }
-                for j in 0..I {
-                    a += self.dof_a_input[i][j] * w0[j];
-                }
-                x[2 * N + i] = a;
+    start_fn! {
+        f64;
+        /// The state at the start of a full-state model (every builder but the modal one) from
+        /// displacements `u0` (m), velocities `v0` (m/s) and input `w0`: `[u0; v0]`, and for
+        /// [`StateSpace::generalized_alpha`] (`S = 3N`) `[u0; v0; a0]` with
+        /// `a0 = M⁻¹ (B w0 − C v0 − K u0)` — what the steppers' `start` computes. For a modal
+        /// model use [`StateSpace::modal_coordinates`].
+        ///
+        /// Errors: [`Error::NonFiniteInput`]; [`Error::StateSizeMismatch`] for a model whose
+        /// state does not begin with `[u; v]` (a modal model, `U ≠ [I 0 …]`).
+        ///
+        /// Cost: `N·(S + I)` flops and a scan of `U`, `V`.
+        pub fn initial_state(&self, u0, v0, w0: &SVector<f64, I>) -> SVector<f64, S> {
+            if !u0
+                .iter()
+                .chain(v0.iter())
+                .chain(w0.iter())
+                .all(|x| x.is_finite())
+            {
+                return Err(Error::NonFiniteInput);
             }
+            let one = |c: bool| if c { 1.0 } else { 0.0 };
+            let full = (0..N).all(|i| {
+                (0..S).all(|j| self.dof_u[i][j] == one(j == i) && self.dof_v[i][j] == one(j == N + i))
+            });
+            if !full {
+                return Err(Error::StateSizeMismatch);
+            }
+            let mut x = SVector::<f64, S>::zeros();
+            for i in 0..N {
+                x[i] = u0[i];
+                x[N + i] = v0[i];
+            }
+            if S == 3 * N {
+                // a0 = A_x x + A_w w0 (the a-block of A_x is zero, and so is that of x).
+                for i in 0..N {
+                    let mut a = 0.0;
+                    for j in 0..S {
+                        a += self.dof_a[i][j] * x[j];
+                    }
+                    for j in 0..I {
+                        a += self.dof_a_input[i][j] * w0[j];
+                    }
+                    x[2 * N + i] = a;
+                }
+            }
+            Ok(x)
         }
-        Ok(x)
     }
 
-    /// The full-state form of [`Exact`] (matrix exponential, load `p = B w` linear over
-    /// the step): `Φ` and the first-order-hold `Γ₀ = (Γ₁ᵉ − Γ₂ᵉ/h) B`, `Γ₁ = (Γ₂ᵉ/h) B` of
-    /// the exponential, `x = [u; v]`, `S = 2N`; reproduces
-    /// [`Stepper::step_with_previous_input`](crate::Stepper::step_with_previous_input) of
-    /// [`Exact`] to rounding. Run time only.
-    ///
-    /// Errors: [`Error::StateSizeMismatch`], those of [`Exact::new`], and
-    /// [`Error::NonFiniteInput`] for `B`.
-    ///
-    /// Cost: that of [`Exact::new`] plus `4N²·I` flops.
-    pub fn exact(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        b: &SMatrix<f64, N, I>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        let bb = rows_f64(b);
-        Self::check_input(2 * N, &bb)?;
-        let ex = Exact::<f64, N>::new(m, c, k, h)?;
-        let (mm, cc, kk) = (rows_f64(m), rows_f64(c), rows_f64(k));
-        let (lu_m, st) = start_operators(&mm, &cc, &kk, f64::MAX)?.ok_or(Error::SingularMass)?;
-        let phi = [[&ex.au[0], &ex.au[1]], [&ex.av[0], &ex.av[1]]];
-        let gamma0 = [&mul(&ex.au[2], &bb), &mul(&ex.av[2], &bb)];
-        let gamma1 = [&mul(&ex.au[3], &bb), &mul(&ex.av[3], &bb)];
-        let ss = Self::from_uv_blocks(h, phi, gamma0, gamma1);
-        ss.physical_outputs(&lu_m, &st, &bb)
+    mck_fn! {
+        /// The full-state form of [`Exact`] (matrix exponential, load `p = B w` linear over
+        /// the step): `Φ` and the first-order-hold `Γ₀ = (Γ₁ᵉ − Γ₂ᵉ/h) B`, `Γ₁ = (Γ₂ᵉ/h) B` of
+        /// the exponential, `x = [u; v]`, `S = 2N`; reproduces
+        /// [`Stepper::step_with_previous_input`](crate::Stepper::step_with_previous_input) of
+        /// [`Exact`] to rounding. Run time only.
+        ///
+        /// Errors: [`Error::StateSizeMismatch`], those of [`Exact::new`], and
+        /// [`Error::NonFiniteInput`] for `B`.
+        ///
+        /// Cost: that of [`Exact::new`] plus `4N²·I` flops.
+        pub fn exact(m, c, k, b: &SMatrix<f64, N, I>, h: f64) {
+            let bb = rows_f64(b);
+            Self::check_input(2 * N, &bb)?;
+            let ex = Exact::<f64, N>::new(m, c, k, h)?;
+            let (mm, cc, kk) = (rows_f64(m), rows_f64(c), rows_f64(k));
+            let (lu_m, st) = start_operators(&mm, &cc, &kk, f64::MAX)?.ok_or(Error::SingularMass)?;
+            let phi = [[&ex.au[0], &ex.au[1]], [&ex.av[0], &ex.av[1]]];
+            let gamma0 = [&mul(&ex.au[2], &bb), &mul(&ex.av[2], &bb)];
+            let gamma1 = [&mul(&ex.au[3], &bb), &mul(&ex.av[3], &bb)];
+            let ss = Self::from_uv_blocks(h, phi, gamma0, gamma1);
+            ss.physical_outputs(&lu_m, &st, &bb)
+        }
     }
 
-    /// The zero-order-hold discretization (`x = [u; v]`, `S = 2N`): the input held
-    /// constant over each step at its sample from the step's start, as a DAC or a
-    /// sample-and-hold drives it and as sampled-data models are written,
-    ///
-    /// ```text
-    /// x_n = Φ x_{n−1} + Γ w_{n−1},   Φ = e^{F h},   Γ = ∫₀ʰ e^{F s} ds · [0; M⁻¹] B,
-    /// F = [[0, I], [−M⁻¹K, −M⁻¹C]]
-    /// ```
-    ///
-    /// exactly (no truncation error, only rounding) — so in the two-ended form
-    /// `Γ₀ = Γ`, `Γ₁ = 0` (for the filters of [`estimation`](crate::estimation):
-    /// `B = Γ`, `D̃ = D`). `Φ` and `Γ` are blocks of the one matrix exponential (Van
-    /// Loan) that [`Exact`] reads, so `Φ` is its `Φ` bit for bit and `Γ` its `Γ₁ᵉ B`. The outputs are those of every full-state builder:
-    /// `u = U x`, `v = V x`, `a = M⁻¹ (B w − C v − K u)` — the acceleration at `t_n` with
-    /// the sample `w_n` that is held from `t_n` on (the right limit at a switch of the
-    /// input), so an acceleration output has the direct feedthrough `D = Y_a M⁻¹ B`, the
-    /// standard `y_n = H x_n + D w_n` of a sampled system. [`StateSpace::exact`] is the
-    /// first-order hold (the input linear between its samples). Run time only.
-    ///
-    /// ```
-    /// use aemstep::observer::StateSpace;
-    /// use aemstep::matrix;
-    /// // u'' + ω² u = w/m, ω = 5 rad/s, m = 2 kg, h = 0.1 s: Γ = [(1 − cos ωh)/ω²; sin(ωh)/ω] / m.
-    /// let (w, h) = (5.0f64, 0.1);
-    /// let ss = StateSpace::<1, 2, 1>::zero_order_hold(
-    ///     &matrix![2.0], &matrix![0.0], &matrix![2.0 * w * w], &matrix![1.0], h)?;
-    /// assert!((ss.phi[0][0] - (w * h).cos()).abs() < 1e-15);
-    /// assert!((ss.gamma0[0][0] - (1.0 - (w * h).cos()) / (w * w) / 2.0).abs() < 1e-16);
-    /// assert!((ss.gamma0[1][0] - (w * h).sin() / w / 2.0).abs() < 1e-16);
-    /// assert_eq!(ss.gamma1, [[0.0], [0.0]]);
-    /// # Ok::<(), aemstep::Error>(())
-    /// ```
-    ///
-    /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`] (`M`,
-    /// `C`, `K` or `B`), [`Error::InvalidTimeStep`], [`Error::SingularMass`],
-    /// [`Error::OperatorOverflow`].
-    ///
-    /// Cost: about `(4N)³ (19 + s)` `f64` flops (`s` squarings, as [`Exact::new`]) plus
-    /// `4N²·I`, and three `16N²` `f64` temporaries on the stack.
-    pub fn zero_order_hold(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        b: &SMatrix<f64, N, I>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        let bb = rows_f64(b);
-        Self::check_input(2 * N, &bb)?;
-        // Φ and Γ₁ᵉ = ∫₀ʰ e^{F s} ds [0; M⁻¹] of the exponential `Exact` reads.
-        let Exponential {
-            h: hf,
-            lu_m,
-            start: st,
-            blocks: [[phi_uu, phi_uv, gu, _], [phi_vu, phi_vv, gv, _]],
-            ..
-        } = exponential(m, c, k, h, f64::MAX)?;
-        let phi = [[&phi_uu, &phi_uv], [&phi_vu, &phi_vv]];
-        let gamma0 = [&mul(&gu, &bb), &mul(&gv, &bb)];
-        let zero = [[0.0; I]; N];
-        let ss = Self::from_uv_blocks(hf, phi, gamma0, [&zero, &zero]);
-        ss.physical_outputs(&lu_m, &st, &bb)
+    mck_fn! {
+        /// The zero-order-hold discretization (`x = [u; v]`, `S = 2N`): the input held
+        /// constant over each step at its sample from the step's start, as a DAC or a
+        /// sample-and-hold drives it and as sampled-data models are written,
+        ///
+        /// ```text
+        /// x_n = Φ x_{n−1} + Γ w_{n−1},   Φ = e^{F h},   Γ = ∫₀ʰ e^{F s} ds · [0; M⁻¹] B,
+        /// F = [[0, I], [−M⁻¹K, −M⁻¹C]]
+        /// ```
+        ///
+        /// exactly (no truncation error, only rounding) — so in the two-ended form
+        /// `Γ₀ = Γ`, `Γ₁ = 0` (for the filters of [`estimation`](crate::estimation):
+        /// `B = Γ`, `D̃ = D`). `Φ` and `Γ` are blocks of the one matrix exponential (Van
+        /// Loan) that [`Exact`] reads, so `Φ` is its `Φ` bit for bit and `Γ` its `Γ₁ᵉ B`. The outputs are those of every full-state builder:
+        /// `u = U x`, `v = V x`, `a = M⁻¹ (B w − C v − K u)` — the acceleration at `t_n` with
+        /// the sample `w_n` that is held from `t_n` on (the right limit at a switch of the
+        /// input), so an acceleration output has the direct feedthrough `D = Y_a M⁻¹ B`, the
+        /// standard `y_n = H x_n + D w_n` of a sampled system. [`StateSpace::exact`] is the
+        /// first-order hold (the input linear between its samples). Run time only.
+        ///
+        /// ```
+        /// use aemstep::observer::StateSpace;
+        /// use aemstep::matrix;
+        /// // u'' + ω² u = w/m, ω = 5 rad/s, m = 2 kg, h = 0.1 s: Γ = [(1 − cos ωh)/ω²; sin(ωh)/ω] / m.
+        /// let (w, h) = (5.0f64, 0.1);
+        /// let ss = StateSpace::<1, 2, 1>::zero_order_hold(
+        ///     &matrix![2.0], &matrix![0.0], &matrix![2.0 * w * w], &matrix![1.0], h)?;
+        /// assert!((ss.phi[0][0] - (w * h).cos()).abs() < 1e-15);
+        /// assert!((ss.gamma0[0][0] - (1.0 - (w * h).cos()) / (w * w) / 2.0).abs() < 1e-16);
+        /// assert!((ss.gamma0[1][0] - (w * h).sin() / w / 2.0).abs() < 1e-16);
+        /// assert_eq!(ss.gamma1, [[0.0], [0.0]]);
+        /// # Ok::<(), aemstep::Error>(())
+        /// ```
+        ///
+        /// Errors: [`Error::StateSizeMismatch`] (`S ≠ 2N`), [`Error::NonFiniteInput`] (`M`,
+        /// `C`, `K` or `B`), [`Error::InvalidTimeStep`], [`Error::SingularMass`],
+        /// [`Error::OperatorOverflow`].
+        ///
+        /// Cost: about `(4N)³ (19 + s)` `f64` flops (`s` squarings, as [`Exact::new`]) plus
+        /// `4N²·I`, and three `16N²` `f64` temporaries on the stack.
+        pub fn zero_order_hold(m, c, k, b: &SMatrix<f64, N, I>, h: f64) {
+            let bb = rows_f64(b);
+            Self::check_input(2 * N, &bb)?;
+            // Φ and Γ₁ᵉ = ∫₀ʰ e^{F s} ds [0; M⁻¹] of the exponential `Exact` reads.
+            let Exponential {
+                h: hf,
+                lu_m,
+                start: st,
+                blocks: [[phi_uu, phi_uv, gu, _], [phi_vu, phi_vv, gv, _]],
+                ..
+            } = exponential(m, c, k, h, f64::MAX)?;
+            let phi = [[&phi_uu, &phi_uv], [&phi_vu, &phi_vv]];
+            let gamma0 = [&mul(&gu, &bb), &mul(&gv, &bb)];
+            let zero = [[0.0; I]; N];
+            let ss = Self::from_uv_blocks(hf, phi, gamma0, [&zero, &zero]);
+            ss.physical_outputs(&lu_m, &st, &bb)
+        }
     }
 
     /// The form of [`Modal`](crate::Modal) keeping the modes `modes` (indices in ascending
@@ -961,15 +934,15 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
 
     /// `Φ` as a `nalgebra` matrix.
     pub fn phi_matrix(&self) -> SMatrix<f64, S, S> {
-        SMatrix::from_fn(|i, j| self.phi[i][j])
+        crate::linalg::matrix_t(&self.phi)
     }
     /// `Γ₀` as a `nalgebra` matrix.
     pub fn gamma0_matrix(&self) -> SMatrix<f64, S, I> {
-        SMatrix::from_fn(|i, j| self.gamma0[i][j])
+        crate::linalg::matrix_t(&self.gamma0)
     }
     /// `Γ₁` as a `nalgebra` matrix.
     pub fn gamma1_matrix(&self) -> SMatrix<f64, S, I> {
-        SMatrix::from_fn(|i, j| self.gamma1[i][j])
+        crate::linalg::matrix_t(&self.gamma1)
     }
 }
 

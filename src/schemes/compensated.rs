@@ -11,7 +11,9 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::kernel::{Kernel, Lows, aem_const_ctors, initial_state, newmark_step_compensated};
 use crate::kinematics::{AemKinematics, Kinematics};
-use crate::{Error, Real, State, StepState, Stepper};
+use crate::macros::mck_fn;
+use crate::stepper::start_fn;
+use crate::{Error, Real, State, Stepper};
 
 /// The state of a [`CompensatedLinear`]: the working-precision [`State`] and the rounding
 /// errors of its `u` and `v` (`u + du` is the displacement to about twice the working
@@ -48,22 +50,17 @@ impl<T: Real, const N: usize> CompensatedState<T, N> {
     }
 }
 
-impl<T: Real, const N: usize> StepState for CompensatedState<T, N> {
-    #[inline]
-    fn is_finite(&self) -> bool {
-        self.state.is_finite()
-            && self
-                .lo
-                .du
-                .iter()
-                .chain(self.lo.dv.iter())
-                .all(|x| x.is_finite())
-    }
-    #[inline]
-    fn steps(&self) -> u64 {
-        self.state.n
-    }
-}
+crate::state::step_state!(
+    CompensatedState<N>,
+    |self| self.state.is_finite()
+        && self
+            .lo
+            .du
+            .iter()
+            .chain(self.lo.dv.iter())
+            .all(|x| x.is_finite()),
+    state.n
+);
 
 /// The AEM ([`Linear`](crate::Linear)'s operators, bit-identical) with the state update
 /// compensated: for long undamped runs in `f32`, where the plain update's rounding drifts
@@ -98,17 +95,14 @@ pub struct CompensatedLinear<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> CompensatedLinear<T, N> {
-    /// Precompute the operators of [`Linear::new`](crate::Linear::new) (same arguments:
-    /// `M, C, K` `N×N` in `f64`, step `h` in s; computed in `f64`, rounded once to `T`).
-    ///
-    /// Errors: as [`Linear::new`](crate::Linear::new). Cost: about `4N³` flops in `f64`.
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
+    mck_fn! {
+        /// Precompute the operators of [`Linear::new`](crate::Linear::new) (same arguments:
+        /// `M, C, K` `N×N` in `f64`, step `h` in s; computed in `f64`, rounded once to `T`).
+        ///
+        /// Errors: as [`Linear::new`](crate::Linear::new). Cost: about `4N³` flops in `f64`.
+        pub fn new(m, c, k, h: f64) {
+            Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
+        }
     }
 
     /// `κ₁` of the row-equilibrated effective matrix, as
@@ -147,23 +141,18 @@ impl<T: Real, const N: usize> Stepper<T, N> for CompensatedLinear<T, N> {
         self.kernel.kin.h()
     }
 
-    /// As [`Stepper::start`]; the carried errors start at zero.
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<CompensatedState<T, N>, Error> {
-        initial_state(self.kernel.start.as_ref(), u0, v0, p0).map(CompensatedState::from_state)
+    start_fn! {
+        /// As [`Stepper::start`]; the carried errors start at zero.
+        fn start(&self, u0, v0, p0: &SVector<T, N>) -> CompensatedState<T, N> {
+            initial_state(self.kernel.start.as_ref(), u0, v0, p0)
+                .map(CompensatedState::from_state)
+        }
     }
 
-    fn start_with_acceleration(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        a0: &SVector<T, N>,
-    ) -> Result<CompensatedState<T, N>, Error> {
-        State::initial_given(u0, v0, a0).map(CompensatedState::from_state)
+    start_fn! {
+        fn start_with_acceleration(&self, u0, v0, a0: &SVector<T, N>) -> CompensatedState<T, N> {
+            State::initial_given(u0, v0, a0).map(CompensatedState::from_state)
+        }
     }
 
     /// Cost: `5N²` multiply-adds + about `34N` (see the type's docs).

@@ -42,6 +42,7 @@ use crate::linalg::lu::Lu;
 use crate::linalg::{
     Mat, add_scaled, finite_as, first_error, fits, fits_alone, identity, round_rows, scaled,
 };
+use crate::macros::mck_fn;
 use crate::{Error, Real, State, Stepper};
 
 /// `y += A x` for a row-major `A`.
@@ -174,73 +175,70 @@ pub(crate) fn exponential<const N: usize>(
 }
 
 impl<T: Real, const N: usize> Exact<T, N> {
-    /// Compute the exact step operators for step `h` (s). Computed in `f64`, rounded
-    /// once to `T`.
-    ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
-    /// [`Error::SingularMass`] (`M` singular: the first-order form needs `M⁻¹`),
-    /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`] (an operator beyond the
-    /// range of `T`, or its largest entry subnormal there).
-    ///
-    /// Cost: about `(4N)³ (19 + s)` flops, `s = ⌈log₂(2‖hF‖)⌉` squarings (balanced norm,
-    /// e.g. `s ≈ 14` for `ω_max h = 10⁴`), and three `16N²` `f64` temporaries on the
-    /// stack (`384 KB` at `N = 50`, `1.5 MB` at `N = 100`: use a large stack there).
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        let Exponential {
-            m,
-            c,
-            k,
-            h: hf,
-            start: st,
-            blocks,
-            ..
-        } = exponential(m, c, k, h, T::MAX)?;
-        let mut under = None;
-        let mut au = [[[T::zero(); N]; N]; 4];
-        let mut av = [[[T::zero(); N]; N]; 4];
-        for (r, out) in [(0usize, &mut au), (1usize, &mut av)] {
-            let [phi_u, phi_v, g1, g2] = blocks[r];
-            // P0 = Γ₁ − Γ₂/h multiplies p_{n−1} = M a + C v + K u; P1 = Γ₂/h multiplies p_n.
-            let p0 = add_scaled(&g1, -1.0 / hf, &g2);
-            let p1 = scaled(1.0 / hf, &g2);
-            // Representable in `T` (overflow now, underflow after every block is seen):
-            // `P1 = Γ₂/h` is never zero for a regular `M`; the others are judged alone.
-            let fit = [
-                fits_alone(&phi_u, T::MAX),
-                fits_alone(&phi_v, T::MAX),
-                fits_alone(&p0, T::MAX),
-                fits(&p1, &m, T::MAX),
-            ];
-            match first_error(fit) {
-                Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
-                Some(e) => under = Some(e),
-                None => {}
+    mck_fn! {
+        /// Compute the exact step operators for step `h` (s). Computed in `f64`, rounded
+        /// once to `T`.
+        ///
+        /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
+        /// [`Error::SingularMass`] (`M` singular: the first-order form needs `M⁻¹`),
+        /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`] (an operator beyond the
+        /// range of `T`, or its largest entry subnormal there).
+        ///
+        /// Cost: about `(4N)³ (19 + s)` flops, `s = ⌈log₂(2‖hF‖)⌉` squarings (balanced norm,
+        /// e.g. `s ≈ 14` for `ω_max h = 10⁴`), and three `16N²` `f64` temporaries on the
+        /// stack (`384 KB` at `N = 50`, `1.5 MB` at `N = 100`: use a large stack there).
+        pub fn new(m, c, k, h: f64) {
+            let Exponential {
+                m,
+                c,
+                k,
+                h: hf,
+                start: st,
+                blocks,
+                ..
+            } = exponential(m, c, k, h, T::MAX)?;
+            let mut under = None;
+            let mut au = [[[T::zero(); N]; N]; 4];
+            let mut av = [[[T::zero(); N]; N]; 4];
+            for (r, out) in [(0usize, &mut au), (1usize, &mut av)] {
+                let [phi_u, phi_v, g1, g2] = blocks[r];
+                // P0 = Γ₁ − Γ₂/h multiplies p_{n−1} = M a + C v + K u; P1 = Γ₂/h multiplies p_n.
+                let p0 = add_scaled(&g1, -1.0 / hf, &g2);
+                let p1 = scaled(1.0 / hf, &g2);
+                // Representable in `T` (overflow now, underflow after every block is seen):
+                // `P1 = Γ₂/h` is never zero for a regular `M`; the others are judged alone.
+                let fit = [
+                    fits_alone(&phi_u, T::MAX),
+                    fits_alone(&phi_v, T::MAX),
+                    fits_alone(&p0, T::MAX),
+                    fits(&p1, &m, T::MAX),
+                ];
+                match first_error(fit) {
+                    Some(Error::OperatorOverflow) => return Err(Error::OperatorOverflow),
+                    Some(e) => under = Some(e),
+                    None => {}
+                }
+                *out = [
+                    round_rows(&phi_u),
+                    round_rows(&phi_v),
+                    round_rows(&p0),
+                    round_rows(&p1),
+                ];
             }
-            *out = [
-                round_rows(&phi_u),
-                round_rows(&phi_v),
-                round_rows(&p0),
-                round_rows(&p1),
-            ];
+            if ![&m, &c, &k].iter().all(|x| finite_as(x, T::MAX)) {
+                return Err(Error::OperatorOverflow);
+            }
+            if let Some(e) = under {
+                return Err(e);
+            }
+            Ok(Self {
+                h: T::from_f64_rounded(hf),
+                au,
+                av,
+                mck: [round_rows(&m), round_rows(&c), round_rows(&k)],
+                start: Some(st.round()),
+            })
         }
-        if ![&m, &c, &k].iter().all(|x| finite_as(x, T::MAX)) {
-            return Err(Error::OperatorOverflow);
-        }
-        if let Some(e) = under {
-            return Err(e);
-        }
-        Ok(Self {
-            h: T::from_f64_rounded(hf),
-            au,
-            av,
-            mck: [round_rows(&m), round_rows(&c), round_rows(&k)],
-            start: Some(st.round()),
-        })
     }
 }
 

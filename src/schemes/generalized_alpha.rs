@@ -28,6 +28,7 @@ use crate::kernel::{StartOps, effective_lu, range_verdict, start_operators};
 use crate::kinematics::{Kinematics, NewmarkKinematics, check_time_step_as};
 use crate::linalg::lu::{Lu, condition};
 use crate::linalg::{Mat, add_scaled, all_finite, finite_as, fits, round_rows, rows_f64, scaled};
+use crate::macros::mck_fn;
 use crate::{Error, Param, Real, State, Stepper};
 
 /// The parameters `(α_m, α_f, β, γ)` of a generalized-α scheme.
@@ -215,63 +216,51 @@ pub struct GeneralizedAlpha<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> GeneralizedAlpha<T, N> {
-    /// The Chung–Hulbert scheme with high-frequency spectral radius `rho_inf ∈ [0, 1]`
-    /// (1: no dissipation, the average-acceleration rule; 0: asymptotic annihilation).
-    ///
-    /// Errors: as [`GeneralizedAlpha::with_parameters`].
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-        rho_inf: f64,
-    ) -> Result<Self, Error> {
-        Self::with_parameters(m, c, k, h, AlphaParameters::chung_hulbert(rho_inf)?)
+    mck_fn! {
+        /// The Chung–Hulbert scheme with high-frequency spectral radius `rho_inf ∈ [0, 1]`
+        /// (1: no dissipation, the average-acceleration rule; 0: asymptotic annihilation).
+        ///
+        /// Errors: as [`GeneralizedAlpha::with_parameters`].
+        pub fn new(m, c, k, h: f64, rho_inf: f64) {
+            Self::with_parameters(m, c, k, h, AlphaParameters::chung_hulbert(rho_inf)?)
+        }
     }
 
-    /// HHT-α with `alpha ∈ [−1/3, 0]` (Hilber's sign; `−0.05 … −0.1` is common).
-    ///
-    /// Errors: as [`GeneralizedAlpha::with_parameters`].
-    pub fn hht(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-        alpha: f64,
-    ) -> Result<Self, Error> {
-        Self::with_parameters(m, c, k, h, AlphaParameters::hht(alpha)?)
+    mck_fn! {
+        /// HHT-α with `alpha ∈ [−1/3, 0]` (Hilber's sign; `−0.05 … −0.1` is common).
+        ///
+        /// Errors: as [`GeneralizedAlpha::with_parameters`].
+        pub fn hht(m, c, k, h: f64, alpha: f64) {
+            Self::with_parameters(m, c, k, h, AlphaParameters::hht(alpha)?)
+        }
     }
 
-    /// Any `(α_m, α_f, β, γ)`; computed in `f64`, rounded once to `T`.
-    ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
-    /// [`Error::InvalidParameter`] (a parameter not finite, `α_m ≥ 1`, `α_f ≥ 1`, `β < 0`
-    /// or `γ < 0`), [`Error::SingularEffectiveMatrix`] (`(1 − α_m) M + (1 − α_f)(γh C +
-    /// βh² K)` singular to working precision against its terms),
-    /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`].
-    ///
-    /// Cost: about `9N³` flops in `f64`, six `N×N` `f64` temporaries on the stack.
-    pub fn with_parameters(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-        p: AlphaParameters,
-    ) -> Result<Self, Error> {
-        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
-        let op = alpha_operators(&m, &c, &k, h, &p, T::MAX)?;
-        Ok(Self {
-            params: p,
-            w1: T::from_f64_rounded(1.0 - p.alpha_f),
-            w0: T::from_f64_rounded(p.alpha_f),
-            kin: op.kin.round(),
-            g: round_rows(&op.g),
-            gk: round_rows(&op.gk),
-            av: round_rows(&op.av),
-            aa: round_rows(&op.aa),
-            start: op.start.map(|(_, s)| s.round()),
-            condition: op.condition,
-        })
+    mck_fn! {
+        /// Any `(α_m, α_f, β, γ)`; computed in `f64`, rounded once to `T`.
+        ///
+        /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
+        /// [`Error::InvalidParameter`] (a parameter not finite, `α_m ≥ 1`, `α_f ≥ 1`, `β < 0`
+        /// or `γ < 0`), [`Error::SingularEffectiveMatrix`] (`(1 − α_m) M + (1 − α_f)(γh C +
+        /// βh² K)` singular to working precision against its terms),
+        /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`].
+        ///
+        /// Cost: about `9N³` flops in `f64`, six `N×N` `f64` temporaries on the stack.
+        pub fn with_parameters(m, c, k, h: f64, p: AlphaParameters) {
+            let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+            let op = alpha_operators(&m, &c, &k, h, &p, T::MAX)?;
+            Ok(Self {
+                params: p,
+                w1: T::from_f64_rounded(1.0 - p.alpha_f),
+                w0: T::from_f64_rounded(p.alpha_f),
+                kin: op.kin.round(),
+                g: round_rows(&op.g),
+                gk: round_rows(&op.gk),
+                av: round_rows(&op.av),
+                aa: round_rows(&op.aa),
+                start: op.start.map(|(_, s)| s.round()),
+                condition: op.condition,
+            })
+        }
     }
 
     /// How close the effective matrix is to singular: `κ₁` of the row-equilibrated
@@ -322,27 +311,16 @@ impl<T: Real, const N: usize> Stepper<T, N> for GeneralizedAlpha<T, N> {
         self.kin.h
     }
 
-    /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration and
-    /// constant loads, but FIRST order for a time-varying load (the weighted load
-    /// `(1 − α_f) p_n + α_f p_{n−1}` needs the previous sample, which the shared [`State`]
-    /// does not carry). Drive it with `step_with_previous_input` for second order.
-    /// Cost: `4N²` multiply-adds + `10N`.
-    #[inline]
-    fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
-        self.step_inner(s, p, p);
-    }
-
-    /// The textbook step: the load taken as `(1 − α_f) p + α_f p_prev`, with
-    /// `p_prev = p(t_{n−1})`, `p = p(t_n)`. Second order for any smooth load.
-    ///
-    /// Cost: `4N²` multiply-adds + `10N`. No allocation, no panic.
-    #[inline]
-    fn step_with_previous_input(
-        &self,
-        s: &mut State<T, N>,
-        p_prev: &SVector<T, N>,
-        p: &SVector<T, N>,
-    ) {
-        self.step_inner(s, p_prev, p);
-    }
+    crate::stepper::steps_through_inner!(
+        /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration and
+        /// constant loads, but FIRST order for a time-varying load (the weighted load
+        /// `(1 − α_f) p_n + α_f p_{n−1}` needs the previous sample, which the shared [`State`]
+        /// does not carry). Drive it with `step_with_previous_input` for second order.
+        /// Cost: `4N²` multiply-adds + `10N`.
+        ;
+        /// The textbook step: the load taken as `(1 − α_f) p + α_f p_prev`, with
+        /// `p_prev = p(t_{n−1})`, `p = p(t_n)`. Second order for any smooth load.
+        ///
+        /// Cost: `4N²` multiply-adds + `10N`. No allocation, no panic.
+    );
 }

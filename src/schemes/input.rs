@@ -19,7 +19,9 @@ use crate::kernel::{StartOps, input_kernel_operators, input_step, interleave};
 use crate::kinematics::AemKinematics;
 use crate::linalg::op_rows::OpRows;
 use crate::linalg::{self, Mat, Rows, finite_as, rows_f64};
+use crate::macros::mck_fn;
 use crate::scalar::initial_inputs_finite;
+use crate::stepper::start_fn;
 use crate::{Error, Real, State, Stepper};
 
 /// The linear AEM stepper for loads `p(t) = B w(t)` entering through an influence matrix
@@ -109,42 +111,38 @@ const fn input_operators<const N: usize, const I: usize>(
 }
 
 impl<T: Real, const N: usize, const I: usize> LinearInput<T, N, I> {
-    /// Precompute the step operators for `M u'' + C u' + K u = B w(t)` with step `h` (s).
-    ///
-    /// `M, C, K` are `N×N` (as for [`Linear::new`](crate::Linear::new)), `B` is `N×I`, all
-    /// in `f64`; computed in `f64`, rounded once to `T`.
-    ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
-    /// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`].
-    ///
-    /// Cost: about `4N³ + 2N²·I` flops in `f64`, a few `N×N` `f64` temporaries on the stack.
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        b: &SMatrix<f64, N, I>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        let op = input_operators(
-            &rows_f64(m),
-            &rows_f64(c),
-            &rows_f64(k),
-            &rows_f64(b),
-            h,
-            T::MAX,
-        )?;
-        let (gc, gk): ([[T; N]; N], [[T; N]; N]) =
-            (linalg::round_rows(&op.gc), linalg::round_rows(&op.gk));
-        Ok(Self {
-            ops: interleave([&gc, &gk], [-T::one(), -T::one()]),
-            gb: linalg::round_rows(&op.gb),
-            kin: op.kin.round(),
-            start: op.start.map(|(mb, s)| InputStart {
-                minv_b: linalg::round_rows(&mb),
-                ops: s.round(),
-            }),
-            condition: op.condition,
-        })
+    mck_fn! {
+        /// Precompute the step operators for `M u'' + C u' + K u = B w(t)` with step `h` (s).
+        ///
+        /// `M, C, K` are `N×N` (as for [`Linear::new`](crate::Linear::new)), `B` is `N×I`, all
+        /// in `f64`; computed in `f64`, rounded once to `T`.
+        ///
+        /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
+        /// [`Error::SingularEffectiveMatrix`], [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`].
+        ///
+        /// Cost: about `4N³ + 2N²·I` flops in `f64`, a few `N×N` `f64` temporaries on the stack.
+        pub fn new(m, c, k, b: &SMatrix<f64, N, I>, h: f64) {
+            let op = input_operators(
+                &rows_f64(m),
+                &rows_f64(c),
+                &rows_f64(k),
+                &rows_f64(b),
+                h,
+                T::MAX,
+            )?;
+            let (gc, gk): ([[T; N]; N], [[T; N]; N]) =
+                (linalg::round_rows(&op.gc), linalg::round_rows(&op.gk));
+            Ok(Self {
+                ops: interleave([&gc, &gk], [-T::one(), -T::one()]),
+                gb: linalg::round_rows(&op.gb),
+                kin: op.kin.round(),
+                start: op.start.map(|(mb, s)| InputStart {
+                    minv_b: linalg::round_rows(&mb),
+                    ops: s.round(),
+                }),
+                condition: op.condition,
+            })
+        }
     }
 
     /// How close the effective matrix is to singular: `κ₁` of the row-equilibrated
@@ -244,24 +242,21 @@ impl<T: Real, const N: usize, const I: usize> Stepper<T, N> for LinearInput<T, N
         self.kin.h
     }
 
-    /// The state at `t = 0` with `q0 = M⁻¹ (B w0 − C v0 − K u0)` (paper eq. 40).
-    /// Cost: `2N² + N·I` multiply-adds.
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        w0: &SVector<T, I>,
-    ) -> Result<State<T, N>, Error> {
-        // A non-finite input first, as every start in the crate (found by fuzzing).
-        if !initial_inputs_finite(u0, v0, w0) {
-            return Err(Error::NonFiniteInput);
+    start_fn! {
+        /// The state at `t = 0` with `q0 = M⁻¹ (B w0 − C v0 − K u0)` (paper eq. 40).
+        /// Cost: `2N² + N·I` multiply-adds.
+        fn start(&self, u0, v0, w0: &SVector<T, I>) -> State<T, N> {
+            // A non-finite input first, as every start in the crate (found by fuzzing).
+            if !initial_inputs_finite(u0, v0, w0) {
+                return Err(Error::NonFiniteInput);
+            }
+            let st = self.start.as_ref().ok_or(Error::SingularMass)?;
+            let mv = |a: &[[T; N]; N], x: &SVector<T, N>| crate::kernel::mat_vec(a, x);
+            let a0 = crate::kernel::mat_vec(&st.minv_b, w0)
+                - mv(&st.ops.minv_c, v0)
+                - mv(&st.ops.minv_k, u0);
+            State::initial_computed(u0, v0, a0)
         }
-        let st = self.start.as_ref().ok_or(Error::SingularMass)?;
-        let mv = |a: &[[T; N]; N], x: &SVector<T, N>| crate::kernel::mat_vec(a, x);
-        let a0 = crate::kernel::mat_vec(&st.minv_b, w0)
-            - mv(&st.ops.minv_c, v0)
-            - mv(&st.ops.minv_k, u0);
-        State::initial_computed(u0, v0, a0)
     }
 
     crate::stepper::full_order_state!();

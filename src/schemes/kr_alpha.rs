@@ -83,6 +83,8 @@ use crate::kinematics::check_time_step_as;
 use crate::linalg::lu::Lu;
 use crate::linalg::{Mat, Rows, add_scaled, all_finite, all_fit, fits, mul};
 use crate::linalg::{round_rows, rows_f64, scaled};
+use crate::macros::mck_fn;
+use crate::stepper::start_fn;
 use crate::{AlphaParameters, Error, Real, State, Stepper};
 
 /// The parameters of the CR algorithm: `α_m = α_f = 0`, `β = 1/4`, `γ = 1/2`.
@@ -275,60 +277,48 @@ pub struct KrAlpha<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> KrAlpha<T, N> {
-    /// The KR-α scheme with high-frequency spectral radius `rho_inf ∈ [0, 1]` (1: no
-    /// dissipation, the CR sequence; 0: asymptotic annihilation) for
-    /// `M u'' + C u' + K u = p(t)` with step `h` (s). `M, C, K` in `f64`, any units
-    /// consistent with `h` in seconds (e.g. kg, N·s/m, N/m). Computed in `f64`, rounded
-    /// once to `T`; bit-identical to [`KrAlpha::from_rows_f32`] / `from_rows_f64`.
-    ///
-    /// Errors: [`Error::InvalidParameter`] (`rho_inf` outside `[0, 1]` or NaN), then
-    /// [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (`h ≤ 0`, not finite, or
-    /// `h²` out of range of `T`), [`Error::SingularEffectiveMatrix`]
-    /// (`M + γh C + βh² K` or `M (I − α3)` singular to working precision against its
-    /// terms), [`Error::SingularMass`] (`M` singular), [`Error::OperatorOverflow`],
-    /// [`Error::OperatorUnderflow`] (an operator does not fit `T`).
-    ///
-    /// Cost: about `10N³` flops in `f64`, a dozen `N×N` `f64` temporaries on the stack.
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-        rho_inf: f64,
-    ) -> Result<Self, Error> {
-        Self::with_rest(m, c, k, k, h, AlphaParameters::chung_hulbert(rho_inf)?)
+    mck_fn! {
+        /// The KR-α scheme with high-frequency spectral radius `rho_inf ∈ [0, 1]` (1: no
+        /// dissipation, the CR sequence; 0: asymptotic annihilation) for
+        /// `M u'' + C u' + K u = p(t)` with step `h` (s). `M, C, K` in `f64`, any units
+        /// consistent with `h` in seconds (e.g. kg, N·s/m, N/m). Computed in `f64`, rounded
+        /// once to `T`; bit-identical to [`KrAlpha::from_rows_f32`] / `from_rows_f64`.
+        ///
+        /// Errors: [`Error::InvalidParameter`] (`rho_inf` outside `[0, 1]` or NaN), then
+        /// [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (`h ≤ 0`, not finite, or
+        /// `h²` out of range of `T`), [`Error::SingularEffectiveMatrix`]
+        /// (`M + γh C + βh² K` or `M (I − α3)` singular to working precision against its
+        /// terms), [`Error::SingularMass`] (`M` singular), [`Error::OperatorOverflow`],
+        /// [`Error::OperatorUnderflow`] (an operator does not fit `T`).
+        ///
+        /// Cost: about `10N³` flops in `f64`, a dozen `N×N` `f64` temporaries on the stack.
+        pub fn new(m, c, k, h: f64, rho_inf: f64) {
+            Self::with_rest(m, c, k, k, h, AlphaParameters::chung_hulbert(rho_inf)?)
+        }
     }
 
-    /// The Chen–Ricles algorithm (`α_m = α_f = 0`, `γ = 1/2`, `β = 1/4`: the equation of
-    /// motion at `t_{n+1}`, no numerical dissipation). Arguments as [`KrAlpha::new`].
-    ///
-    /// Errors and cost: as [`KrAlpha::new`] (no parameter to check).
-    pub fn chen_ricles(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        Self::with_rest(m, c, k, k, h, CHEN_RICLES)
+    mck_fn! {
+        /// The Chen–Ricles algorithm (`α_m = α_f = 0`, `γ = 1/2`, `β = 1/4`: the equation of
+        /// motion at `t_{n+1}`, no numerical dissipation). Arguments as [`KrAlpha::new`].
+        ///
+        /// Errors and cost: as [`KrAlpha::new`] (no parameter to check).
+        pub fn chen_ricles(m, c, k, h: f64) {
+            Self::with_rest(m, c, k, k, h, CHEN_RICLES)
+        }
     }
 
-    /// The operators of `p` with `k_rest` for the computed restoring force
-    /// ([`kr_operators`]; `k` for [`KrAlpha`], the numerical part for
-    /// [`Split`](crate::hybrid::Split)), rounded once to `T`: the run-time twin of
-    /// `from_params`.
-    pub(crate) fn with_rest(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        k_rest: &SMatrix<f64, N, N>,
-        h: f64,
-        p: AlphaParameters,
-    ) -> Result<Self, Error> {
-        let (m, c, k, kr) = (rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(k_rest));
-        Ok(Self::from_ops(
-            &kr_operators(&m, &c, &k, &kr, h, &p, T::MAX)?,
-            p,
-        ))
+    mck_fn! {
+        /// The operators of `p` with `k_rest` for the computed restoring force
+        /// ([`kr_operators`]; `k` for [`KrAlpha`], the numerical part for
+        /// [`Split`](crate::hybrid::Split)), rounded once to `T`: the run-time twin of
+        /// `from_params`.
+        pub(crate) fn with_rest(m, c, k, k_rest: &SMatrix<f64, N, N>, h: f64, p: AlphaParameters) {
+            let (m, c, k, kr) = (rows_f64(m), rows_f64(c), rows_f64(k), rows_f64(k_rest));
+            Ok(Self::from_ops(
+                &kr_operators(&m, &c, &k, &kr, h, &p, T::MAX)?,
+                p,
+            ))
+        }
     }
 
     /// Round the `f64` operators once to `T` (run time).
@@ -509,22 +499,19 @@ impl<T: Real, const N: usize> Stepper<T, N> for KrAlpha<T, N> {
     type Input = SVector<T, N>;
     type State = State<T, N>;
 
-    /// The state at `t = 0` for a second-order run from any initial condition: `u0`,
-    /// `a0 = M⁻¹ (p0 − C v0 − K u0)`, and the scheme's velocity variable
-    /// `v0 − γh α1 a0` in place of `v0` (see the type's docs, "The start").
-    ///
-    /// Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if `a0` or the
-    /// velocity variable overflows. Cost: `4N²` multiply-adds.
-    fn start(
-        &self,
-        u0: &SVector<T, N>,
-        v0: &SVector<T, N>,
-        p0: &SVector<T, N>,
-    ) -> Result<State<T, N>, Error> {
-        let s = crate::kernel::initial_state(self.start.as_ref(), u0, v0, p0)?;
-        let w = self.alpha1_times(s.a());
-        let v = SVector::from_fn(|i, _| v0[i] - self.gamma_h * w[i]);
-        State::initial_computed(u0, &v, *s.a())
+    start_fn! {
+        /// The state at `t = 0` for a second-order run from any initial condition: `u0`,
+        /// `a0 = M⁻¹ (p0 − C v0 − K u0)`, and the scheme's velocity variable
+        /// `v0 − γh α1 a0` in place of `v0` (see the type's docs, "The start").
+        ///
+        /// Errors: [`Error::NonFiniteInput`]; [`Error::NonFiniteState`] if `a0` or the
+        /// velocity variable overflows. Cost: `4N²` multiply-adds.
+        fn start(&self, u0, v0, p0: &SVector<T, N>) -> State<T, N> {
+            let s = crate::kernel::initial_state(self.start.as_ref(), u0, v0, p0)?;
+            let w = self.alpha1_times(s.a());
+            let v = SVector::from_fn(|i, _| v0[i] - self.gamma_h * w[i]);
+            State::initial_computed(u0, &v, *s.a())
+        }
     }
 
     crate::stepper::full_order_state!();
@@ -534,25 +521,14 @@ impl<T: Real, const N: usize> Stepper<T, N> for KrAlpha<T, N> {
         self.h
     }
 
-    /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration
-    /// and constant loads, first order for a time-varying load when `α_f ≠ 0` (KR-α); the
-    /// same as the two-sample step for CR (`α_f = 0`). Cost: `5N²` multiply-adds + `12N`.
-    #[inline]
-    fn step(&self, s: &mut State<T, N>, p: &SVector<T, N>) {
-        self.step_inner(s, p, p);
-    }
-
-    /// The textbook step: the load taken as `(1 − α_f) p + α_f p_prev`, with
-    /// `p_prev = p(t_n)`, `p = p(t_{n+1})`. Second order for any smooth load.
-    ///
-    /// Cost: `5N²` multiply-adds + `12N`. No allocation, no panic.
-    #[inline]
-    fn step_with_previous_input(
-        &self,
-        s: &mut State<T, N>,
-        p_prev: &SVector<T, N>,
-        p: &SVector<T, N>,
-    ) {
-        self.step_inner(s, p_prev, p);
-    }
+    crate::stepper::steps_through_inner!(
+        /// [`Stepper::step_with_previous_input`] with `p_prev = p`: exact for free vibration
+        /// and constant loads, first order for a time-varying load when `α_f ≠ 0` (KR-α); the
+        /// same as the two-sample step for CR (`α_f = 0`). Cost: `5N²` multiply-adds + `12N`.
+        ;
+        /// The textbook step: the load taken as `(1 − α_f) p + α_f p_prev`, with
+        /// `p_prev = p(t_n)`, `p = p(t_{n+1})`. Second order for any smooth load.
+        ///
+        /// Cost: `5N²` multiply-adds + `12N`. No allocation, no panic.
+    );
 }

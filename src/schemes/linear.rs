@@ -18,6 +18,7 @@ use nalgebra::SMatrix;
 
 use crate::kernel::{Kernel, aem_const_ctors, kernel_stepper};
 use crate::kinematics::AemKinematics;
+use crate::macros::mck_fn;
 use crate::{AForm, Error, Real};
 
 /// The linear constant-coefficient AEM stepper (paper Algorithm 1, eliminated form).
@@ -52,28 +53,25 @@ pub struct Linear<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> Linear<T, N> {
-    /// Precompute the step operators for `M u'' + C u' + K u = p(t)` with step `h` (s).
-    ///
-    /// `M, C, K` are `N×N` in `f64` (whatever `T`: the operators are computed in `f64`
-    /// and rounded once, so the same data gives bit-identical operators through
-    /// [`Linear::from_rows_f32`]), fully populated, not necessarily symmetric. `M` may be
-    /// singular as long as `M + (h/2) C + (h²/4) K` is not (then start with
-    /// [`Stepper::start_with_acceleration`](crate::Stepper::start_with_acceleration)).
-    ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (`h ≤ 0`, not finite,
-    /// or `h²` out of range), [`Error::SingularEffectiveMatrix`] (singular to working
-    /// precision against the size of its terms `|M| + (h/2)|C| + (h²/4)|K|`),
-    /// [`Error::OperatorOverflow`] (an operator does not fit `T`), [`Error::OperatorUnderflow`]
-    /// (an operator from nonzero data is zero or subnormal in `T`).
-    ///
-    /// Cost: about `4N³` flops in `f64` and a few `N×N` `f64` temporaries on the stack.
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
+    mck_fn! {
+        /// Precompute the step operators for `M u'' + C u' + K u = p(t)` with step `h` (s).
+        ///
+        /// `M, C, K` are `N×N` in `f64` (whatever `T`: the operators are computed in `f64`
+        /// and rounded once, so the same data gives bit-identical operators through
+        /// [`Linear::from_rows_f32`]), fully populated, not necessarily symmetric. `M` may be
+        /// singular as long as `M + (h/2) C + (h²/4) K` is not (then start with
+        /// [`Stepper::start_with_acceleration`](crate::Stepper::start_with_acceleration)).
+        ///
+        /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`] (`h ≤ 0`, not finite,
+        /// or `h²` out of range), [`Error::SingularEffectiveMatrix`] (singular to working
+        /// precision against the size of its terms `|M| + (h/2)|C| + (h²/4)|K|`),
+        /// [`Error::OperatorOverflow`] (an operator does not fit `T`), [`Error::OperatorUnderflow`]
+        /// (an operator from nonzero data is zero or subnormal in `T`).
+        ///
+        /// Cost: about `4N³` flops in `f64` and a few `N×N` `f64` temporaries on the stack.
+        pub fn new(m, c, k, h: f64) {
+            Kernel::aem(m, c, k, h).map(|kernel| Self { kernel })
+        }
     }
 
     /// `G = (M + (h/2) C + (h²/4) K)⁻¹`.

@@ -17,6 +17,7 @@ use nalgebra::SMatrix;
 use crate::kernel::{Kernel, kernel_stepper, newmark_operators};
 use crate::kinematics::NewmarkKinematics;
 use crate::linalg::rows_f64;
+use crate::macros::mck_fn;
 use crate::{Error, Real};
 
 /// A Newmark-family stepper (β, γ) for constant `M, C, K`.
@@ -48,63 +49,49 @@ pub struct Newmark<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> Newmark<T, N> {
-    /// Precompute the step operators of the Newmark scheme with parameters `beta` (β ≥ 0)
-    /// and `gamma` (γ ≥ 0) for `M u'' + C u' + K u = p(t)` with step `h` (s). Computed in
-    /// `f64`, rounded once to `T`.
-    ///
-    /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
-    /// [`Error::InvalidParameter`] (β or γ negative or not finite),
-    /// [`Error::SingularEffectiveMatrix`] (`M + γh C + βh² K` singular to working
-    /// precision against its terms; e.g. central difference with singular `M`),
-    /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`].
-    ///
-    /// Cost: about `5N³` flops in `f64`, four `N×N` `f64` temporaries on the stack.
-    pub fn new(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-        beta: f64,
-        gamma: f64,
-    ) -> Result<Self, Error> {
-        let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
-        let op = newmark_operators(&m, &c, &k, h, beta, gamma, T::MAX)?;
-        Ok(Self {
-            kernel: op.round_newmark(),
-        })
+    mck_fn! {
+        /// Precompute the step operators of the Newmark scheme with parameters `beta` (β ≥ 0)
+        /// and `gamma` (γ ≥ 0) for `M u'' + C u' + K u = p(t)` with step `h` (s). Computed in
+        /// `f64`, rounded once to `T`.
+        ///
+        /// Errors: [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`],
+        /// [`Error::InvalidParameter`] (β or γ negative or not finite),
+        /// [`Error::SingularEffectiveMatrix`] (`M + γh C + βh² K` singular to working
+        /// precision against its terms; e.g. central difference with singular `M`),
+        /// [`Error::OperatorOverflow`], [`Error::OperatorUnderflow`].
+        ///
+        /// Cost: about `5N³` flops in `f64`, four `N×N` `f64` temporaries on the stack.
+        pub fn new(m, c, k, h: f64, beta: f64, gamma: f64) {
+            let (m, c, k) = (rows_f64(m), rows_f64(c), rows_f64(k));
+            let op = newmark_operators(&m, &c, &k, h, beta, gamma, T::MAX)?;
+            Ok(Self {
+                kernel: op.round_newmark(),
+            })
+        }
     }
 
-    /// Average acceleration (trapezoidal), β = 1/4, γ = 1/2: the same recurrence as the
-    /// AEM [`Linear`](crate::Linear) (bit-identical operators). Errors: as [`Newmark::new`].
-    pub fn average_acceleration(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        Self::new(m, c, k, h, 0.25, 0.5)
+    mck_fn! {
+        /// Average acceleration (trapezoidal), β = 1/4, γ = 1/2: the same recurrence as the
+        /// AEM [`Linear`](crate::Linear) (bit-identical operators). Errors: as [`Newmark::new`].
+        pub fn average_acceleration(m, c, k, h: f64) {
+            Self::new(m, c, k, h, 0.25, 0.5)
+        }
     }
 
-    /// Linear acceleration, β = 1/6, γ = 1/2: second order, stable for `ωh ≤ 2√3`.
-    /// Errors: as [`Newmark::new`].
-    pub fn linear_acceleration(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        Self::new(m, c, k, h, 1.0 / 6.0, 0.5)
+    mck_fn! {
+        /// Linear acceleration, β = 1/6, γ = 1/2: second order, stable for `ωh ≤ 2√3`.
+        /// Errors: as [`Newmark::new`].
+        pub fn linear_acceleration(m, c, k, h: f64) {
+            Self::new(m, c, k, h, 1.0 / 6.0, 0.5)
+        }
     }
 
-    /// Central difference, β = 0, γ = 1/2: second order, stable for `ωh ≤ 2`
-    /// (undamped). Needs `M + (h/2) C` invertible. Errors: as [`Newmark::new`].
-    pub fn central_difference(
-        m: &SMatrix<f64, N, N>,
-        c: &SMatrix<f64, N, N>,
-        k: &SMatrix<f64, N, N>,
-        h: f64,
-    ) -> Result<Self, Error> {
-        Self::new(m, c, k, h, 0.0, 0.5)
+    mck_fn! {
+        /// Central difference, β = 0, γ = 1/2: second order, stable for `ωh ≤ 2`
+        /// (undamped). Needs `M + (h/2) C` invertible. Errors: as [`Newmark::new`].
+        pub fn central_difference(m, c, k, h: f64) {
+            Self::new(m, c, k, h, 0.0, 0.5)
+        }
     }
 }
 
