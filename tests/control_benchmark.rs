@@ -4,9 +4,10 @@
 //! at 1 kHz with `ClippedOptimal` switching) against the independent RK4 reference
 //! (`tests/support/dyke1996.rs`, which calls nothing of `aemstep`).
 //!
-//! Fast tests run the first `SHORT` samples of the record (the strong motion: the peaks of
-//! the full record fall inside it); the full record is `docs/control.md`
-//! (`cargo run --release -p xtask --bin control_benchmark`).
+//! Fast tests run the first `SHORT` samples of the record (its first 3 s, 0.6 s of model
+//! time: the motion builds up later, the peaks there are a tenth of the full record's);
+//! the full record is the `#[ignore]`d `full_record_rows` (release stage) and
+//! `docs/control.md` (`cargo run --release -p xtask --bin control_benchmark`).
 
 #[path = "support/dyke1996.rs"]
 mod dyke1996;
@@ -165,7 +166,9 @@ fn passive_rows_agree_with_the_reference_to_second_order() {
 /// (measured 4.4e-2: a force jump read one plant step apart); regression pins. The differences from the reference
 /// are printed and pinned (displacement/drift below 10 %, accelerations below 25 %,
 /// force below 12 %: measured 5.4 %, 18 %, 7.8 %; regression pins); both controllers
-/// lower every drift below the uncontrolled run's.
+/// lower storey 1's drift (where the damper acts) below the uncontrolled run's. (Over this
+/// opening part both RAISE storey 3's drift, 0.37 and 0.35 mm against 0.29 mm: printed,
+/// not hidden; over the whole record every drift is lowered, `full_record_rows`.)
 #[test]
 fn clipped_optimal_row_against_the_reference_design() {
     let ag = short(SHORT);
@@ -194,6 +197,48 @@ fn clipped_optimal_row_against_the_reference_design() {
         "{self_w:?} (regression pins)"
     );
     for i in 0..3 {
+        println!(
+            "drift {i}: crate {:.5} reference {:.5} uncontrolled {:.5} (m)",
+            c.drift[i], r.drift[i], bare.drift[i]
+        );
+    }
+    assert!(c.drift[0] < bare.drift[0] && r.drift[0] < bare.drift[0]);
+}
+
+/// The whole record (the table of `docs/control.md`): the passive rows at `h = 1` and
+/// `0.5` ms against the reference (RK4, `h = 5e-5` s): second order — halving the step
+/// divides the largest difference of each row by more than 3 (measured 3.7 to 4.6; 4 for
+/// second order, 2 for first); and the clipped-optimal runs, the crate's and the
+/// reference's, lower every drift below the uncontrolled run's.
+#[test]
+#[ignore = "release stage: the 17 s record, 7 crate runs and 4 RK4 reference runs (~3 s in release)"]
+fn full_record_rows() {
+    let ag = elcentro::AG_F64.to_vec();
+    let bare = scene::run(Case::Uncontrolled, &ag, elcentro::DT, 1e-3).unwrap();
+    for case in [Case::Uncontrolled, Case::PassiveOff, Case::PassiveOn] {
+        let r = reference(case, &ag, 5e-5);
+        let e: Vec<f64> = [1e-3, 5e-4]
+            .iter()
+            .map(|&h| {
+                let c = scene::run(case, &ag, elcentro::DT, h).unwrap();
+                worst(&c, &r).iter().copied().fold(0.0, f64::max)
+            })
+            .collect();
+        println!(
+            "{case:?}, whole record: largest relative difference {:.2e} at 1 ms, {:.2e} at 0.5 ms, ratio {:.2}",
+            e[0],
+            e[1],
+            e[0] / e[1]
+        );
+        assert!(e[0] / e[1] > 3.0, "{case:?}: {e:?}");
+    }
+    let c = scene::run(Case::ClippedOptimal, &ag, elcentro::DT, 1e-3).unwrap();
+    let r = reference(Case::ClippedOptimal, &ag, 5e-5);
+    for i in 0..3 {
+        println!(
+            "drift {i}: crate {:.5} reference {:.5} uncontrolled {:.5} (m)",
+            c.drift[i], r.drift[i], bare.drift[i]
+        );
         assert!(c.drift[i] < bare.drift[i] && r.drift[i] < bare.drift[i]);
     }
 }
