@@ -127,7 +127,7 @@ GENERATED = {
     # constant-ductility spectra of 60 periods: about 2 s (release).
     "docs/ida.md": dict(cmd=example("ida", "{dir}"), out="file"),
     # The MR-damper benchmark: 8 crate runs and 4 RK4 reference runs of the 17 s record
-    # (about 3 s, release).
+    # (under 1 s, release).
     "docs/control.md": dict(cmd=example("control_benchmark", "{dir}"), out="file"),
     # The families, their files and the cores they stand on, read from src/ (under a second).
     "docs/layout.md": dict(cmd=["python3", "scripts/layout.py"], out="stdout"),

@@ -211,7 +211,7 @@ fn clipped_optimal_row_against_the_reference_design() {
 /// second order, 2 for first); and the clipped-optimal runs, the crate's and the
 /// reference's, lower every drift below the uncontrolled run's.
 #[test]
-#[ignore = "release stage: the 17 s record, 7 crate runs and 4 RK4 reference runs (~3 s in release)"]
+#[ignore = "release stage: the 17 s record, 7 crate runs and 4 RK4 reference runs (~1 s in release)"]
 fn full_record_rows() {
     let ag = elcentro::AG_F64.to_vec();
     let bare = scene::run(Case::Uncontrolled, &ag, elcentro::DT, 1e-3).unwrap();

@@ -3,7 +3,7 @@
 //! reference (`tests/support/dyke1996.rs`), the paper's column "not obtained".
 //!
 //! `cargo run --release -p xtask --bin control_benchmark -- DIR` writes `DIR/control.md`
-//! (about 3 s in release).
+//! (under a second in release).
 
 #[path = "../../../tests/support/dyke1996.rs"]
 mod dyke1996;
