@@ -126,6 +126,9 @@ GENERATED = {
     # 72 yielding-building runs of the whole record (about 670 000 steps) and 3
     # constant-ductility spectra of 60 periods: about 2 s (release).
     "docs/ida.md": dict(cmd=example("ida", "{dir}"), out="file"),
+    # The MR-damper benchmark: 8 crate runs and 4 RK4 reference runs of the 17 s record
+    # (under 1 s, release).
+    "docs/control.md": dict(cmd=example("control_benchmark", "{dir}"), out="file"),
     # The families, their files and the cores they stand on, read from src/ (under a second).
     "docs/layout.md": dict(cmd=["python3", "scripts/layout.py"], out="stdout"),
 }

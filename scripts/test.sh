@@ -59,6 +59,9 @@ cargo run -q --release --example hybrid_loop > "$out" || fail "hybrid_loop examp
 grep -q 'peak drift (m)' "$out" && grep -q 'tracking error (m)' "$out" &&
     grep -q 'specimen force (kN)' "$out" && grep -q 'actuator delay 10 ms' "$out" ||
     fail "hybrid_loop: peak drift (m), tracking error (m), specimen force (kN) expected"
+cargo run -q --release --example mr_damper > "$out" || fail "mr_damper example"
+grep -q 'peak drift (cm)' "$out" && grep -q 'peak damper force (N)' "$out" ||
+    fail "mr_damper: peak drifts (cm) and damper force (N) expected"
 cargo run -q --release --features std --example ida > "$out" || fail "ida example"
 grep -q 'PGA (g)' "$out" && grep -q 'drift ratio (%)' "$out" && grep -q 'collapse between PGA' "$out" ||
     fail "ida: intensity (g) against peak drift ratio (%), a collapse bracket (g) expected"

@@ -330,6 +330,11 @@ pub struct DetectionDocDoctests;
 #[doc = include_str!("../docs/hybrid.md")]
 pub struct HybridDocDoctests;
 
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/control.md")]
+pub struct ControlDocDoctests;
+
 /// As [`ModalDocDoctests`] (its code needs the feature `std`).
 #[cfg(all(doctest, feature = "std"))]
 #[doc = include_str!("../docs/ida.md")]

@@ -21,6 +21,7 @@ const SKIP: &[(&str, &str)] = &[
     ("EstimationDocDoctests", "cfg(doctest) marker"),
     ("DetectionDocDoctests", "cfg(doctest) marker"),
     ("HybridDocDoctests", "cfg(doctest) marker"),
+    ("ControlDocDoctests", "cfg(doctest) marker"),
     ("IdaDocDoctests", "cfg(doctest) marker"),
     // Feature `std` only (host: heap-held records and IDA results); `defmt` is for firmware.
     ("Record", "std only"),
