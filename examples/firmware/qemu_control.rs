@@ -101,12 +101,40 @@ const FORCE_ERROR: f64 = if cfg!(aemstep_broken = "control-nan") {
     0.0
 };
 
-/// One real-time step. Out of line so its code size (symbol `qemu_control_step`, read by
-/// `scripts/qemu.sh`) and stack can be measured alone.
+/// The controller's side of one sample (`Rig::control`: sense, controller, switching law,
+/// the voltage held): what a controller board runs. Out of line so its code size (symbol
+/// `qemu_control_step`, read by `scripts/qemu.sh`), stack and call graph (no panic
+/// reachable) are measured alone.
 #[unsafe(no_mangle)]
 #[inline(never)]
-fn qemu_control_step(rig: &Rig<F>, s: &mut Loop<F>, ag: F, missing: bool) -> Result<Out<F>, Error> {
-    rig.step(&CTL, s, ag, missing, F::from_f64_rounded(FORCE_ERROR))
+fn qemu_control_step(
+    rig: &Rig<F>,
+    s: &mut Loop<F>,
+    missing: bool,
+) -> Result<(Command<F, I>, F), Error> {
+    rig.control(&CTL, s, missing, F::from_f64_rounded(FORCE_ERROR))
+}
+
+/// The emulated structure and damper, one step (`Rig::advance`): the test rig, not the
+/// controller.
+#[inline(never)]
+fn emulate_plant(rig: &Rig<F>, s: &mut Loop<F>, ag: F) -> Result<F, Error> {
+    rig.advance(s, ag)
+}
+
+/// One loop step, as `Rig::step` (the host twin's): the controller's side, then the
+/// plant's; on error nothing in `s` changes.
+#[inline(always)]
+fn loop_step(rig: &Rig<F>, s: &mut Loop<F>, ag: F, missing: bool) -> Result<Out<F>, Error> {
+    let mut next = *s;
+    let (command, voltage) = qemu_control_step(rig, &mut next, missing)?;
+    let x1 = emulate_plant(rig, &mut next, ag)?;
+    *s = next;
+    Ok(Out {
+        command,
+        voltage,
+        x1,
+    })
 }
 
 /// The controller's step alone (observer, gain, saturation): what `COST control-matrix`
@@ -204,7 +232,7 @@ fn SysTick() {
         return;
     };
     *n += 1;
-    let result = qemu_control_step(rig, s, scene::ground(AG, *n), *n == MISSING_STEP);
+    let result = loop_step(rig, s, scene::ground(AG, *n), *n == MISSING_STEP);
     let last = *n >= steps() || result.is_err();
     if tx.enqueue((*n, result)).is_err() {
         periodic::overrun();
@@ -278,12 +306,7 @@ fn main() -> ! {
     };
     let mut probe = s0;
     let step_stack = fw::stack_used_by(|| {
-        let _ = black_box(qemu_control_step(
-            &rig,
-            &mut probe,
-            scene::ground(AG, 1),
-            false,
-        ));
+        let _ = black_box(qemu_control_step(&rig, &mut probe, false));
     });
 
     // Pass 1, counted: the instructions of every step.
@@ -295,7 +318,7 @@ fn main() -> ! {
         let ag = scene::ground(AG, n);
         let mut result = Err(Error::NonFiniteInput);
         let c = fw::instructions(syst, || {
-            result = qemu_control_step(&rig, &mut s, ag, n == MISSING_STEP)
+            result = loop_step(&rig, &mut s, ag, n == MISSING_STEP)
         });
         let o = match result {
             Ok(o) => o,

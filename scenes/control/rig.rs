@@ -79,10 +79,9 @@ impl<T: Real> Rig<T> {
         Ok((rig, s))
     }
 
-    /// One sample: sense, control, switch, and step the plant to the next sample with
-    /// ground acceleration `ag` (m/s²). `missing`: the floor-1 accelerometer's sample is
-    /// lost (NaN). `force_error` is added to the measured force (zero; NaN in a broken
-    /// firmware build). On error nothing in `s` changes.
+    /// One sample: sense, control, switch ([`Rig::control`]), and step the plant to the
+    /// next sample with ground acceleration `ag` (m/s², [`Rig::advance`]). On error nothing
+    /// in `s` changes.
     #[inline(always)]
     pub fn step(
         &self,
@@ -93,28 +92,54 @@ impl<T: Real> Rig<T> {
         force_error: T,
     ) -> Result<Out<T>, Error> {
         let mut next = *s;
-        let mut y: SVector<T, O> = next.state.a().map(|a| a + next.ag);
-        if missing {
-            y[0] = T::from_f64_rounded(f64::NAN);
-        }
-        let f = SVector::from([next.plant.delivered_force(&next.history) + force_error]);
-        let command = ctl.try_step(&mut next.control, &y, &f, false)?;
-        let voltage = self.law.command(&SVector::from(command.force), &f)?[0];
-        next.plant.set_command(voltage)?;
-        self.stepper.try_step_with_history(
-            &next.plant,
-            &mut next.state,
-            &mut next.history,
-            &load(ag),
-        )?;
-        next.ag = ag;
-        let x1 = next.state.u()[0];
+        let (command, voltage) = self.control(ctl, &mut next, missing, force_error)?;
+        let x1 = self.advance(&mut next, ag)?;
         *s = next;
         Ok(Out {
             command,
             voltage,
             x1,
         })
+    }
+
+    /// The controller's side of a sample (what a controller board runs): sample the
+    /// absolute floor accelerations and the damper's measured force, the controller's
+    /// desired force, the clipped-optimal voltage, held on the plant. `missing`: the
+    /// floor-1 accelerometer's sample is lost (NaN). `force_error` is added to the measured
+    /// force (zero; NaN in a broken firmware build). Returns the command and the voltage.
+    /// On error nothing in `s` changes.
+    #[inline(always)]
+    pub fn control(
+        &self,
+        ctl: &Ctl<T>,
+        s: &mut Loop<T>,
+        missing: bool,
+        force_error: T,
+    ) -> Result<(Command<T, I>, T), Error> {
+        let mut y: SVector<T, O> = s.state.a().map(|a| a + s.ag);
+        if missing {
+            y[0] = T::from_f64_rounded(f64::NAN);
+        }
+        let f = SVector::from([s.plant.delivered_force(&s.history) + force_error]);
+        let mut control = s.control;
+        let command = ctl.try_step(&mut control, &y, &f, false)?;
+        let voltage = self.law.command(&SVector::from(command.force), &f)?[0];
+        let mut plant = s.plant;
+        plant.set_command(voltage)?;
+        s.control = control;
+        s.plant = plant;
+        Ok((command, voltage))
+    }
+
+    /// The emulated plant's side: structure and damper, the voltage held, one step to the
+    /// next sample with ground acceleration `ag` (m/s²). Returns the floor-1 displacement
+    /// (m). On error nothing in `s` changes.
+    #[inline(always)]
+    pub fn advance(&self, s: &mut Loop<T>, ag: T) -> Result<T, Error> {
+        self.stepper
+            .try_step_with_history(&s.plant, &mut s.state, &mut s.history, &load(ag))?;
+        s.ag = ag;
+        Ok(s.state.u()[0])
     }
 }
 
