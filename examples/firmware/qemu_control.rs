@@ -285,7 +285,7 @@ fn main() -> ! {
         fail!("the counted controller refused a step");
     }
     cost("control-step", c, CONTROLLER_MADDS);
-    let mut e = CTL.start_at_rest().estimate().clone();
+    let mut e = *CTL.start_at_rest().estimate();
     let c = per_step(syst, 1000, |y, f| {
         cost_step_control_observer(black_box(CTL.observer()), black_box(&mut e), y, f)
     });
