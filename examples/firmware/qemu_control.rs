@@ -6,7 +6,9 @@
 //! step (`scenes/control/rig.rs`, shared with the host twin): sample the three absolute
 //! floor accelerations and the damper's measured force, `Controller::try_step` (observer
 //! and regulator gain) gives the desired force, `ClippedOptimal` the voltage, held while
-//! the emulated structure and damper (`Coupled` + `Nonlinear`) advance one step. At
+//! the emulated structure and damper (`Coupled` + `Nonlinear`) advance one step. The
+//! controller's side is its own symbol (`qemu_control_step`: what a controller board runs;
+//! `scripts/qemu.sh` proves no panic reachable from it), the plant's is the test rig. At
 //! `MISSING_STEP` the floor-1 accelerometer's sample is lost (NaN): the step must report
 //! it (`Status::MissingSample`) and hold the last safe output.
 //!
@@ -16,9 +18,12 @@
 //! (the Cortex-M4F, QEMU `mps2-an386`); `f64` with `--cfg aemstep_fpu="double"` and
 //! `-C target-cpu=cortex-m7` (the M7, `mps2-an500`), as `qemu_hybrid`.
 //!
-//! First the controller's step alone is counted (`COST control-matrix <type> <instructions>
-//! <multiply-adds>`, 94 multiply-adds: `S² + 2S·I + 2S·O + O·I + S·I + I²` with `S = 6`,
-//! `I = 1`, `O = 3`); on the M4F it must stay within 3 instructions a multiply-add. Then
+//! First the controller's step alone is counted (`COST control-step <type> <instructions>
+//! <multiply-adds>`: `Controller::try_step`, 94 multiply-adds, `S² + 2S·I + 2S·O + O·I +
+//! S·I + I²` with `S = 6`, `I = 1`, `O = 3`) and its observer's update (`COST
+//! control-observer …`: `Observer::step`, the first four terms, 87); on the M4F the
+//! observer's update must stay within 3 instructions a multiply-add (the checked step
+//! around it adds its safety checks, reported beside it). Then
 //! two passes over the record. Counted: the instructions of every loop step
 //! (`COST control <type> <mean> <max>`). Real time: SysTick fires every 1 ms, its handler
 //! steps the loop and sends the result through a `heapless::spsc::Queue`; the main loop
