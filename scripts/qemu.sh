@@ -7,9 +7,11 @@
 # across Cortex-M cores (docs/cortex-m-cores.md), which fails if the M4F's f32 step
 # exceeds 3 instructions per multiply-add at N >= 6.
 #
-# `qemu_hybrid` runs twice: as every example on the M4F (f32), and built with
-# `-C target-cpu=cortex-m7 --cfg aemstep_fpu="double"` on the Cortex-M7 board (`mps2-an500`,
-# the runner of scripts/cores.sh) in f64; both runs' costs go into the hybrid section.
+# `qemu_hybrid` and `qemu_control` run twice: as every example on the M4F (f32), and built
+# with `-C target-cpu=cortex-m7 --cfg aemstep_fpu="double"` on the Cortex-M7 board
+# (`mps2-an500`, the runner of scripts/cores.sh) in f64; both runs' costs go into their
+# sections. `qemu_control` also fails if its controller's observer update exceeds 3
+# instructions per multiply-add on the M4F (checked here too, with a control).
 #
 # The examples are package `aemstep-firmware` (examples/firmware/, a workspace member; the
 # root crate has no firmware feature or dependency). One more, `qemu_defmt`, logs through
@@ -24,7 +26,7 @@ cd "$(dirname "$0")/.."
 TARGET=thumbv7em-none-eabihf
 # Examples that must exit 0. Each prints `MEM <name> stack_high_water_bytes <n>` and may
 # print `MEM <name> step_stack_bytes <n>` and define a `#[no_mangle]` `<name>_step`.
-EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum qemu_hysteretic qemu_observer qemu_estimator qemu_hybrid)
+EXAMPLES=(qemu_timer qemu_cost qemu_nonlinear qemu_modal qemu_schemes qemu_spectrum qemu_hysteretic qemu_observer qemu_estimator qemu_hybrid qemu_control)
 # Broken on purpose: "example variant" pairs that must exit with failure (status 1); the
 # variant is `--cfg aemstep_broken="<variant>"` (not a public feature, see Cargo.toml).
 BROKEN=("qemu_timer inject-nan" "qemu_timer tight-bound" "qemu_nonlinear inject-nan"
@@ -32,7 +34,8 @@ BROKEN=("qemu_timer inject-nan" "qemu_timer tight-bound" "qemu_nonlinear inject-
     "qemu_hysteretic hysteretic-tight-bound"
     "qemu_observer observer-nan" "qemu_observer observer-tight-bound"
     "qemu_estimator estimator-tight-bound"
-    "qemu_hybrid hybrid-tight-bound" "qemu_hybrid hybrid-nan")
+    "qemu_hybrid hybrid-tight-bound" "qemu_hybrid hybrid-nan"
+    "qemu_control control-tight-bound" "qemu_control control-nan")
 RUN_TIMEOUT=300 # seconds per QEMU run (each takes a few seconds)
 PKG=(-p aemstep-firmware)
 DEFMT_PRINT_VERSION=1.2.0 # the host decoder; its format must match the target's defmt 1.x
@@ -94,8 +97,10 @@ run() { # <example> <variant>: runs the ELF `build` kept under QEMU; sets RC
 step "qemu: clippy of the firmware examples ($TARGET)"
 cargo clippy "${PKG[@]}" --release --target "$TARGET" --features defmt --examples -- -D warnings ||
     fail "clippy (firmware examples)"
-cargo clippy "${PKG[@]}" --release --target "$TARGET" --example qemu_hybrid \
-    -- -D warnings --cfg 'aemstep_fpu="double"' || fail "clippy (qemu_hybrid, f64)"
+for ex in qemu_hybrid qemu_control; do
+    cargo clippy "${PKG[@]}" --release --target "$TARGET" --example "$ex" \
+        -- -D warnings --cfg 'aemstep_fpu="double"' || fail "clippy ($ex, f64)"
+done
 for variant in footprint-modal footprint-all; do
     cargo clippy "${PKG[@]}" --release --target "$TARGET" --example qemu_footprint \
         -- -D warnings --cfg "aemstep_control=\"$variant\"" || fail "clippy (qemu_footprint, $variant)"
@@ -119,36 +124,39 @@ for pair in "${BROKEN[@]}"; do
     echo "ok: $ex with --cfg aemstep_broken=\"$variant\" failed as it must (exit 1)"
 done
 
-step "qemu: qemu_hybrid in f64 on the Cortex-M7 (mps2-an500, double-precision FPU)"
+step "qemu: qemu_hybrid and qemu_control in f64 on the Cortex-M7 (mps2-an500, double-precision FPU)"
 # The runner and target directory of scripts/cores.sh's M7 (its dependencies stay cached);
 # `cargo rustc` passes the cfg to the example crate only.
 M7_RUNNER=(qemu-system-arm -machine mps2-an500 -cpu cortex-m7 -nographic -semihosting-config
     enable=on,target=native -icount shift=0,sleep=off -kernel)
 M7_DIR=$TARGET_DIR/core-M7
-m7_hybrid() { # <name> <extra cfg or ->: builds qemu_hybrid in f64 for the M7 as $OUT/qemu_hybrid-<name>, runs it; sets RC
-    local name=$1 extra=()
-    [[ $2 == - ]] || extra=(--cfg "$2")
+m7_run() { # <example> <name> <extra cfg or ->: builds <example> in f64 for the M7 as $OUT/<example>-<name>, runs it; sets RC
+    local ex=$1 name=$2 extra=()
+    [[ $3 == - ]] || extra=(--cfg "$3")
     env CARGO_TARGET_DIR="$M7_DIR" CARGO_TARGET_THUMBV7EM_NONE_EABIHF_RUSTFLAGS="-C target-cpu=cortex-m7" \
-        cargo rustc -q "${PKG[@]}" --release --target "$TARGET" --example qemu_hybrid -- \
-        --cfg 'aemstep_fpu="double"' "${extra[@]}" || fail "build qemu_hybrid ($name)"
-    cp "$M7_DIR/$TARGET/release/examples/qemu_hybrid" "$OUT/qemu_hybrid-$name"
+        cargo rustc -q "${PKG[@]}" --release --target "$TARGET" --example "$ex" -- \
+        --cfg 'aemstep_fpu="double"' "${extra[@]}" || fail "build $ex ($name)"
+    cp "$M7_DIR/$TARGET/release/examples/$ex" "$OUT/$ex-$name"
     set +e
-    timeout "$RUN_TIMEOUT" "${M7_RUNNER[@]}" "$OUT/qemu_hybrid-$name" >"$OUT/qemu_hybrid-$name.log" 2>&1
+    timeout "$RUN_TIMEOUT" "${M7_RUNNER[@]}" "$OUT/$ex-$name" >"$OUT/$ex-$name.log" 2>&1
     RC=$?
     set -e
-    cat "$OUT/qemu_hybrid-$name.log"
-    [[ $RC -ne 124 ]] || fail "qemu_hybrid ($name) timed out after ${RUN_TIMEOUT}s"
+    cat "$OUT/$ex-$name.log"
+    [[ $RC -ne 124 ]] || fail "$ex ($name) timed out after ${RUN_TIMEOUT}s"
 }
-m7_hybrid m7 -
-[[ $RC -eq 0 ]] || fail "qemu_hybrid on the Cortex-M7 (f64) exited with $RC"
-grep '^COST hybrid f64 ' "$OUT/qemu_hybrid-m7.log" >/dev/null || fail "qemu_hybrid on the M7 did not step in f64"
-echo "ok: qemu_hybrid in f64 on the Cortex-M7 exited 0"
-# The broken variant here is the NaN force: the f64 run is bit-identical to the host's (error
-# 0), so no tightened bound can fail it.
-m7_hybrid m7-broken 'aemstep_broken="hybrid-nan"'
-[[ $RC -eq 1 ]] || fail "qemu_hybrid on the M7 with --cfg aemstep_broken=\"hybrid-nan\" exited $RC, expected 1"
-grep '^FAIL: ' "$OUT/qemu_hybrid-m7-broken.log" >/dev/null || fail "qemu_hybrid on the M7 (broken) failed without saying why"
-echo "ok: qemu_hybrid on the M7 with --cfg aemstep_broken=\"hybrid-nan\" failed as it must (exit 1)"
+# The broken variant on the M7 is the NaN force: the f64 run is bit-identical to the host's
+# (error 0), so no tightened bound can fail it.
+for pair in "qemu_hybrid hybrid" "qemu_control control"; do
+    read -r ex cost <<<"$pair"
+    m7_run "$ex" m7 -
+    [[ $RC -eq 0 ]] || fail "$ex on the Cortex-M7 (f64) exited with $RC"
+    grep "^COST $cost f64 " "$OUT/$ex-m7.log" >/dev/null || fail "$ex on the M7 did not step in f64"
+    echo "ok: $ex in f64 on the Cortex-M7 exited 0"
+    m7_run "$ex" m7-broken "aemstep_broken=\"$cost-nan\""
+    [[ $RC -eq 1 ]] || fail "$ex on the M7 with --cfg aemstep_broken=\"$cost-nan\" exited $RC, expected 1"
+    grep '^FAIL: ' "$OUT/$ex-m7-broken.log" >/dev/null || fail "$ex on the M7 (broken) failed without saying why"
+    echo "ok: $ex on the M7 with --cfg aemstep_broken=\"$cost-nan\" failed as it must (exit 1)"
+done
 
 step "qemu: defmt: the decoded log of qemu_defmt, line by line against $DEFMT_EXPECTED"
 # The firmware writes defmt frames to semihosting stdout; defmt-print formats them on the
@@ -326,6 +334,32 @@ for rate in 1024 2048; do
     done
 done
 
+step "qemu: host and target runs are bit-identical (control loop: floor-1 displacement at 16.0 s; M4F f32, M7 f64)"
+host_log=$(cargo test -q --release --features std --test firmware_control -- --nocapture 2>&1)
+for pair in "f32 qemu_control-qemu" "f64 qemu_control-m7"; do
+    read -r ty log <<<"$pair"
+    host_bits=$(sed -n "s/^host last floor-1 displacement $ty bits = //p" <<<"$host_log")
+    target_bits=$(sed -n "s/^target last floor-1 displacement $ty bits = //p" "$OUT/$log.log")
+    [[ -n $host_bits && $host_bits == "$target_bits" ]] ||
+        fail "control floor-1 displacement ($ty): host '$host_bits', target '$target_bits'"
+    echo "ok: $ty both $host_bits"
+done
+
+step "qemu: the controller's observer update within 3 instructions per multiply-add on the Cortex-M4F"
+# The firmware fails on its own count too; this reads the logged row and proves, on a
+# made-up row just above the limit, that the check can fail.
+MAX_CONTROL_PER_MADD=3
+control_over() { # <log>: the M4F f32 control-observer row if above the limit
+    awk -v max="$MAX_CONTROL_PER_MADD" '$1 == "COST" && $2 == "control-observer" && $3 == "f32" &&
+        $5 > 0 && $4 / $5 > max { printf "%s instructions for %d multiply-adds (%.2f each)\n", $4, $5, $4 / $5 }' "$1"
+}
+[[ -n $(control_over <(echo "COST control-observer f32 261.1 87")) ]] ||
+    fail "control: the limit check passed a row of 3.001 instructions per multiply-add"
+grep '^COST control-observer f32 ' "$OUT/qemu_control-qemu.log" >/dev/null || fail "qemu_control printed no control-observer row"
+bad=$(control_over "$OUT/qemu_control-qemu.log")
+[[ -z $bad ]] || fail "the controller's observer update above $MAX_CONTROL_PER_MADD instructions per multiply-add: $bad"
+echo "ok: $(awk '$2 == "control-observer" { printf "%.2f", $4 / $5 }' "$OUT/qemu_control-qemu.log") instructions per multiply-add"
+
 step "qemu: host and Cortex-M4F runs are bit-identical (joint estimator: roof force and detector window at 80 s)"
 host_log=$(cargo test -q --release --test firmware_estimator -- --nocapture --exact \
     f32_run_within_the_firmware_bound 2>&1)
@@ -390,6 +424,12 @@ hyb_err() { # <run: qemu or m7> <rate>: the max |drift − host| the run printed
 }
 hyb_bound() { # <run>: the bound the run checked
     sed -n 's/^qemu_hybrid: .* <= bound \([^ ]*\) m$/\1/p' "$OUT/qemu_hybrid-$1.log" | sed -n 1p
+}
+ctl_err() { # <run: qemu or m7>: the max |x1 − host| the control run printed
+    sed -n 's/^qemu_control: .* = \([^ ]*\) m <= bound .*/\1/p' "$OUT/qemu_control-$1.log"
+}
+ctl_bound() { # <run>: the bound the control run checked
+    sed -n 's/^qemu_control: .* <= bound \([^ ]*\) m$/\1/p' "$OUT/qemu_control-$1.log"
 }
 mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
     awk -v e="$1" -v k="$2" '$1 == "MEM" && $2 == e && $3 == k { v = $4 } END { printf "%s", v == "" ? "-" : v }' \
@@ -509,6 +549,45 @@ mem_of() { # <example> <key>: a MEM figure from the example's log, or "-"
         read -r run core mhz <<<"$pair"
         grep '^COST hybrid ' "$OUT/qemu_hybrid-$run.log" | while read -r _ _ ty rate mean max; do
             awk -v c="$core" -v t="$ty" -v r="$rate" -v a="$mean" -v b="$max" -v m="$mhz" 'BEGIN {
+                budget = m * 1e6 / r
+                printf "| %s | `%s` | %d | %d | %d | %d | %d | %.2f %% | %.2f %% |\n", c, t, r, a, b, m, budget, 100 * a / budget, 100 * b / budget }'
+        done
+    done
+    echo
+    echo "## Semi-active control loop (\`examples/firmware/qemu_control.rs\`)"
+    echo
+    echo "The clipped-optimal MR-damper controller of issue 33 on the 3-storey model building of the Dyke et al. (1996)"
+    echo "benchmark (\`scenes/control/\`), stepped from SysTick at 1 kHz with the structure and the damper emulated beside it."
+    echo "Controller step: \`Controller::try_step\` (\`Controller<T, 6, 1, 3>\`: observer, gain on the delayed model,"
+    echo "saturation, checks and status), \`S² + 2S·I + 2S·O + O·I + S·I + I²\` = 94 multiply-adds (S = 6 states, I = 1"
+    echo "input, O = 3 accelerometers); its observer update alone (\`Observer::step\`), \`S² + 2S·I + 2S·O + O·I\` = 87, must"
+    echo "stay within 3 instructions per multiply-add on the Cortex-M4F (\`scripts/qemu.sh\` fails otherwise). Averages of"
+    echo "1000 calls, loop overhead subtracted. \`f32\` on the Cortex-M4F, \`f64\` on the Cortex-M7."
+    echo
+    echo "| core | type | step | instructions / step | multiply-adds | instructions / multiply-add |"
+    echo "|---|---|---|---:|---:|---:|"
+    for pair in "qemu Cortex-M4F" "m7 Cortex-M7"; do
+        read -r run core <<<"$pair"
+        grep -E '^COST control-(step|observer) ' "$OUT/qemu_control-$run.log" | while read -r _ what ty instr madds; do
+            case $what in
+            control-step) name="\`Controller::try_step\`" ;;
+            control-observer) name="its \`Observer::step\`" ;;
+            esac
+            echo "| $core | \`$ty\` | $name | $instr | $madds | $(awk -v a="$instr" -v b="$madds" 'BEGIN { printf "%.2f", a / b }') |"
+        done
+    done
+    echo
+    echo "The whole loop step (sense, controller, switching law, the emulated structure and damper: \`Coupled\` and"
+    echo "\`Nonlinear<T, 3>\` with up to 20 Newton iterations), mean and worst case over the 15976 steps of the record."
+    echo "Against the host's f64 run: max |floor-1 displacement − host| = $(ctl_err qemu) m in \`f32\` (bound"
+    echo "$(ctl_bound qemu) m), $(ctl_err m7) m in \`f64\` (bound $(ctl_bound m7) m). Share of the budget as for the hybrid loop."
+    echo
+    echo "| core | type | rate (Hz) | instructions / step (mean) | instructions / step (max) | clock (MHz) | budget (cycles / step) | share of the budget (mean) | share of the budget (max) |"
+    echo "|---|---|---:|---:|---:|---:|---:|---:|---:|"
+    for pair in "qemu Cortex-M4F 168" "m7 Cortex-M7 480"; do
+        read -r run core mhz <<<"$pair"
+        grep '^COST control ' "$OUT/qemu_control-$run.log" | while read -r _ _ ty mean max; do
+            awk -v c="$core" -v t="$ty" -v r=1000 -v a="$mean" -v b="$max" -v m="$mhz" 'BEGIN {
                 budget = m * 1e6 / r
                 printf "| %s | `%s` | %d | %d | %d | %d | %d | %.2f %% | %.2f %% |\n", c, t, r, a, b, m, budget, 100 * a / budget, 100 * b / budget }'
         done
