@@ -111,6 +111,19 @@ pub fn design<const S: usize, const Z: usize>(
     r: f64,
     delay_aware: bool,
 ) -> Result<Design<S, Z>, Error> {
+    design_with(ss, ssg, r, delay_aware, SENSOR_SIGMA, RECOVERY)
+}
+
+/// [`design`] with the observer's accelerometer noise `sensor_sigma` (m/s²) and recovery
+/// noise `recovery` (MN) given.
+pub fn design_with<const S: usize, const Z: usize>(
+    ss: &StateSpace<5, S, 1>,
+    ssg: &StateSpace<5, S, 1>,
+    r: f64,
+    delay_aware: bool,
+    sensor_sigma: f64,
+    recovery: f64,
+) -> Result<Design<S, Z>, Error> {
     let drifts = ss.outputs(&Outputs::displacements(storey_drifts::<5>()))?;
     let mut qy = [[0.0; 5]; 5];
     for (i, row) in qy.iter_mut().enumerate() {
@@ -131,9 +144,9 @@ pub fn design<const S: usize, const Z: usize>(
     };
     let q = SMatrix::<f64, S, S>::from_fn(|i, j| {
         ssg.input_noise(&[[GROUND_SIGMA * GROUND_SIGMA]])[i][j]
-            + ss.input_noise(&[[RECOVERY * RECOVERY]])[i][j]
+            + ss.input_noise(&[[recovery * recovery]])[i][j]
     }) + SMatrix::identity() * 1e-14;
-    let rn = SMatrix::<f64, O, O>::identity() * SENSOR_SIGMA * SENSOR_SIGMA;
+    let rn = SMatrix::<f64, O, O>::identity() * sensor_sigma * sensor_sigma;
     let kf = SteadyState::new(ss, &sensors(ss), &q, &rn)?;
     Ok(Design {
         gain,
