@@ -335,6 +335,11 @@ pub struct HybridDocDoctests;
 #[doc = include_str!("../docs/control.md")]
 pub struct ControlDocDoctests;
 
+/// As [`ModalDocDoctests`].
+#[cfg(doctest)]
+#[doc = include_str!("../docs/control-tradeoff.md")]
+pub struct ControlTradeoffDocDoctests;
+
 /// As [`ModalDocDoctests`] (its code needs the feature `std`).
 #[cfg(all(doctest, feature = "std"))]
 #[doc = include_str!("../docs/ida.md")]

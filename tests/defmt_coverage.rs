@@ -22,6 +22,7 @@ const SKIP: &[(&str, &str)] = &[
     ("DetectionDocDoctests", "cfg(doctest) marker"),
     ("HybridDocDoctests", "cfg(doctest) marker"),
     ("ControlDocDoctests", "cfg(doctest) marker"),
+    ("ControlTradeoffDocDoctests", "cfg(doctest) marker"),
     ("IdaDocDoctests", "cfg(doctest) marker"),
     // Feature `std` only (host: heap-held records and IDA results); `defmt` is for firmware.
     ("Record", "std only"),
