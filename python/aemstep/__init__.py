@@ -14,8 +14,9 @@ accelerations in m/s² (``G`` converts from g).
 - ``constant_strength``, ``constant_ductility``: inelastic spectra.
 - ``observe``: a steady-state (Kalman-gain) observer or a Kalman filter of a building's
   state from measured floor accelerations.
-- ``zero_order_hold``, ``lqr``: the sampled design model of a building and the discrete
-  linear–quadratic regulator (with the one-sample computation delay if asked).
+- ``zero_order_hold``, ``lqr``, ``lqg``: the sampled design model of a building, the
+  discrete linear–quadratic regulator (with the one-sample computation delay if asked),
+  and the observer and regulator gains of an output-feedback controller.
 - ``mr_damper_response``, ``mr_building``: the Bouc–Wen MR damper of Dyke et al. (1996)
   driven by a motion, and a building with one MR damper (passive off/on, clipped-optimal).
 - ``read_at2``, ``read_column``: PEER NGA ``.AT2`` and one-column records (the library's
@@ -671,6 +672,64 @@ def lqr(
     return Regulator(k, p, cl, float(radius), int(iterations))
 
 
+class OutputFeedback(NamedTuple):
+    """The gains of an LQG controller (``lqg``)."""
+
+    observer_gain: np.ndarray  #: L = P Hᵀ (H P Hᵀ + V)⁻¹ (2n×sensors)
+    gain: np.ndarray  #: K (1×2n): u = −K x̂
+    filter_covariance: np.ndarray  #: the a-priori error covariance P (2n×2n)
+    cost: np.ndarray  #: the regulator's Riccati solution (2n×2n)
+    radius_bound: float  #: certified bound on the spectral radius of Φ − Γ K (< 1)
+
+
+SENSED = ("displacements", "velocities", "accelerations")
+
+
+def lqg(
+    m: ArrayLike,
+    c: ArrayLike,
+    k: ArrayLike,
+    b: ArrayLike,
+    h: float,
+    sensors: Sequence[int],
+    *,
+    q: ArrayLike,
+    r: float,
+    w: ArrayLike,
+    v: ArrayLike,
+    sensed: str = "velocities",
+) -> OutputFeedback:
+    """The two gains of an output-feedback (LQG) controller of a building with one control
+    force ``b`` (``n`` values): the steady-state Kalman gain of its zero-order-hold model
+    at sample interval ``h`` (s), measuring ``sensed`` (``SENSED``: relative displacements,
+    velocities or accelerations) of the DOFs ``sensors``, with process noise covariance
+    ``w`` (``2n×2n``, on ``x = [u; v]``) and measurement noise covariance ``v``
+    (``sensors×sensors``, or a scalar for ``σ² I``); and the LQR gain for the weights ``q``
+    (``2n×2n``) and ``r`` (scalar, on the force). The Rust ``Controller`` combines them.
+    Raises ``InvalidCovariance``, ``InvalidParameter`` (``.parameter == "Weight"``),
+    ``RiccatiNotConverged``, ``NotStabilizing``, ``UnsupportedSize``, …"""
+    if sensed not in SENSED:
+        raise ValueError(f"unknown sensed {sensed!r}: one of {SENSED}")
+    sensors = [int(s) for s in sensors]
+    vv = np.asarray(v, dtype=np.float64)
+    if vv.ndim == 0:
+        vv = float(vv) * np.eye(len(sensors))
+    ell, kk, pf, pr, radius = _aemstep.lqg(
+        _mat(m, "m"),
+        _mat(c, "c"),
+        _mat(k, "k"),
+        _vec(b, "b"),
+        float(h),
+        sensors,
+        sensed,
+        _mat(q, "q"),
+        float(r),
+        _mat(w, "w"),
+        _mat(vv, "v"),
+    )
+    return OutputFeedback(ell, kk, pf, pr, float(radius))
+
+
 #: The Bouc–Wen MR damper parameters of Dyke, Spencer, Sain & Carlson (1996), "Modeling
 #: and control of magnetorheological dampers for seismic response reduction", Smart Mater.
 #: Struct. 5, in SI units — as quoted by the literature citing the paper (its table was not
@@ -860,6 +919,9 @@ __all__ = [
     "zero_order_hold",
     "Regulator",
     "lqr",
+    "SENSED",
+    "OutputFeedback",
+    "lqg",
     "DYKE_1996",
     "MR_PARAMETERS",
     "DamperResponse",

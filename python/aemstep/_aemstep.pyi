@@ -225,6 +225,25 @@ def lqr(
     with ``decision`` (``I×I``) on the model with the one-sample computation delay.
     Returns (K, P, phi − gamma K, certified spectral-radius bound, doubling iterations)."""
 
+def lqg(
+    m: F64,
+    c: F64,
+    k: F64,
+    b: F64,
+    h: float,
+    sensors: List[int],
+    sensed: str,
+    q: F64,
+    r: float,
+    w: F64,
+    v: F64,
+) -> Tuple[F64, F64, F64, F64, float]:
+    """Gains of an LQG controller of a building with one control force b (``n``) sampled
+    at h s: the steady-state Kalman gain of its zero-order-hold model measuring ``sensed``
+    ("displacements", "velocities", "accelerations") at ``sensors``, noise covariances w
+    (``2n×2n``) and v, and the LQR gain for weights q (``2n×2n``), r. Returns (L
+    ``2n×sensors``, K ``1×2n``, filter covariance, regulator cost, radius bound)."""
+
 def mr_damper_response(
     x: F64,
     xdot: F64,

@@ -13,7 +13,7 @@ use aemstep::control::{
 };
 use aemstep::hysteresis::HistoryModel;
 use aemstep::nalgebra::{SMatrix, SVector};
-use aemstep::observer::StateSpace;
+use aemstep::observer::{Outputs, StateSpace, SteadyState};
 use aemstep::{Error, NewtonSettings};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -270,6 +270,170 @@ fn lqr<'py>(
         out2(py, cl, z),
         radius,
         iterations,
+    ))
+}
+
+// ---------------------------------------------------------------------------------------
+// Output feedback: the observer gain and the regulator gain of one model.
+
+/// Which physical outputs the sensors read.
+#[derive(Clone, Copy)]
+enum Sensed {
+    Displacements,
+    Velocities,
+    Accelerations,
+}
+
+struct LqgJob {
+    m: Vec<f64>,
+    c: Vec<f64>,
+    k: Vec<f64>,
+    b: Vec<f64>,
+    h: f64,
+    sensors: Vec<usize>,
+    sensed: Sensed,
+    q: Vec<f64>,
+    r: f64,
+    w: Vec<f64>,
+    v: Vec<f64>,
+}
+
+/// `(L, K, P_filter, P_regulator, radius bound)`, row-major.
+type LqgOut = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>, f64);
+
+fn lqg_no<const N: usize, const S: usize, const O: usize>(job: &LqgJob) -> Res<LqgOut> {
+    let b = SMatrix::<f64, N, 1>::from_column_slice(&job.b);
+    let ss = StateSpace::<N, S, 1>::zero_order_hold(
+        &matrix::<N>(&job.m),
+        &matrix::<N>(&job.c),
+        &matrix::<N>(&job.k),
+        &b,
+        job.h,
+    )?;
+    let y = Outputs::<N, 1, O>::select(core::array::from_fn(|o| job.sensors[o]));
+    let outputs = match job.sensed {
+        Sensed::Displacements => Outputs::displacements(y),
+        Sensed::Velocities => Outputs::velocities(y),
+        Sensed::Accelerations => Outputs::accelerations(y),
+    };
+    let meas = ss.outputs(&outputs)?;
+    let filter = SteadyState::<S, O>::from_parts(&ss, &meas, &table(&job.w), &table(&job.v))?;
+    let design = DesignModel::from_state_space(&ss);
+    let weights = Weights::<S, 1>::new(&table(&job.q), &[[job.r]]);
+    let reg = Lqr::from_parts(&design, &weights)?;
+    Ok((
+        flat(&filter.gain),
+        flat(&reg.gain),
+        flat(&filter.covariance),
+        flat(&reg.cost),
+        reg.radius_bound,
+    ))
+}
+
+fn lqg_n<const N: usize, const S: usize>(job: &LqgJob) -> Res<LqgOut> {
+    match job.sensors.len() {
+        1 => lqg_no::<N, S, 1>(job),
+        2 if N >= 2 => lqg_no::<N, S, 2>(job),
+        3 if N >= 3 => lqg_no::<N, S, 3>(job),
+        o => Err(Fail::Size(format!(
+            "{o} sensors on {N} floors: this build takes 1 to {} sensors",
+            crate::MAX_SENSORS.min(N)
+        ))),
+    }
+}
+
+/// The two gains of an output-feedback (LQG) controller of a building driven by one
+/// control force: the steady-state Kalman gain of its zero-order-hold model
+/// (`aemstep::observer::SteadyState`) and the LQR gain (`aemstep::control::Lqr`), as
+/// `aemstep::control::Controller` combines them.
+///
+/// Arguments: `m`, `c`, `k` (kg, N·s/m, N/m; `n×n`, `n` in `SIZES`), `b` (`n`: the control
+/// force's distribution), `h` (s); `sensors` (0-based DOFs, 1 to `MAX_SENSORS`, distinct),
+/// `sensed` — `"displacements"`, `"velocities"` or `"accelerations"` (relative); `q`
+/// (`2n×2n`) and `r` (scalar, `> 0`) — the regulator's weights on `x = [u; v]` and the
+/// force; `w` (`2n×2n`) and `v` (`sensors×sensors`) — the process and measurement noise
+/// covariances of the discrete model.
+///
+/// Returns `(L, K, P_filter, P_regulator, radius_bound)`: the observer gain
+/// `L = P Hᵀ (H P Hᵀ + V)⁻¹` (`2n×sensors`), the regulator gain (`1×2n`, `u = −K x̂`), the
+/// two Riccati solutions and the regulator's certified spectral-radius bound. Raises
+/// `InvalidCovariance`, `InvalidParameter` (`"Weight"`), `RiccatiNotConverged`,
+/// `NotStabilizing`, … Cost: two Riccati solutions of size `2n`.
+#[pyfunction]
+#[pyo3(signature = (m, c, k, b, h, sensors, sensed, q, r, w, v))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn lqg<'py>(
+    py: Python<'py>,
+    m: PyReadonlyArray2<'py, f64>,
+    c: PyReadonlyArray2<'py, f64>,
+    k: PyReadonlyArray2<'py, f64>,
+    b: PyReadonlyArray1<'py, f64>,
+    h: f64,
+    sensors: Vec<usize>,
+    sensed: &str,
+    q: PyReadonlyArray2<'py, f64>,
+    r: f64,
+    w: PyReadonlyArray2<'py, f64>,
+    v: PyReadonlyArray2<'py, f64>,
+) -> PyResult<(
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    f64,
+)> {
+    let n = m.as_array().dim().0;
+    let o = sensors.len();
+    let prepare = || -> Res<LqgJob> {
+        let b = read1(&b);
+        if b.len() != n {
+            return shape(format!("b must have {n} values, got {}", b.len()));
+        }
+        if sensors.is_empty() || sensors.iter().any(|&s| s >= n) {
+            return shape(format!(
+                "sensors must be 1 or more DOF indices in 0..{n}, got {sensors:?}"
+            ));
+        }
+        let mut sorted = sensors.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        if sorted.len() != o {
+            return shape(format!("sensors must be distinct, got {sensors:?}"));
+        }
+        let sensed = match sensed {
+            "displacements" => Sensed::Displacements,
+            "velocities" => Sensed::Velocities,
+            "accelerations" => Sensed::Accelerations,
+            s => {
+                return shape(format!(
+                    "sensed must be \"displacements\", \"velocities\" or \"accelerations\", got {s:?}"
+                ));
+            }
+        };
+        Ok(LqgJob {
+            m: square(&m, n, "m")?,
+            c: square(&c, n, "c")?,
+            k: square(&k, n, "k")?,
+            b,
+            h,
+            sensors: sensors.clone(),
+            sensed,
+            q: square(&q, 2 * n, "q")?,
+            r,
+            w: square(&w, 2 * n, "w")?,
+            v: square(&v, o, "v")?,
+        })
+    };
+    let job = prepare().map_err(|f| f.raise(py))?;
+    let (l, kk, pf, pr, radius) = py
+        .detach(|| by_size!(n, lqg_n(&job)))
+        .map_err(|f| f.raise(py))?;
+    Ok((
+        out2(py, l, o),
+        out2(py, kk, 2 * n),
+        out2(py, pf, 2 * n),
+        out2(py, pr, 2 * n),
+        radius,
     ))
 }
 
@@ -544,6 +708,7 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_CONTROL_INPUTS", MAX_CONTROL_INPUTS)?;
     m.add_function(wrap_pyfunction!(zero_order_hold, m)?)?;
     m.add_function(wrap_pyfunction!(lqr, m)?)?;
+    m.add_function(wrap_pyfunction!(lqg, m)?)?;
     m.add_function(wrap_pyfunction!(mr_damper_response, m)?)?;
     m.add_function(wrap_pyfunction!(mr_building, m)?)?;
     Ok(())
