@@ -577,10 +577,12 @@ fn mr_building_n<const N: usize, const S: usize>(job: &MrBuildingJob) -> Res<MrB
         0 => Link::Ground(0),
         j => Link::Between(j, j - 1),
     };
-    let mut model = match job.law {
-        Law::On => Coupled::passive_on(structure, damper, link, job.h)?,
-        Law::Off | Law::Clipped(_) => Coupled::passive_off(structure, damper, link, job.h)?,
-    };
+    // Started at 0 V whatever the law: the start commits the device's trial history at
+    // rest, a trial over one step `h` with the held command, so a command held at the
+    // start would advance the voltage filter by one step before t = 0 (a one-step shift of
+    // the filter, an O(h) error: measured first order with the command on from the start).
+    // `"on"` holds V_max from the first step on.
+    let mut model = Coupled::passive_off(structure, damper, link, job.h)?;
     let clipped = ClippedOptimal::<f64, 1>::new(job.params.v_max)?;
     let stepper = model.nonlinear(NewtonSettings::default())?;
     let mass = matrix::<N>(&job.m);
@@ -597,6 +599,10 @@ fn mr_building_n<const N: usize, const S: usize>(job: &MrBuildingJob) -> Res<MrB
             &model.initial_history(),
         )
         .map_err(at(0))?;
+    if let Law::On = job.law {
+        let on = model.device().command_limits().1;
+        model.set_command(on).map_err(at(0))?;
+    }
     let (mut u, mut v, mut f, mut cmd) = (
         Vec::with_capacity(steps * N),
         Vec::with_capacity(steps * N),
