@@ -14,6 +14,11 @@ accelerations in m/s² (``G`` converts from g).
 - ``constant_strength``, ``constant_ductility``: inelastic spectra.
 - ``observe``: a steady-state (Kalman-gain) observer or a Kalman filter of a building's
   state from measured floor accelerations.
+- ``zero_order_hold``, ``lqr``, ``lqg``: the sampled design model of a building, the
+  discrete linear–quadratic regulator (with the one-sample computation delay if asked),
+  and the observer and regulator gains of an output-feedback controller.
+- ``mr_damper_response``, ``mr_building``: the Bouc–Wen MR damper of Dyke et al. (1996)
+  driven by a motion, and a building with one MR damper (passive off/on, clipped-optimal).
 - ``read_at2``, ``read_column``: PEER NGA ``.AT2`` and one-column records (the library's
   readers).
 - ``ida_stripes``, ``ida_hunt_fill``, ``ida_fractiles``: incremental dynamic analysis of
@@ -39,6 +44,8 @@ from . import _aemstep
 from ._aemstep import (  # noqa: F401  (re-exported)
     CHUNK,
     ERROR_VARIANTS,
+    MAX_CONTROL_INPUTS,
+    MAX_DESIGN_STATES,
     MAX_SENSORS,
     MAX_TRUNCATED_MODES,
     ROTD_ANGLES,
@@ -594,6 +601,255 @@ def observe(
     )
     return Estimate(u, v, np.diff(u, axis=1, prepend=0.0), gain)
 
+# ---------------------------------------------------------------------------------------
+# Vibration control.
+
+
+def zero_order_hold(m: ArrayLike, c: ArrayLike, k: ArrayLike, b: ArrayLike, h: float) -> Tuple[np.ndarray, np.ndarray]:
+    """The exact sampled model ``x_{k+1} = Φ x_k + Γ f_k`` of ``M u'' + C u' + K u = B f``
+    with the force held over each step of ``h`` s (zero-order hold), ``x = [u; v]``.
+
+    ``m``, ``c``, ``k``: kg, N·s/m, N/m (``n×n``, ``n`` in ``SIZES``). ``b``: the force
+    distribution (``n`` or ``n×inputs``, 1 to ``MAX_CONTROL_INPUTS`` columns). Returns
+    ``(phi, gamma)``: ``2n×2n`` and ``2n×inputs`` (m/N, m/s/N)."""
+    bb = np.asarray(b, dtype=np.float64)
+    if bb.ndim == 1:
+        bb = bb[:, None]
+    return _aemstep.zero_order_hold(_mat(m, "m"), _mat(c, "c"), _mat(k, "k"), _mat(bb, "b"), float(h))
+
+
+class Regulator(NamedTuple):
+    """A discrete LQR design (``lqr``)."""
+
+    gain: np.ndarray  #: K (inputs×states; inputs×(states+inputs) with the delay): u = −K x
+    cost: np.ndarray  #: P, the stabilizing Riccati solution (cost-to-go x₀ᵀ P x₀)
+    closed_loop: np.ndarray  #: Φ − Γ K (of the delayed model with the delay)
+    radius_bound: float  #: certified upper bound on the closed loop's spectral radius (< 1)
+    iterations: int  #: doubling iterations of the Riccati solver
+
+
+def lqr(
+    phi: ArrayLike,
+    gamma: ArrayLike,
+    q: ArrayLike,
+    r: ArrayLike,
+    s: Optional[ArrayLike] = None,
+    delay: bool = False,
+    decision: Optional[ArrayLike] = None,
+) -> Regulator:
+    """The discrete linear–quadratic regulator of ``x_{k+1} = Φ x_k + Γ u_k`` for the cost
+    ``Σ xᵀQx + 2xᵀSu + uᵀRu``: ``u = −K x`` (``aemstep::control::Lqr``, certified
+    stabilizing).
+
+    ``phi`` (``S×S``, ``S`` ≤ ``MAX_DESIGN_STATES``), ``gamma`` (``S`` or ``S×I``, ``I`` ≤
+    ``MAX_CONTROL_INPUTS``), ``q`` (``S×S``, symmetric positive semidefinite), ``r``
+    (``I×I`` or a scalar, symmetric positive definite), ``s`` (``S×I`` cross weight,
+    default zero). ``delay=True`` designs on the model with the one-sample computation
+    delay ``z = [x; u_{k−1}]`` (the force computed from sample ``k`` acts from ``k+1``):
+    ``K`` is then ``I×(S+I)``, and ``decision`` (default ``1e-3·R``) weighs the command as
+    computed. Raises ``InvalidParameter`` (``.parameter == "Weight"``),
+    ``RiccatiNotConverged``, ``NotStabilizing``, ``UnsupportedSize``, …"""
+    g = np.asarray(gamma, dtype=np.float64)
+    if g.ndim == 1:
+        g = g[:, None]
+    rr = np.asarray(r, dtype=np.float64)
+    if rr.ndim == 0:
+        rr = rr.reshape(1, 1)
+    ss = np.zeros(g.shape) if s is None else np.asarray(s, dtype=np.float64)
+    if ss.ndim == 1:
+        ss = ss[:, None]
+    dec = None
+    if delay:
+        dec = 1e-3 * rr if decision is None else np.asarray(decision, dtype=np.float64)
+        if dec.ndim == 0:
+            dec = dec.reshape(1, 1)
+        dec = _mat(dec, "decision")
+    elif decision is not None:
+        raise ShapeError("decision weighs the delayed design: pass delay=True with it")
+    k, p, cl, radius, iterations = _aemstep.lqr(
+        _mat(phi, "phi"), _mat(g, "gamma"), _mat(q, "q"), _mat(rr, "r"), _mat(ss, "s"), dec
+    )
+    return Regulator(k, p, cl, float(radius), int(iterations))
+
+
+class OutputFeedback(NamedTuple):
+    """The gains of an LQG controller (``lqg``)."""
+
+    observer_gain: np.ndarray  #: L = P Hᵀ (H P Hᵀ + V)⁻¹ (2n×sensors)
+    gain: np.ndarray  #: K (1×2n): u = −K x̂
+    filter_covariance: np.ndarray  #: the a-priori error covariance P (2n×2n)
+    cost: np.ndarray  #: the regulator's Riccati solution (2n×2n)
+    radius_bound: float  #: certified bound on the spectral radius of Φ − Γ K (< 1)
+
+
+SENSED = ("displacements", "velocities", "accelerations")
+
+
+def lqg(
+    m: ArrayLike,
+    c: ArrayLike,
+    k: ArrayLike,
+    b: ArrayLike,
+    h: float,
+    sensors: Sequence[int],
+    *,
+    q: ArrayLike,
+    r: float,
+    w: ArrayLike,
+    v: ArrayLike,
+    sensed: str = "velocities",
+) -> OutputFeedback:
+    """The two gains of an output-feedback (LQG) controller of a building with one control
+    force ``b`` (``n`` values): the steady-state Kalman gain of its zero-order-hold model
+    at sample interval ``h`` (s), measuring ``sensed`` (``SENSED``: relative displacements,
+    velocities or accelerations) of the DOFs ``sensors``, with process noise covariance
+    ``w`` (``2n×2n``, on ``x = [u; v]``) and measurement noise covariance ``v``
+    (``sensors×sensors``, or a scalar for ``σ² I``); and the LQR gain for the weights ``q``
+    (``2n×2n``) and ``r`` (scalar, on the force). The Rust ``Controller`` combines them.
+    Raises ``InvalidCovariance``, ``InvalidParameter`` (``.parameter == "Weight"``),
+    ``RiccatiNotConverged``, ``NotStabilizing``, ``UnsupportedSize``, …"""
+    if sensed not in SENSED:
+        raise ValueError(f"unknown sensed {sensed!r}: one of {SENSED}")
+    sensors = [int(s) for s in sensors]
+    vv = np.asarray(v, dtype=np.float64)
+    if vv.ndim == 0:
+        vv = float(vv) * np.eye(len(sensors))
+    ell, kk, pf, pr, radius = _aemstep.lqg(
+        _mat(m, "m"),
+        _mat(c, "c"),
+        _mat(k, "k"),
+        _vec(b, "b"),
+        float(h),
+        sensors,
+        sensed,
+        _mat(q, "q"),
+        float(r),
+        _mat(w, "w"),
+        _mat(vv, "v"),
+    )
+    return OutputFeedback(ell, kk, pf, pr, float(radius))
+
+
+#: The Bouc–Wen MR damper parameters of Dyke, Spencer, Sain & Carlson (1996), "Modeling
+#: and control of magnetorheological dampers for seismic response reduction", Smart Mater.
+#: Struct. 5, in SI units — as quoted by the literature citing the paper (its table was not
+#: read here): the 3-kN prototype of the benchmark. ``gamma``, ``beta`` in m⁻ⁿ (``n = 1``).
+DYKE_1996 = {
+    "c0a": 4.40,  # N·s/m
+    "c0b": 44.0,  # N·s/(m·V)
+    "alpha_a": 1.0872e5,  # N/m
+    "alpha_b": 4.9616e5,  # N/(m·V)
+    "gamma": 300.0,  # m⁻¹
+    "beta": 300.0,  # m⁻¹
+    "a": 1.2,
+    "n": 1.0,
+    "eta": 50.0,  # 1/s
+    "v_max": 2.25,  # V
+}
+
+#: The order of the damper's parameters in the native calls.
+MR_PARAMETERS = ("c0a", "c0b", "alpha_a", "alpha_b", "gamma", "beta", "a", "n", "eta", "v_max")
+
+
+def _mr_params(params: Optional[dict]) -> List[float]:
+    p = dict(DYKE_1996)
+    if params is not None:
+        unknown = set(params) - set(MR_PARAMETERS)
+        if unknown:
+            raise ValueError(f"unknown MR damper parameters {sorted(unknown)}: known are {MR_PARAMETERS}")
+        p.update(params)
+    return [float(p[name]) for name in MR_PARAMETERS]
+
+
+class DamperResponse(NamedTuple):
+    """An MR damper driven by a motion (``mr_damper_response``), one value per sample."""
+
+    force: np.ndarray  #: the damper force (N)
+    z: np.ndarray  #: the Bouc–Wen variable (m)
+    voltage: np.ndarray  #: the filtered voltage u (V)
+
+
+def mr_damper_response(
+    x: ArrayLike,
+    xdot: ArrayLike,
+    voltage: Union[float, ArrayLike],
+    h: float,
+    params: Optional[dict] = None,
+) -> DamperResponse:
+    """The force of the Bouc–Wen MR damper of Dyke et al. (1996) (``aemstep::control::MrDamper``)
+    driven by a displacement ``x`` (m) and velocity ``xdot`` (m/s) history sampled every
+    ``h`` s, and a command ``voltage`` (V; a scalar, or one value per sample, each held
+    over the step that follows, clipped into ``[0, V_max]``).
+
+    ``params``: a dict overriding ``DYKE_1996`` (keys ``MR_PARAMETERS``, SI units). The
+    damper starts at rest at ``x[0]`` (row 0: force 0). Raises ``InvalidMaterial``
+    (``.parameter == "Device"``), ``InvalidParameter`` (``"Saturation"``),
+    ``NonFiniteInput`` (``.step``), ``InvalidTimeStep``."""
+    xs = _vec(x, "x")
+    v = np.asarray(voltage, dtype=np.float64)
+    if v.ndim == 0:
+        v = np.full(xs.shape[0], float(v))
+    f, z, u = _aemstep.mr_damper_response(xs, _vec(xdot, "xdot"), _vec(v, "voltage"), float(h), _mr_params(params))
+    return DamperResponse(f, z, u)
+
+
+class ControlledResponse(NamedTuple):
+    """A building with one MR damper (``mr_building``)."""
+
+    u: np.ndarray  #: displacements relative to the ground (m), steps×n
+    v: np.ndarray  #: velocities (m/s), steps×n
+    force: np.ndarray  #: the damper force (N), one value per sample
+    command: np.ndarray  #: the voltage held from each sample on (V)
+
+
+MR_LAWS = ("off", "on", "clipped")
+
+
+def mr_building(
+    m: ArrayLike,
+    c: ArrayLike,
+    k: ArrayLike,
+    ground_acceleration: ArrayLike,
+    h: float,
+    *,
+    storey: int = 0,
+    law: str = "off",
+    gain: Optional[ArrayLike] = None,
+    params: Optional[dict] = None,
+) -> ControlledResponse:
+    """A linear building (``m``, ``c``, ``k``: kg, N·s/m, N/m, ``n×n``) with one MR damper
+    (Dyke et al. 1996; ``params`` as in ``mr_damper_response``) in storey ``storey`` (0:
+    ground to floor 0; ``j``: floor ``j−1`` to ``j``) under ``ground_acceleration`` (m/s²,
+    one value per step of ``h`` s).
+
+    ``law``: ``"off"`` (0 V), ``"on"`` (``V_max``), or ``"clipped"``: the clipped-optimal
+    law on the desired force ``f_c = −K x`` of the state ``x = [u; v]`` (``gain`` ``K``,
+    ``2n`` values, internal-force sign: a positive ``f_c`` resists a positive storey
+    drift; e.g. ``lqr(*zero_order_hold(m, c, k, -b, h), q, r).gain`` with ``b`` the
+    damper's unit drift vector), the measured force the damper's own; the command is held
+    from the next step. Raises ``NotConverged``, ``InvalidMaterial``, … (``.step``)."""
+    if law not in MR_LAWS:
+        raise ValueError(f"unknown law {law!r}: one of {MR_LAWS}")
+    kk = None
+    if law == "clipped":
+        if gain is None:
+            raise ValueError("law='clipped' needs the state-feedback gain")
+        kk = _mat(np.asarray(gain, dtype=np.float64).reshape(1, -1), "gain")
+    elif gain is not None:
+        raise ValueError(f"law={law!r} takes no gain")
+    u, v, f, cmd = _aemstep.mr_building(
+        _mat(m, "m"),
+        _mat(c, "c"),
+        _mat(k, "k"),
+        _vec(ground_acceleration, "ground_acceleration"),
+        float(h),
+        int(storey),
+        _mr_params(params),
+        law,
+        kk,
+    )
+    return ControlledResponse(u, v, f, cmd)
+
 
 # ---------------------------------------------------------------------------------------
 # Records.
@@ -658,6 +914,21 @@ __all__ = [
     "constant_ductility",
     "Estimate",
     "observe",
+    "MAX_DESIGN_STATES",
+    "MAX_CONTROL_INPUTS",
+    "zero_order_hold",
+    "Regulator",
+    "lqr",
+    "SENSED",
+    "OutputFeedback",
+    "lqg",
+    "DYKE_1996",
+    "MR_PARAMETERS",
+    "DamperResponse",
+    "mr_damper_response",
+    "MR_LAWS",
+    "ControlledResponse",
+    "mr_building",
     "read_at2",
     "read_column",
     "ida_stripes",

@@ -23,6 +23,10 @@ MAX_TRUNCATED_MODES: int
 MAX_SENSORS: int
 #: Rotation angles of RotD (180: 1° apart).
 ROTD_ANGLES: int
+#: Most states of a design model (``lqr``; with the delay, states + inputs).
+MAX_DESIGN_STATES: int
+#: Most control inputs of a design model (``zero_order_hold``, ``lqr``).
+MAX_CONTROL_INPUTS: int
 #: The names of the ``aemstep::Error`` variants, in declaration order.
 ERROR_VARIANTS: List[str]
 
@@ -204,6 +208,67 @@ def observe(
     Kalman-gain observer or full Kalman filter; process noise sigma_f (N, white forces
     on every floor), sensor noise sigma_y (m/s²). Returns (u m, v m/s, gain
     ``2n×sensors``, empty for the Kalman filter)."""
+
+def zero_order_hold(m: F64, c: F64, k: F64, b: F64, h: float) -> Tuple[F64, F64]:
+    """Exact sampled model of M u'' + C u' + K u = B f with f held over each step of h s
+    (x = [u; v]): (phi ``2n×2n``, gamma ``2n×inputs``, m/N and m/s/N)."""
+
+def lqr(
+    phi: F64,
+    gamma: F64,
+    q: F64,
+    r: F64,
+    s: F64,
+    decision: Optional[F64] = None,
+) -> Tuple[F64, F64, F64, float, int]:
+    """Discrete LQR of x' = phi x + gamma u for the cost Σ xᵀqx + 2xᵀsu + uᵀru, u = −K x;
+    with ``decision`` (``I×I``) on the model with the one-sample computation delay.
+    Returns (K, P, phi − gamma K, certified spectral-radius bound, doubling iterations)."""
+
+def lqg(
+    m: F64,
+    c: F64,
+    k: F64,
+    b: F64,
+    h: float,
+    sensors: List[int],
+    sensed: str,
+    q: F64,
+    r: float,
+    w: F64,
+    v: F64,
+) -> Tuple[F64, F64, F64, F64, float]:
+    """Gains of an LQG controller of a building with one control force b (``n``) sampled
+    at h s: the steady-state Kalman gain of its zero-order-hold model measuring ``sensed``
+    ("displacements", "velocities", "accelerations") at ``sensors``, noise covariances w
+    (``2n×2n``) and v, and the LQR gain for weights q (``2n×2n``), r. Returns (L
+    ``2n×sensors``, K ``1×2n``, filter covariance, regulator cost, radius bound)."""
+
+def mr_damper_response(
+    x: F64,
+    xdot: F64,
+    voltage: F64,
+    h: float,
+    params: List[float],
+) -> Tuple[F64, F64, F64]:
+    """Bouc–Wen MR damper (Dyke et al. 1996) driven by x (m), xdot (m/s) and a command
+    voltage (V, held over the following step), params (c0a, c0b, alpha_a, alpha_b, gamma,
+    beta, a, n, eta, v_max) in SI. Returns (force N, z m, filtered voltage V) per sample."""
+
+def mr_building(
+    m: F64,
+    c: F64,
+    k: F64,
+    ag: F64,
+    h: float,
+    storey: int,
+    params: List[float],
+    law: str,
+    gain: Optional[F64] = None,
+) -> Tuple[F64, F64, F64, F64]:
+    """Linear building with one MR damper in ``storey`` under ag (m/s²): law "off", "on"
+    or "clipped" (clipped-optimal on f_c = −gain·[u; v], gain ``1×2n``). Returns (u m,
+    v m/s, damper force N, command V held from each sample)."""
 
 def parse_at2(text: str) -> Tuple[str, float, F64]:
     """PEER NGA AT2 text parsed by ``aemstep::records``: (title, dt s, the NPTS values in

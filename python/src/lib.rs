@@ -17,6 +17,9 @@
 //! subclass of `AemstepError` (itself a `ValueError`), with the Rust `Display` as message;
 //! a step that fails sets the exception's `step` attribute to its index.
 //!
+//! Vibration control (`control.rs`): the zero-order-hold design model, the LQR, the MR
+//! damper and a building with one MR damper.
+//!
 //! Incremental dynamic analysis (`ida.rs`) runs the building of [`shear_building`] (its laws
 //! built by `laws.rs`) over many records and intensities; `records.rs` reads records.
 
@@ -1232,6 +1235,7 @@ fn observe<'py>(
 }
 
 // Sections in their own files (after the macros above, which they use).
+mod control;
 mod ida;
 mod laws;
 mod records;
@@ -1254,5 +1258,6 @@ fn _aemstep(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(observe, m)?)?;
     records::register(m)?;
     ida::register(m)?;
+    control::register(m)?;
     Ok(())
 }

@@ -12,7 +12,7 @@
 //! `common.rs` the decoder (`Bytes`), the counters, the independent references and the
 //! checks several targets share; each fuzz target `fuzz_targets/<t>.rs` has its checks in
 //! `<t>.rs` here (`linear_family`, `modal`, `nonlinear`, `hysteresis`, `observer`,
-//! `spectrum`, `estimation`, `detection`, `hybrid`), each starting with a line saying what it checks.
+//! `spectrum`, `estimation`, `detection`, `hybrid`, `control`), each starting with a line saying what it checks.
 //!
 //! Properties (as `tests/properties.rs`, over much more varied data):
 //! - never a panic (a panic aborts the fuzzer: a crash);
@@ -33,7 +33,11 @@
 //!   `KrAlpha`'s with the load `p0 − r0`, `command` is the `u` a successful `complete`
 //!   commits, `complete` is the scheme's step with the load `p − r` bit for bit, and a
 //!   failed `complete` (`NonFiniteForce`, `NonFiniteInput`, `NonFiniteState`) changes
-//!   nothing.
+//!   nothing;
+//! - the control family (`control`): a failed controller step, command or coupled
+//!   structure–damper step changes nothing; an `Lqr` that is `Ok` is finite with its
+//!   closed loop's spectral radius within the certified bound; the clipped-optimal law
+//!   is its sign rule.
 //!
 //! Every property break panics with a message starting `property broken:`.
 #![allow(
@@ -54,6 +58,7 @@ macro_rules! check {
 }
 
 mod common;
+mod control;
 mod detection;
 mod estimation;
 mod hybrid;
@@ -68,6 +73,7 @@ mod spectrum;
 // re-exports all of it); the replay test uses only `run` and `TARGETS`.
 #[allow(unused_imports)]
 pub use common::{Bytes, SpdInfo, System, context, count, count_lines, counts, spd_info};
+pub use control::control;
 pub use detection::detection;
 pub use estimation::estimation;
 pub use hybrid::hybrid;
@@ -79,7 +85,7 @@ pub use observer::observer;
 pub use spectrum::spectrum;
 
 /// The fuzz targets, in the order of the docs table.
-pub const TARGETS: [&str; 9] = [
+pub const TARGETS: [&str; 10] = [
     "linear_family",
     "modal",
     "nonlinear",
@@ -89,6 +95,7 @@ pub const TARGETS: [&str; 9] = [
     "estimation",
     "detection",
     "hybrid",
+    "control",
 ];
 
 /// Run the checks of `target` on one input. Panics when a property breaks.
@@ -103,6 +110,7 @@ pub fn run(target: &str, data: &[u8]) {
         "estimation" => estimation(data),
         "detection" => detection(data),
         "hybrid" => hybrid(data),
+        "control" => control(data),
         _ => panic!("unknown fuzz target {target}"),
     }
 }
