@@ -70,7 +70,7 @@ pub const STRUCTURE: Structure = Structure {
 
 /// The Bouc–Wen damper of Dyke et al. (1996), SI: `αa = 1.0872e5 N/m`,
 /// `αb = 4.9616e5 N/(m·V)`, `c₀a = 4.40 N·s/m`, `c₀b = 44.0 N·s/(m·V)`, `n = 1`, `A = 1.2`,
-/// `γ = β = 300 m⁻²`, `η = 50 s⁻¹`, `V_max = 2.25 V`. Quoted by the literature citing the
+/// `γ = β = 300 m⁻¹`, `η = 50 s⁻¹`, `V_max = 2.25 V`. Quoted by the literature citing the
 /// paper; corroborated as stated in `docs/control-benchmark-data.md` (a public MATLAB
 /// script with the same `A`, `n`, `γ`, `β`, `η`, for a 10× larger damper); not read from
 /// the paper's text.

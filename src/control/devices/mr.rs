@@ -59,8 +59,9 @@ pub struct MrParameters {
 impl MrParameters {
     /// The Bouc–Wen damper of Dyke, Spencer, Sain & Carlson (1996), SI:
     /// `α_a = 1.0872e5 N/m`, `α_b = 4.9616e5 N/(m·V)`, `c₀a = 4.40 N·s/m`,
-    /// `c₀b = 44.0 N·s/(m·V)`, `n = 1`, `A = 1.2`, `γ = β = 300 m⁻²`, `η = 50 s⁻¹`,
-    /// `V_max = 2.25 V`.
+    /// `c₀b = 44.0 N·s/(m·V)`, `n = 1`, `A = 1.2`, `γ = β = 300 m⁻¹`, `η = 50 s⁻¹`,
+    /// `V_max = 2.25 V` (`γ`, `β` per metre: with `n = 1`, `γ |ẋ| z` is a rate of `z`, a
+    /// length; often printed m⁻²).
     ///
     /// Provenance: quoted by the literature citing the paper; corroborated as stated in
     /// `docs/control-benchmark-data.md` (a public script that names the paper as its
