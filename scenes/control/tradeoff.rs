@@ -44,6 +44,11 @@ pub const RECOVERY: f64 = 0.2;
 pub const QY: f64 = 1.0;
 /// The chosen design's force weight `R` (1/MN²).
 pub const R_CHOSEN: f64 = 3.0e-4;
+/// The sweep of the force weight `R` (1/MN²), lightest control last: the page's
+/// trade-off table, and the designs `tests/control_lqr.rs` certifies in other units.
+pub const SWEEP: [f64; 10] = [
+    3.0e-5, 1.0e-4, 2.0e-4, 3.0e-4, 5.0e-4, 1.0e-3, 2.0e-3, 5.0e-3, 1.0e-2, 1.0e-1,
+];
 /// The decision weight on the delayed model, relative to `R`.
 pub const DECISION: f64 = 1.0e-3;
 /// The record's sample interval (s).

@@ -26,10 +26,6 @@ use aemstep::control::Controller;
 /// The test file whose `page_example` is the page's opening code.
 const EXAMPLE: &str = include_str!("../../../tests/control_tradeoff.rs");
 
-/// The sweep of the force weight `R` (1/MN²), lightest control last.
-const SWEEP: [f64; 10] = [
-    3.0e-5, 1.0e-4, 2.0e-4, 3.0e-4, 5.0e-4, 1.0e-3, 2.0e-3, 5.0e-3, 1.0e-2, 1.0e-1,
-];
 /// A heavier design for the rate table (1/MN²).
 const R_HEAVY: f64 = 3.0e-5;
 /// Controller rates (Hz).
@@ -70,7 +66,7 @@ fn refused_in_newtons(
     ))?;
     let delayed = model.delayed::<11>()?;
     let mut refused = 0;
-    for &r in &SWEEP {
+    for &r in &scene::SWEEP {
         let rn = r / (scene::FORCE_UNIT * scene::FORCE_UNIT);
         let w = Weights::outputs(&drifts, &aemstep::models::diagonal([scene::QY; 5]), &[[rn]]);
         match Lqr::from_parts(&delayed, &w.delayed(&[[scene::DECISION * rn]])?) {
@@ -166,7 +162,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         scene::GROUND_SIGMA,
         scene::RECOVERY,
         refused_in_newtons(&ss)?,
-        SWEEP.len()
+        scene::SWEEP.len()
     )?;
     writeln!(
         w,
@@ -243,7 +239,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     writeln!(w, "|{}", " --- |".repeat(15))?;
     // (R, J1, J3, every plant stable) of each design, for the summary.
     let mut curve = Vec::new();
-    for &r in &SWEEP {
+    for &r in &scene::SWEEP {
         let d = scene::design::<10, 11>(&ss, &ssg, r, true)?;
         let c = scene::controller::<f64, 10, 11>(&ss, &d)?;
         let rho = [0.9, 1.0, 1.1].map(|s| scene::closed_loop_radius(s, H, &ss, &d));
