@@ -25,9 +25,9 @@ pub const WEIGHT: f64 = 5.0 * models::FIVE_STOREY_MASS * G;
 /// The actuator's force limit (N): 50 % of the weight.
 pub const LIMIT: f64 = 0.5 * WEIGHT;
 /// The unit of force of the control loop (N): the models' input, the controller's
-/// measured force and command are in MN. In newtons the delayed state `[x; f]` mixes
-/// metres with 10⁵ N, and the regulator's closed-loop certificate (`Aᵀ X A − X = −I`, not
-/// invariant under a change of units) refuses loops it accepts in MN.
+/// measured force and command are in MN, and the weights and noise per MN. The
+/// regulator's closed-loop certificate gives the same verdict in newtons
+/// (`tests/control_lqr.rs`, `certificate_is_independent_of_units`).
 pub const FORCE_UNIT: f64 = 1.0e6;
 /// The accelerometers: absolute accelerations of floors 1, 3 and 5 (0-based DOFs).
 pub const SENSORS: [usize; O] = [0, 2, 4];

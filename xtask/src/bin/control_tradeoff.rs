@@ -49,10 +49,10 @@ fn example() -> String {
     out.trim_end().to_string() + "\n"
 }
 
-/// How many designs of the sweep the regulator's certificate refuses with the force in
+/// How many designs of the sweep the regulator's certificate accepts with the force in
 /// newtons: the same model and weights as the scene's, the force unit changed (`Γ/10⁶`,
 /// `R/10¹²`).
-fn refused_in_newtons(
+fn certified_in_newtons(
     ss: &aemstep::observer::StateSpace<5, 10, 1>,
 ) -> Result<usize, aemstep::Error> {
     use aemstep::control::{DesignModel, Lqr, Weights};
@@ -65,17 +65,17 @@ fn refused_in_newtons(
         aemstep::models::storey_drifts::<5>(),
     ))?;
     let delayed = model.delayed::<11>()?;
-    let mut refused = 0;
+    let mut certified = 0;
     for &r in &scene::SWEEP {
         let rn = r / (scene::FORCE_UNIT * scene::FORCE_UNIT);
         let w = Weights::outputs(&drifts, &aemstep::models::diagonal([scene::QY; 5]), &[[rn]]);
         match Lqr::from_parts(&delayed, &w.delayed(&[[scene::DECISION * rn]])?) {
-            Err(aemstep::Error::NotStabilizing) => refused += 1,
+            Err(aemstep::Error::NotStabilizing) => {}
             Err(e) => return Err(e),
-            Ok(_) => {}
+            Ok(_) => certified += 1,
         }
     }
-    Ok(refused)
+    Ok(certified)
 }
 
 /// `J1 … J10` formatted as table cells.
@@ -155,13 +155,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          (1/MN²), on the delayed model (`DesignModel::delayed`, the command as computed \
          weighted by 10⁻³ R); the observer's gain for the ground acceleration \
          (σ = {} m/s²) as process noise, plus a recovery noise of {} MN in the actuator's \
-         direction (Doyle & Stein 1979). Forces in MN: in newtons the regulator's \
-         closed-loop certificate (`Aᵀ X A − X = −I`, which is not invariant under a change \
-         of units) refuses {} of the {} designs of the sweep below (`Error::NotStabilizing`) \
-         that it certifies in MN.",
+         direction (Doyle & Stein 1979). Forces in MN, the weights per MN²; the \
+         regulator's closed-loop certificate (`Lqr::radius_bound`, on the loop balanced by \
+         a diagonal similarity) does not depend on the unit: with the force in newtons it \
+         certifies {} of the {} designs of the sweep below, as in MN.",
         scene::GROUND_SIGMA,
         scene::RECOVERY,
-        refused_in_newtons(&ss)?,
+        certified_in_newtons(&ss)?,
         scene::SWEEP.len()
     )?;
     writeln!(
