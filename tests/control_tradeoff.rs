@@ -29,8 +29,7 @@ fn page_example() -> Result<aemstep::control::Controller<f32, 10, 1, 3>, Error> 
     use aemstep::vector;
 
     // The 5-storey building (kg, N·s/m, N/m); an ideal actuator between the ground and
-    // floor 1, its force in MN (the unit keeps the regulator's certificate well scaled);
-    // the controller at 200 Hz.
+    // floor 1, its force in MN (the weights below are per MN²); the controller at 200 Hz.
     let (m, c, k) = models::five_storey_building();
     let h = 0.005;
     let mat = |r| models::matrix_of::<f64, 5>(&r);

@@ -25,9 +25,9 @@ pub const WEIGHT: f64 = 5.0 * models::FIVE_STOREY_MASS * G;
 /// The actuator's force limit (N): 50 % of the weight.
 pub const LIMIT: f64 = 0.5 * WEIGHT;
 /// The unit of force of the control loop (N): the models' input, the controller's
-/// measured force and command are in MN. In newtons the delayed state `[x; f]` mixes
-/// metres with 10⁵ N, and the regulator's closed-loop certificate (`Aᵀ X A − X = −I`, not
-/// invariant under a change of units) refuses loops it accepts in MN.
+/// measured force and command are in MN, and the weights and noise per MN. The
+/// regulator's closed-loop certificate gives the same verdict in newtons
+/// (`tests/control_lqr.rs`, `certificate_is_independent_of_units`).
 pub const FORCE_UNIT: f64 = 1.0e6;
 /// The accelerometers: absolute accelerations of floors 1, 3 and 5 (0-based DOFs).
 pub const SENSORS: [usize; O] = [0, 2, 4];
@@ -44,6 +44,11 @@ pub const RECOVERY: f64 = 0.2;
 pub const QY: f64 = 1.0;
 /// The chosen design's force weight `R` (1/MN²).
 pub const R_CHOSEN: f64 = 3.0e-4;
+/// The sweep of the force weight `R` (1/MN²), lightest control last: the page's
+/// trade-off table, and the designs `tests/control_lqr.rs` certifies in other units.
+pub const SWEEP: [f64; 10] = [
+    3.0e-5, 1.0e-4, 2.0e-4, 3.0e-4, 5.0e-4, 1.0e-3, 2.0e-3, 5.0e-3, 1.0e-2, 1.0e-1,
+];
 /// The decision weight on the delayed model, relative to `R`.
 pub const DECISION: f64 = 1.0e-3;
 /// The record's sample interval (s).

@@ -67,8 +67,8 @@ use crate::linalg::{
     Mat, add_scaled, all_finite, identity, max_abs, mul, put, rows_f64, scaled, sqrt, transpose,
 };
 use crate::observer::{
-    Measurement, StateSpace, SteadyState, abs_of, bare_model, definite_lu, inf_norm, is_covariance,
-    stein, symmetrize,
+    Measurement, StateSpace, SteadyState, abs_of, balance, bare_model, definite_lu, inf_norm,
+    is_covariance, stein, symmetrize,
 };
 use crate::{Error, Param};
 
@@ -116,6 +116,51 @@ impl<const S: usize, const I: usize> DesignModel<S, I> {
         let mut gamma = [[0.0; I]; Z];
         put(&mut gamma, &identity::<I>(), S, 0);
         Ok(DesignModel { phi, gamma })
+    }
+}
+
+impl<const S: usize, const I: usize> DesignModel<S, I> {
+    /// A certified upper bound (`< 1`) on the spectral radius of the closed loop
+    /// `Φ − Γ K` of the state feedback `u = −K x` (`gain`: `K`, `I×S`, input units per
+    /// state unit), for any gain: the certificate [`Lqr::from_parts`] applies to its own
+    /// (method there). It does not depend on the units: a diagonal scaling of the state
+    /// and a scaling of the input (`Γ` and `K` scaled inversely) give the same verdict and
+    /// bounds within the bisection's resolution (`2^-30` relative) of each other and of the
+    /// spectral radius (`tests/control_lqr.rs`: newtons, kN, MN; metres and millimetres).
+    /// `const fn`.
+    ///
+    /// ```
+    /// use aemstep::control::DesignModel;
+    /// use aemstep::Error;
+    /// // A double integrator sampled at h = 0.1 s (position, velocity; force per unit mass).
+    /// let plant = DesignModel { phi: [[1.0, 0.1], [0.0, 1.0]], gamma: [[0.005], [0.1]] };
+    /// // A gain placing the poles at 0.9 ± 0.1i (|λ| = √0.82 = 0.905539), and the same
+    /// // gain with its sign flipped (poles outside the unit circle).
+    /// let rho = plant.radius_bound(&[[2.0, 1.9]])?;
+    /// assert!(rho >= 0.82f64.sqrt() && rho < 0.905540);
+    /// assert_eq!(plant.radius_bound(&[[-2.0, -1.9]]), Err(Error::NotStabilizing));
+    /// # Ok::<(), aemstep::Error>(())
+    /// ```
+    ///
+    /// Errors: [`Error::NonFiniteInput`] (`Φ`, `Γ` or `K` not finite),
+    /// [`Error::OperatorOverflow`] (`Φ − Γ K` not finite), [`Error::NotStabilizing`] (not
+    /// certified: a spectral radius at or above 1, or within rounding of it).
+    ///
+    /// Cost: `S²·I` flops for the closed loop and as much for its rounding bound, then
+    /// the certificate's (in [`Lqr::from_parts`]: up to 41 Lyapunov certificates of about
+    /// `3 S³` flops a squaring and `10 S³` more each).
+    pub const fn radius_bound(&self, gain: &[[f64; S]; I]) -> Result<f64, Error> {
+        if !(all_finite(&self.phi) && all_finite(&self.gamma) && all_finite(gain)) {
+            return Err(Error::NonFiniteInput);
+        }
+        let a = closed_loop(&self.phi, &self.gamma, gain);
+        if !all_finite(&a) {
+            return Err(Error::OperatorOverflow);
+        }
+        match certified_radius(&self.phi, &self.gamma, gain, &a) {
+            Some(b) => Ok(b),
+            None => Err(Error::NotStabilizing),
+        }
     }
 }
 
@@ -305,7 +350,8 @@ impl<const S: usize, const I: usize> Weights<S, I> {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Lqr<const S: usize, const I: usize> {
     /// A certified upper bound on the spectral radius of `Φ − Γ K` (`< 1`), from the
-    /// Lyapunov certificate ([`Lqr::from_parts`]).
+    /// Lyapunov certificate ([`Lqr::from_parts`], [`DesignModel::radius_bound`]): within
+    /// `2^-30` (relative) of it, in any units.
     pub radius_bound: f64,
     /// Doubling iterations the Riccati solver took.
     pub iterations: u32,
@@ -342,16 +388,26 @@ impl<const S: usize, const I: usize> Lqr<S, I> {
     /// The cross weight is taken out (`Φ̄ = Φ − Γ R⁻¹ Sᵀ`, `Q̄ = Q − S R⁻¹ Sᵀ`) and the
     /// equation handed, as the dual of the filter's, to the observer's doubling solver
     /// [`SteadyState::from_parts`] (which refines and verifies its solution). The closed
-    /// loop `A = Φ − Γ K` of the gain formed here is then certified: the Stein equation
-    /// `Aᵀ X A − X = −I` solved ([`SteadyState`]'s doubling), `X` shown positive definite
-    /// by a Cholesky factorization of `X − δI` (`δ = 2(S+1)² ε ‖X‖∞`, which covers the
-    /// factorization's rounding), and the residual `E = Aᵀ X A − X + I` bounded with the
-    /// rounding of its own evaluation (`e = ‖E‖_F + (2S+4) ε ‖|A|ᵀ|X||A| + |X| + I‖_F`).
-    /// For an eigenvector `A v = λ v`, `(|λ|² − 1) v*Xv = −v*(I − E)v`, so every
-    /// `|λ|² ≤ 1 − (1 − e)/‖X‖∞`. That is loose where `X` is large (a lightly damped
-    /// loop), so the same certificate of `A/β` (`ρ(A) ≤ β ρ(A/β)`) is bisected on `β` 12
-    /// times: [`Lqr::radius_bound`], within about `2^-12` of the spectral radius
-    /// (`tests/control_lqr.rs`: `0.997067` for `0.997063`).
+    /// loop `Φ − Γ K` of the gain formed here is then certified, in coordinates that do
+    /// not depend on the units of the state or of the input ([`DesignModel::radius_bound`]):
+    /// its rounded form `A` balanced by a diagonal similarity of powers of two
+    /// (`B = D⁻¹ A D`, exact; LAPACK's `gebal` rule), the rounding of `A`'s formation bounded
+    /// entrywise by `F = (I + 2) ε (|Φ| + |Γ||K|)` (invariant too) and scaled with it. For
+    /// `B/β`: the Stein equation `Bᵀ X B − X = −I` solved ([`SteadyState`]'s doubling), `X`
+    /// shown positive definite by a Cholesky factorization of `X − δI`
+    /// (`δ = 2(S+1)² ε ‖X‖∞`, which covers the factorization's rounding), and the residual
+    /// `E = Bᵀ X B − X + I` bounded with the rounding of its own evaluation and with `F`'s
+    /// share (`e = ‖E‖_F + (2S+7) ε ‖|B|ᵀ|X||B| + |X| + I‖_F + ‖Fᵀ|X|(|B| + F)‖_F +
+    /// ‖|B|ᵀ|X|F‖_F`). For an eigenvector `B v = λ v`, `(|λ|² − 1) v*Xv = −v*(I − E)v`, so
+    /// every `|λ|² ≤ 1 − (1 − e)/‖X‖∞`. That is loose where `X` is large (a lightly damped
+    /// loop), so the certificate of `B/β` (`ρ(A) ≤ β ρ(B/β)`) is bisected on `β` until the
+    /// bracket is `2^-30` of its top (at most 40 times): [`Lqr::radius_bound`], within that
+    /// resolution of the spectral radius (`tests/control_lqr.rs`: `2.6e-10` above `0.997063`;
+    /// on the 5-storey designs of `docs/control-tradeoff.md`, at most `4.3e-10` above, with
+    /// the force in N, kN or MN and the state in m or mm). Balancing is what makes it
+    /// independent of units: on `A` itself, with the force in newtons, the Stein solution is
+    /// dominated by the force's entry and its rounding swamped the metres' part (9 of the 10
+    /// designs of that sweep were refused).
     ///
     /// Errors: [`Error::NonFiniteInput`] (a non-finite `Φ`, `Γ` or weight);
     /// [`Error::InvalidParameter`]`(`[`Param::Weight`]`)` (`Q` not symmetric positive
@@ -364,9 +420,9 @@ impl<const S: usize, const I: usize> Lqr<S, I> {
     ///
     /// Cost: that of [`SteadyState::from_parts`] for `S` states and `I` outputs (about
     /// `10 S³` flops a doubling iteration, 10–25 iterations, plus its verification), the
-    /// gain (`S²·I + S·I² + I³`), and up to 13 certificates (each `3 S³` flops a squaring
-    /// of the scaled closed loop, about `log₂(1/(1 − ρ/β))` of them, and `4 S³` for the
-    /// residual and the factorization).
+    /// gain (`S²·I + S·I² + I³`), and up to 41 certificates (each `3 S³` flops a squaring
+    /// of the scaled closed loop, about `log₂(20/(1 − ρ/β))` of them, up to 64, and
+    /// `10 S³` for the residual, its bounds and the factorization).
     pub const fn from_parts(
         model: &DesignModel<S, I>,
         weights: &Weights<S, I>,
@@ -411,11 +467,11 @@ impl<const S: usize, const I: usize> Lqr<S, I> {
             None => return Err(Error::RiccatiNotConverged),
         };
         let gain = lu_m.solve(&add_scaled(&mul(&gtp, phi), 1.0, &transpose(s)));
-        let closed_loop = add_scaled(phi, -1.0, &mul(gamma, &gain));
+        let closed_loop = closed_loop(phi, gamma, &gain);
         if !(all_finite(&gain) && all_finite(&closed_loop)) {
             return Err(Error::OperatorOverflow);
         }
-        let radius_bound = match certified_radius(&closed_loop) {
+        let radius_bound = match certified_radius(phi, gamma, &gain, &closed_loop) {
             Some(b) => b,
             None => return Err(Error::NotStabilizing),
         };
@@ -470,32 +526,81 @@ impl<const S: usize, const I: usize> Lqr<S, I> {
     }
 }
 
-/// Bisections of [`certified_radius`]'s tightening.
-const RADIUS_BISECTIONS: u32 = 12;
+/// The closed loop `Φ − Γ K`, formed as `Φ − (Γ K)` (the order [`certified_radius`]'s
+/// rounding bound assumes). Cost: `S²·I` multiply-adds.
+const fn closed_loop<const S: usize, const I: usize>(
+    phi: &Mat<S, S>,
+    gamma: &Mat<S, I>,
+    gain: &Mat<I, S>,
+) -> Mat<S, S> {
+    add_scaled(phi, -1.0, &mul(gamma, gain))
+}
 
-/// A certified upper bound on the spectral radius of `a` below 1, or `None` (the
-/// Lyapunov certificate of [`Lqr::from_parts`], [`lyapunov_bound`]). The certificate of
-/// `a` itself bounds `ρ² ≤ 1 − 1/λ_max(X)`, loose where `X` is large; it is tightened by
-/// certifying `a/β` (`ρ(a) ≤ β ρ(a/β)`) for `β` bisected between 0 and the first bound,
-/// [`RADIUS_BISECTIONS`] times, keeping the smallest certified bound (within about
-/// `2^-12` of the spectral radius, plus the certificate's own slack). Cost: up to 13
-/// certificates.
-pub(crate) const fn certified_radius<const N: usize>(a: &Mat<N, N>) -> Option<f64> {
-    let mut best = match lyapunov_bound(a, 1.0) {
-        Some(b) => b,
+/// Most bisections of [`certified_radius`]'s tightening.
+const RADIUS_BISECTIONS: u32 = 40;
+
+/// [`certified_radius`] stops bisecting once its bracket on `β` is narrower than this
+/// fraction of its upper end (`2^-30`).
+const RADIUS_RESOLUTION: f64 = 9.313225746154785e-10;
+
+/// A certified upper bound below 1 on the spectral radius of the closed loop
+/// `Φ − Γ K` (exact, of the stored `Φ`, `Γ`, `K`), whose rounded form is `a` (formed
+/// as `Φ − (Γ K)`), or `None`.
+///
+/// Three steps make it independent of the units of the state and of the input (a
+/// diagonal similarity `T (Φ − Γ K) T⁻¹` has the same spectrum; scaling the input scales
+/// `Γ` and `K` inversely):
+///
+/// 1. The rounding of `a`'s formation, entrywise: `|a − (Φ − Γ K)| ≤ (I + 2) ε (|Φ| + |Γ||K|)`
+///    (a product of length `I` and a subtraction), a bound that is itself invariant
+///    (`|Γ s⁻¹||s K| = |Γ||K|`, and a state scaling is a similarity of it).
+/// 2. Balancing ([`balance`]): `B = D⁻¹ a D` with `D` powers of two, checked exact entry by
+///    entry (else `D = I`); the formation bound is scaled with it. In newtons the delayed
+///    model's state `[x; u_{k−1}]` mixes metres with 10⁵ N: the Stein solution of `a`
+///    itself is then dominated by the force's entry, its `δ` and its rounding swamp the
+///    metres' part, and the certificate failed for loops it certified in MN.
+/// 3. The Lyapunov certificate of `B/β` ([`lyapunov_bound`], `ρ(a) ≤ β ρ(B/β)`), first at
+///    `β = 1`, then with `β` bisected between 0 and the best bound so far until the bracket is
+///    narrower than [`RADIUS_RESOLUTION`] of its top or [`RADIUS_BISECTIONS`] are done,
+///    keeping the smallest certified bound: the bracket closes on the smallest `β` whose
+///    certificate rounding still allows, so the bound is within that rounding (and the
+///    resolution) of the spectral radius, whatever the units.
+///
+/// Cost: `S²·I` flops for the formation bound, `O(S²)` a balancing sweep, and up to 41
+/// certificates (each `3 S³` flops a squaring of the scaled closed loop, about
+/// `log₂(20/(1 − ρ/β))` of them, up to 64, and `10 S³` for the residual, its bounds and the
+/// factorization).
+pub(crate) const fn certified_radius<const S: usize, const I: usize>(
+    phi: &Mat<S, S>,
+    gamma: &Mat<S, I>,
+    gain: &Mat<I, S>,
+    a: &Mat<S, S>,
+) -> Option<f64> {
+    let size = add_scaled(&abs_of(phi), 1.0, &mul(&abs_of(gamma), &abs_of(gain)));
+    let form = scaled((I + 2) as f64 * f64::EPSILON, &size);
+    if !all_finite(&form) {
+        return None;
+    }
+    let (_, d) = balance(a);
+    let (b, f) = match (similar(a, &d), similar(&form, &d)) {
+        (Some(b), Some(f)) => (b, f),
+        _ => (*a, form),
+    };
+    let mut best = match lyapunov_bound(&b, &f, 1.0) {
+        Some(v) => v,
         None => return None,
     };
     let (mut lo, mut hi) = (0.0f64, best);
     let mut k = 0;
-    while k < RADIUS_BISECTIONS {
+    while k < RADIUS_BISECTIONS && hi - lo > RADIUS_RESOLUTION * hi {
         let mid = 0.5 * (lo + hi);
         if mid.is_nan() || mid <= 0.0 {
             break;
         }
-        match lyapunov_bound(a, mid) {
-            Some(b) => {
-                if b < best {
-                    best = b;
+        match lyapunov_bound(&b, &f, mid) {
+            Some(v) => {
+                if v < best {
+                    best = v;
                 }
                 hi = mid;
             }
@@ -506,15 +611,38 @@ pub(crate) const fn certified_radius<const N: usize>(a: &Mat<N, N>) -> Option<f6
     Some(best)
 }
 
-/// `β ρ_c`, `ρ_c` a certified bound below 1 on the spectral radius of `Ã = fl(a/β)`, or
-/// `None`: `Ãᵀ X Ã − X = −I` solved by doubling, `X` positive definite with margin (a
-/// Cholesky factorization of `X − δI`, `δ = 2(N+1)² ε ‖X‖∞`), the residual
-/// `E = Ãᵀ X Ã − X + I` bounded with the rounding of its evaluation and of `Ã` itself
-/// (`e = ‖E‖_F + (2N + 7) ε ‖|Ã|ᵀ|X||Ã| + |X| + I‖_F`); then every eigenvalue of `a/β`
-/// has `|λ|² ≤ 1 − (1 − e)/‖X‖∞`. Cost: about `3 N³` flops a squaring
-/// (`log₂(1/(1 − ρ/β))` of them) and `4 N³` more.
-const fn lyapunov_bound<const N: usize>(a: &Mat<N, N>, beta: f64) -> Option<f64> {
-    let a = scaled(1.0 / beta, a);
+/// `D⁻¹ a D` for `D = diag(d)` of powers of two, or `None` if an entry does not scale
+/// exactly (a result that is not finite, or subnormal and rounded). Cost: `2 N²` flops.
+const fn similar<const N: usize>(a: &Mat<N, N>, d: &[f64; N]) -> Option<Mat<N, N>> {
+    let mut b = *a;
+    let mut i = 0;
+    while i < N {
+        let mut j = 0;
+        while j < N {
+            let p = d[j] / d[i];
+            let x = a[i][j] * p;
+            if !(p.is_finite() && p > 0.0 && x.is_finite() && (x.is_normal() || x / p == a[i][j])) {
+                return None;
+            }
+            b[i][j] = x;
+            j += 1;
+        }
+        i += 1;
+    }
+    Some(b)
+}
+
+/// `β ρ_c`, `ρ_c` a certified bound below 1 on the spectral radius of `T/β`, where
+/// `|T − b| ≤ f` entrywise (`b` the balanced closed loop, `f` its formation bound), or
+/// `None`. With `Ã = fl(b/β)` and `F = f/β`: `Ãᵀ X Ã − X = −I` solved by doubling, `X`
+/// positive definite with margin (a Cholesky factorization of `X − δI`,
+/// `δ = 2(N+1)² ε ‖X‖∞`), the residual `E = Ãᵀ X Ã − X + I` bounded with the rounding of
+/// its evaluation and of `Ã` itself (`(2N + 7) ε ‖|Ã|ᵀ|X||Ã| + |X| + I‖_F`) and with the
+/// difference `T/β − Ã`'s share (`‖Fᵀ|X|(|Ã| + F)‖_F + ‖|Ã|ᵀ|X|F‖_F`): `e`. Then every
+/// eigenvalue of `T/β` has `|λ|² ≤ 1 − (1 − e)/‖X‖∞`. Cost: about `3 N³` flops a squaring
+/// (`log₂(20/(1 − ρ/β))` of them) and `10 N³` more.
+const fn lyapunov_bound<const N: usize>(b: &Mat<N, N>, f: &Mat<N, N>, beta: f64) -> Option<f64> {
+    let a = scaled(1.0 / beta, b);
     let at = transpose(&a);
     let id: Mat<N, N> = identity();
     // X = Ãᵀ X Ã + I.
@@ -544,9 +672,13 @@ const fn lyapunov_bound<const N: usize>(a: &Mat<N, N>, beta: f64) -> Option<f64>
         1.0,
         &id,
     );
+    // The formation's share: (Ã + Δ)ᵀ X (Ã + Δ) − Ãᵀ X Ã, |Δ| ≤ F.
+    let fs = scaled(1.0 / beta, f);
+    let fx = mul(&transpose(&fs), &xa);
+    let formation = frobenius(&mul(&fx, &add_scaled(&aa, 1.0, &fs))) + frobenius(&mul(&fx, &aa));
     let unit = (2 * N + 7) as f64 * eps;
-    let bound =
-        (frobenius(&e) + unit * frobenius(&size)) * (1.0 + 4.0 * ((N * N + 2) as f64) * eps);
+    let bound = (frobenius(&e) + unit * frobenius(&size) + formation)
+        * (1.0 + 4.0 * ((N * N + 2) as f64) * eps);
     if bound.is_nan() || bound >= 1.0 {
         return None;
     }

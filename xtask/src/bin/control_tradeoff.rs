@@ -26,10 +26,6 @@ use aemstep::control::Controller;
 /// The test file whose `page_example` is the page's opening code.
 const EXAMPLE: &str = include_str!("../../../tests/control_tradeoff.rs");
 
-/// The sweep of the force weight `R` (1/MN²), lightest control last.
-const SWEEP: [f64; 10] = [
-    3.0e-5, 1.0e-4, 2.0e-4, 3.0e-4, 5.0e-4, 1.0e-3, 2.0e-3, 5.0e-3, 1.0e-2, 1.0e-1,
-];
 /// A heavier design for the rate table (1/MN²).
 const R_HEAVY: f64 = 3.0e-5;
 /// Controller rates (Hz).
@@ -53,10 +49,10 @@ fn example() -> String {
     out.trim_end().to_string() + "\n"
 }
 
-/// How many designs of the sweep the regulator's certificate refuses with the force in
+/// How many designs of the sweep the regulator's certificate accepts with the force in
 /// newtons: the same model and weights as the scene's, the force unit changed (`Γ/10⁶`,
 /// `R/10¹²`).
-fn refused_in_newtons(
+fn certified_in_newtons(
     ss: &aemstep::observer::StateSpace<5, 10, 1>,
 ) -> Result<usize, aemstep::Error> {
     use aemstep::control::{DesignModel, Lqr, Weights};
@@ -69,17 +65,17 @@ fn refused_in_newtons(
         aemstep::models::storey_drifts::<5>(),
     ))?;
     let delayed = model.delayed::<11>()?;
-    let mut refused = 0;
-    for &r in &SWEEP {
+    let mut certified = 0;
+    for &r in &scene::SWEEP {
         let rn = r / (scene::FORCE_UNIT * scene::FORCE_UNIT);
         let w = Weights::outputs(&drifts, &aemstep::models::diagonal([scene::QY; 5]), &[[rn]]);
         match Lqr::from_parts(&delayed, &w.delayed(&[[scene::DECISION * rn]])?) {
-            Err(aemstep::Error::NotStabilizing) => refused += 1,
+            Err(aemstep::Error::NotStabilizing) => {}
             Err(e) => return Err(e),
-            Ok(_) => {}
+            Ok(_) => certified += 1,
         }
     }
-    Ok(refused)
+    Ok(certified)
 }
 
 /// `J1 … J10` formatted as table cells.
@@ -159,14 +155,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          (1/MN²), on the delayed model (`DesignModel::delayed`, the command as computed \
          weighted by 10⁻³ R); the observer's gain for the ground acceleration \
          (σ = {} m/s²) as process noise, plus a recovery noise of {} MN in the actuator's \
-         direction (Doyle & Stein 1979). Forces in MN: in newtons the regulator's \
-         closed-loop certificate (`Aᵀ X A − X = −I`, which is not invariant under a change \
-         of units) refuses {} of the {} designs of the sweep below (`Error::NotStabilizing`) \
-         that it certifies in MN.",
+         direction (Doyle & Stein 1979). Forces in MN, the weights per MN²; the \
+         regulator's closed-loop certificate (`Lqr::radius_bound`, on the loop balanced by \
+         a diagonal similarity) does not depend on the unit: with the force in newtons it \
+         certifies {} of the {} designs of the sweep below, as in MN.",
         scene::GROUND_SIGMA,
         scene::RECOVERY,
-        refused_in_newtons(&ss)?,
-        SWEEP.len()
+        certified_in_newtons(&ss)?,
+        scene::SWEEP.len()
     )?;
     writeln!(
         w,
@@ -243,7 +239,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     writeln!(w, "|{}", " --- |".repeat(15))?;
     // (R, J1, J3, every plant stable) of each design, for the summary.
     let mut curve = Vec::new();
-    for &r in &SWEEP {
+    for &r in &scene::SWEEP {
         let d = scene::design::<10, 11>(&ss, &ssg, r, true)?;
         let c = scene::controller::<f64, 10, 11>(&ss, &d)?;
         let rho = [0.9, 1.0, 1.1].map(|s| scene::closed_loop_radius(s, H, &ss, &d));
