@@ -54,7 +54,7 @@ TARGETS_ALL=(linear_family modal nonlinear hysteresis observer spectrum estimati
 # targets differ in cost per input by a factor of ten).
 declare -A RUNS=([linear_family]=30000 [modal]=300000 [nonlinear]=300000
     [hysteresis]=200000 [observer]=150000 [spectrum]=90000
-    [estimation]=90000 [detection]=220000 [hybrid]=120000 [control]=200000)
+    [estimation]=90000 [detection]=220000 [hybrid]=120000 [control]=400000)
 SECS=${FUZZ_SECONDS:-30}
 SEED=${FUZZ_SEED:-1}
 CAP=${FUZZ_CAP:-120}

@@ -675,3 +675,22 @@ fn unstable_hand_gain_is_refused_in_every_unit_system() {
     bad[0][3] = f64::NAN;
     assert_eq!(design.radius_bound(&bad), Err(Error::NonFiniteInput));
 }
+
+/// Found by the control fuzz target: a marginal loop (Φ = 1, an input 1e-17 strong) whose
+/// certified bound rounded up to 1.0000000000000002 was accepted; the bound is promised
+/// below 1, so it is refused.
+#[test]
+fn bound_that_rounds_up_to_one_is_refused() {
+    let model = DesignModel::<1, 1> {
+        phi: [[1.0]],
+        gamma: [[-8.985290527343751e-18]],
+    };
+    let w = Weights::new(&[[0.10941138105771858]], &[[1e-6]]);
+    match Lqr::from_parts(&model, &w) {
+        Ok(l) => panic!("accepted with radius bound {}", l.radius_bound),
+        Err(e) => assert!(
+            matches!(e, Error::NotStabilizing | Error::RiccatiNotConverged),
+            "{e:?}"
+        ),
+    }
+}

@@ -100,11 +100,11 @@ fn check_lqr<const S: usize, const I: usize>(what: &str, r: &Result<Lqr<S, I>, E
         finite,
         "{what}: Ok with a non-finite gain, cost or closed loop: {l:?}"
     );
-    // The documented contract (`Lqr::radius_bound`: `< 1`, else `NotStabilizing`). Open:
-    // seed 1 run past 200000 executions (at 280440) finds `Lqr::from_parts` Ok with a bound
-    // of 1.0000000000000002 for Φ = [[1]], Γ = [[-8.985290527343751e-18]],
-    // Q = [[0.10941138105771858]], R = [[1e-6]] (a marginal mode the input barely reaches:
-    // the closed loop is 1 in f64); reported on issue 33, to be fixed in src/control/lqr.rs.
+    // The documented contract (`Lqr::radius_bound`: `< 1`, else `NotStabilizing`). A seed-1
+    // run found `Lqr::from_parts` Ok with a bound of 1.0000000000000002 for Φ = [[1]],
+    // Γ = [[-8.985290527343751e-18]], Q = [[0.10941138105771858]], R = [[1e-6]] (a marginal
+    // mode the input barely reaches): fixed, kept in fuzz/regressions/control/ and
+    // tests/control_lqr.rs (`bound_that_rounds_up_to_one_is_refused`).
     check!(
         l.radius_bound >= 0.0 && l.radius_bound < 1.0,
         "{what}: radius bound {} outside [0, 1)",
