@@ -129,6 +129,9 @@ GENERATED = {
     # The MR-damper benchmark: 8 crate runs and 4 RK4 reference runs of the 17 s record
     # (under 1 s, release).
     "docs/control.md": dict(cmd=example("control_benchmark", "{dir}"), out="file"),
+    # The Python wheel (built by the Python stage before, so only checked here: seconds), its
+    # sizes, and its install and one call on every CPython 3.9+ of the machine (~15 s each).
+    "docs/wheel.md": dict(cmd=["bash", "scripts/wheel.sh", "--page", "{dir}"], out="file"),
     # The families, their files and the cores they stand on, read from src/ (under a second).
     "docs/layout.md": dict(cmd=["python3", "scripts/layout.py"], out="stdout"),
 }
