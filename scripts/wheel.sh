@@ -76,7 +76,8 @@ done
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 pythons=("$(command -v python3)")
-for p in "$HOME"/.pyenv/versions/3.*/bin/python3; do
+for d in $(ls -d "$HOME"/.pyenv/versions/3.* 2>/dev/null | sort -V); do
+    p=$d/bin/python3
     [ -x "$p" ] || continue
     "$p" -c 'import sys; sys.exit(sys.version_info < (3, 9))' 2>/dev/null || continue
     [ "$("$p" -c 'import sys; print(sys.version)')" = "$(python3 -c 'import sys; print(sys.version)')" ] ||
@@ -114,10 +115,11 @@ PyPI and pinned in the script). Generated page: \`python3 scripts/check_docs.py 
 it; the test command regenerates it and compares the sizes to one unit in their last digit; the
 install times are host timings (this machine), not compared.
 
-- The wheel: \`$(basename "$wheel")\`, $(mb "$wheel"); one file
-  for every CPython from 3.9 on (the stable ABI) on any x86-64 Linux with glibc 2.17 or later.
+- The wheel: \`$(basename "$wheel")\`,
+  $(mb "$wheel"); one file for every CPython from 3.9 on (the stable ABI) on any x86-64 Linux with glibc 2.17 or later.
 - The sdist: \`$(basename "$sdist")\`, $(mb "$sdist") (building it needs Rust).
-- \`auditwheel show\`: the wheel $verdict.
+- \`auditwheel show\`: the wheel
+  $verdict.
 - Installed from the wheel alone (\`pip install --no-index --find-links DIR aemstep\`) into a
   fresh virtual environment of each CPython this machine has, numpy already present and no
   cargo or rustc on PATH; then imported, and one call run (a free vibration checked against
@@ -127,7 +129,8 @@ install times are host timings (this machine), not compared.
 |---|---|
 ${rows}
 Before the package is on an index: \`bash scripts/wheel.sh\` builds the wheel into
-\`target/wheels/\` (once, with Rust), and \`pip install target/wheels/aemstep-*.whl\` installs it
-on any machine, no Rust needed; the test command does this in its Python stage.
+\`target/wheels/\` (\`\$CARGO_TARGET_DIR/wheels/\` if set; once, with Rust), and
+\`pip install target/wheels/aemstep-*.whl\` installs it on any machine, no Rust needed; the
+test command does this in its Python stage.
 PAGE
 echo "wrote $page/wheel.md"
