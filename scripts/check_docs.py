@@ -132,6 +132,9 @@ GENERATED = {
     # The LQG trade-off on the 5-storey building: about 35 designs and 50 runs of the
     # record at up to 2 kHz: about a second (release).
     "docs/control-tradeoff.md": dict(cmd=example("control_tradeoff", "{dir}"), out="file"),
+    # The Python wheel (built by the Python stage before, so only checked here: seconds), its
+    # sizes, and its install and one call on every CPython 3.9+ of the machine (~15 s each).
+    "docs/wheel.md": dict(cmd=["bash", "scripts/wheel.sh", "--page", "{dir}"], out="file"),
     # The families, their files and the cores they stand on, read from src/ (under a second).
     "docs/layout.md": dict(cmd=["python3", "scripts/layout.py"], out="stdout"),
 }

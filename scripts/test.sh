@@ -67,21 +67,40 @@ grep -q 'PGA (g)' "$out" && grep -q 'drift ratio (%)' "$out" && grep -q 'collaps
     fail "ida: intensity (g) against peak drift ratio (%), a collapse bracket (g) expected"
 rm -f "$out"
 
-step "the Python package: pip install ./python in a fresh virtual environment, pytest python/tests"
-# A clean environment every run (only the pip cache is shared); maturin builds the extension
-# (release) into this repository's target directory, so a later run reuses the build.
+step "the Python package: the manylinux wheel (scripts/wheel.sh) installed in a fresh virtual environment with no Rust on PATH, pytest python/tests"
+# The wheel a user installs, not a source build: scripts/wheel.sh builds it (abi3,
+# manylinux2014, checked by auditwheel) into the cargo target directory, so a later run reuses
+# the build. A clean environment every run (only the pip cache is shared).
 venv=$(mktemp -d)
-trap 'rm -f "$log"; rm -rf "$venv"' EXIT
+dist=$(mktemp -d)
+trap 'rm -f "$log"; rm -rf "$venv" "$dist"' EXIT
+CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}" bash scripts/wheel.sh "$dist" ||
+    fail "scripts/wheel.sh (the manylinux wheel and sdist of python/)"
 python3 -m venv "$venv" || fail "python3 -m venv (Debian: apt-get install python3-venv)"
 "$venv/bin/pip" install -q --upgrade "pip>=23" || fail "pip upgrade in the fresh venv"
 # dask[distributed] and tqdm: the cluster and progress-bar tests (optional at run time).
-"$venv/bin/pip" install -q "maturin>=1.5,<2" "numpy>=1.21" "pytest>=7" \
-    "dask[distributed]>=2023.1" "tqdm>=4.60" ||
-    fail "pip install maturin numpy pytest dask[distributed] tqdm"
-CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}" "$venv/bin/pip" install -q ./python ||
-    fail "pip install ./python (the maturin build of python/)"
+"$venv/bin/pip" install -q "numpy>=1.21" "pytest>=7" "dask[distributed]>=2023.1" "tqdm>=4.60" ||
+    fail "pip install numpy pytest dask[distributed] tqdm"
+# PATH without any directory holding cargo or rustc: the install and the tests see no Rust.
+norust="$venv/bin"
+IFS=: read -r -a dirs <<<"$PATH"
+for d in "${dirs[@]}"; do
+    [ -e "$d/cargo" ] || [ -e "$d/rustc" ] || norust="$norust:$d"
+done
+for tool in cargo rustc rustup; do
+    ! PATH="$norust" command -v "$tool" >/dev/null ||
+        fail "$tool is on the PATH of the wheel's environment: $(PATH="$norust" command -v "$tool")"
+done
+echo "no cargo, rustc or rustup on the environment's PATH"
+# From the wheel alone (--no-index: nothing downloaded, numpy already present), timed.
+t0=$(date +%s.%N)
+PATH="$norust" "$venv/bin/pip" install -q --no-index --find-links "$dist" aemstep ||
+    fail "pip install of the wheel with no Rust on PATH"
+t1=$(date +%s.%N)
+awk -v a="$t0" -v b="$t1" -v w="$(basename "$dist"/aemstep-*.whl)" -v n="$(stat -c %s "$dist"/aemstep-*.whl)" \
+    'BEGIN { printf "install time from the wheel: %.1f s (%s, %d bytes)\n", b - a, w, n }'
 pyout=$(mktemp)
-"$venv/bin/python" -m pytest python/tests -q -p no:cacheprovider 2>&1 | tee "$pyout" ||
+PATH="$norust" "$venv/bin/python" -m pytest python/tests -q -p no:cacheprovider 2>&1 | tee "$pyout" ||
     { rm -f "$pyout"; fail "pytest python/tests"; }
 # Its count in the total below, in the form the sum reads.
 awk '/ passed/ { p = 0; f = 0; for (i = 2; i <= NF; i++) { if ($i ~ /^passed/) p = $(i - 1);

@@ -54,19 +54,19 @@ pub const MAX_SENSORS: usize = 3;
 pub const ROTD_ANGLES: usize = 180;
 
 pyo3::create_exception!(
-    _aemstep,
+    aemstep,
     AemstepError,
     PyValueError,
     "Base of every aemstep error (a ValueError)."
 );
 pyo3::create_exception!(
-    _aemstep,
+    aemstep,
     ShapeError,
     AemstepError,
     "An array has the wrong shape or length for the call."
 );
 pyo3::create_exception!(
-    _aemstep,
+    aemstep,
     UnsupportedSize,
     ShapeError,
     "A number of degrees of freedom or sensors outside those compiled in."
@@ -74,10 +74,16 @@ pyo3::create_exception!(
 
 /// One Python exception per `aemstep::Error` variant, same name, subclass of
 /// `AemstepError`; `variants!` also writes the mapping and the registration.
+///
+/// Every class is created with module `aemstep` (not `_aemstep`) and re-exported there by
+/// `aemstep/__init__.py`, so pickle finds `aemstep.NotConverged` by that name: an error
+/// raised in a process pool or on a Dask worker reaches the caller with its class, and its
+/// attributes (`step`, `line`, `parameter`, set on the instance) travel in the instance
+/// `__dict__` that `BaseException.__reduce__` carries.
 macro_rules! variants {
     ($($name:ident),* $(,)?) => {
         $(pyo3::create_exception!(
-            _aemstep,
+            aemstep,
             $name,
             AemstepError,
             concat!("aemstep::Error::", stringify!($name), " (see the Rust docs).")
