@@ -221,6 +221,7 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Controller<T, S, I
     // Always inlined: a loop calls it once a sample, and the call's own entry, exit and
     // spills cost a few percent of the step.
     #[inline(always)]
+    #[must_use = "the output to hold from the next sample, or why the step was refused"]
     pub fn try_step(
         &self,
         state: &mut ControlState<T, S, I>,
@@ -387,38 +388,29 @@ mod tests {
     ) -> Result<Command<T, I>, Error> {
         let mut e = state.estimate;
         c.observer.try_step(&mut e, measured_force, y)?;
-        let mut u = [T::zero(); I];
-        let mut saturated = false;
-        let mut finite = true;
-        for (i, ui) in u.iter_mut().enumerate() {
-            let mut s = -T::zero();
-            for j in 0..S {
-                s -= c.gain_x[i][j] * e.x[j];
-            }
-            for j in 0..I {
-                s -= c.gain_u[i][j] * measured_force[j];
-            }
-            finite &= s.is_finite();
-            let lim = c.limit[i];
-            if s > lim {
-                s = lim;
-                saturated = true;
-            } else if s < -lim {
-                s = -lim;
-                saturated = true;
-            }
-            *ui = s;
-        }
-        if !finite {
+        // Each row summed from −0 in the order `try_step` sums it, checked, then clipped.
+        let sums: [T; I] = core::array::from_fn(|i| {
+            let s = (0..S).fold(-T::zero(), |s, j| s - c.gain_x[i][j] * e.x[j]);
+            (0..I).fold(s, |s, j| s - c.gain_u[i][j] * measured_force[j])
+        });
+        if !sums.iter().all(|s| s.is_finite()) {
             return Err(Error::NonFiniteState);
         }
-        let present = y.iter().all(|v| v.is_finite());
-        let status = if !present {
-            Status::MissingSample
-        } else if overrun {
-            Status::Overrun
-        } else {
-            Status::Computed
+        let saturated = sums.iter().zip(&c.limit).any(|(s, &lim)| s.abs() > lim);
+        let u: [T; I] = core::array::from_fn(|i| {
+            let (s, lim) = (sums[i], c.limit[i]);
+            if s > lim {
+                lim
+            } else if s < -lim {
+                -lim
+            } else {
+                s
+            }
+        });
+        let status = match (y.iter().all(|v| v.is_finite()), overrun) {
+            (false, _) => Status::MissingSample,
+            (true, true) => Status::Overrun,
+            (true, false) => Status::Computed,
         };
         let overruns = match state.overruns.checked_add(u64::from(overrun)) {
             Some(n) => n,
