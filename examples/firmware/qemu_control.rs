@@ -7,8 +7,9 @@
 //! floor accelerations and the damper's measured force, `Controller::try_step` (observer
 //! and regulator gain) gives the desired force, `ClippedOptimal` the voltage, held while
 //! the emulated structure and damper (`Coupled` + `Nonlinear`) advance one step. The
-//! controller's side is its own symbol (`qemu_control_step`: what a controller board runs;
-//! `scripts/qemu.sh` proves no panic reachable from it), the plant's is the test rig. At
+//! controller's side is its own symbol (`qemu_control_step`: what a controller board runs,
+//! its code and stack measured alone), the plant's another (`qemu_control_plant_step`: the
+//! test rig); `scripts/qemu.sh` proves no panic reachable from either. At
 //! `MISSING_STEP` the floor-1 accelerometer's sample is lost (NaN): the step must report
 //! it (`Status::MissingSample`) and hold the last safe output.
 //!
@@ -22,9 +23,9 @@
 //! <multiply-adds>`: `Controller::try_step`, 94 multiply-adds, `S² + 2S·I + 2S·O + O·I +
 //! S·I + I²` with `S = 6`, `I = 1`, `O = 3`) and its observer's update (`COST
 //! control-observer …`: `Observer::step`, the first four terms, 87); on the M4F the
-//! observer's update must stay within 3 instructions a multiply-add (the checked step
-//! around it adds its safety checks, reported beside it). Then
-//! two passes over the record. Counted: the instructions of every loop step
+//! whole checked step, its safety checks included, must stay within 3 instructions a
+//! multiply-add (issue 33's goal for the controller's matrix work). Then two passes over
+//! the record. Counted: the instructions of every loop step
 //! (`COST control <type> <mean> <max>`). Real time: SysTick fires every 1 ms, its handler
 //! steps the loop and sends the result through a `heapless::spsc::Queue`; the main loop
 //! checks every status and, every 50 ms, the floor-1 displacement against the host's f64
@@ -121,9 +122,11 @@ fn qemu_control_step(
 }
 
 /// The emulated structure and damper, one step (`Rig::advance`): the test rig, not the
-/// controller.
+/// controller. Out of line and unmangled so that `scripts/qemu.sh` walks its call graph
+/// too (no panic reachable).
+#[unsafe(no_mangle)]
 #[inline(never)]
-fn emulate_plant(rig: &Rig<F>, s: &mut Loop<F>, ag: F) -> Result<F, Error> {
+fn qemu_control_plant_step(rig: &Rig<F>, s: &mut Loop<F>, ag: F) -> Result<F, Error> {
     rig.advance(s, ag)
 }
 
@@ -133,7 +136,7 @@ fn emulate_plant(rig: &Rig<F>, s: &mut Loop<F>, ag: F) -> Result<F, Error> {
 fn loop_step(rig: &Rig<F>, s: &mut Loop<F>, ag: F, missing: bool) -> Result<Out<F>, Error> {
     let mut next = *s;
     let (command, voltage) = qemu_control_step(rig, &mut next, missing)?;
-    let x1 = emulate_plant(rig, &mut next, ag)?;
+    let x1 = qemu_control_plant_step(rig, &mut next, ag)?;
     *s = next;
     Ok(Out {
         command,
@@ -142,8 +145,8 @@ fn loop_step(rig: &Rig<F>, s: &mut Loop<F>, ag: F, missing: bool) -> Result<Out<
     })
 }
 
-/// The controller's step alone (observer, gain, saturation): what `COST control-matrix`
-/// counts.
+/// The controller's step alone (observer, gain, saturation, checks, status): what `COST
+/// control-step` counts.
 #[unsafe(no_mangle)]
 #[inline(never)]
 fn cost_step_controller(
@@ -290,20 +293,20 @@ fn main() -> ! {
         fail!("the counted controller refused a step");
     }
     cost("control-step", c, CONTROLLER_MADDS);
+    // The goal every stepper's matrix work meets on the M4F: at most 3 instructions per
+    // multiply-add, here for the whole checked step.
+    if cfg!(not(aemstep_fpu = "double")) && c > 30 * CONTROLLER_MADDS as u32 {
+        fail!(
+            "the controller's step: {}.{} instructions > 3 per multiply-add",
+            c / 10,
+            c % 10
+        );
+    }
     let mut e = *CTL.start_at_rest().estimate();
     let c = per_step(syst, 1000, |y, f| {
         cost_step_control_observer(black_box(CTL.observer()), black_box(&mut e), y, f)
     });
     cost("control-observer", c, OBSERVER_MADDS);
-    // The goal every stepper's matrix work meets on the M4F: at most 3 instructions per
-    // multiply-add.
-    if cfg!(not(aemstep_fpu = "double")) && c > 30 * OBSERVER_MADDS as u32 {
-        fail!(
-            "the controller's observer: {}.{} instructions a step > 3 per multiply-add",
-            c / 10,
-            c % 10
-        );
-    }
 
     let (rig, s0) = match Rig::new(&CTL, scene::ground(AG, 0)) {
         Ok(r) => r,

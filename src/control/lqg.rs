@@ -47,7 +47,7 @@ use nalgebra::{SMatrix, SVector};
 
 use crate::linalg::{self, all_finite, finite_as, round_rows, rows_f64};
 use crate::observer::{Estimate, Observer};
-use crate::{Error, Param, Real};
+use crate::{Error, Param, Real, StepState};
 
 /// Why the output is what it is ([`Command::status`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -218,6 +218,10 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Controller<T, S, I
     /// (`measured_force` not finite), [`Error::NonFiniteState`] (the estimate or the
     /// command would not be finite), [`Error::StepCountOverflow`]. Cost: fixed, as
     /// [`Controller`] states; no allocation, no panic.
+    // Always inlined: a loop calls it once a sample, and the call's own entry, exit and
+    // spills cost a few percent of the step.
+    #[inline(always)]
+    #[must_use = "the output to hold from the next sample, or why the step was refused"]
     pub fn try_step(
         &self,
         state: &mut ControlState<T, S, I>,
@@ -225,8 +229,22 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Controller<T, S, I
         measured_force: &SVector<T, I>,
         overrun: bool,
     ) -> Result<Command<T, I>, Error> {
-        let mut e = state.estimate;
-        self.observer.try_step(&mut e, measured_force, y)?;
+        // The observer's update on a copy, committed only if every check passes: the
+        // checks of `Observer::try_step`, each made once and none by a second scan. The
+        // observer adds 1 to its count of missing samples exactly when `y` has a
+        // non-finite entry, so the count's last bit tells whether the sample is present;
+        // the finiteness of the input and of the new estimate rides on the command's
+        // (below).
+        let est = state.estimate;
+        let mut e = est;
+        self.observer.step(&mut e, measured_force, y);
+        let present = (e.missing ^ est.missing) & 1 == 0;
+        // Room for one more step in the estimate's counters (`Observer::try_step`'s
+        // check): the count of missing samples never passes the step count (both start at
+        // 0, [`Controller::start_at_rest`], and only this step advances them), so room in
+        // the step count is room in both.
+        let counted = est.n != u64::MAX;
+        let overruns = state.overruns.checked_add(u64::from(overrun));
         let mut u = [T::zero(); I];
         let mut saturated = false;
         let mut finite = true;
@@ -238,21 +256,26 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Controller<T, S, I
             for j in 0..I {
                 s -= self.gain_u[i][j] * measured_force[j];
             }
-            finite &= s.is_finite();
+            // Within the limit: finite, kept. Beyond it: clipped if finite (NaN fails
+            // `|s| ≤ lim` too, and is refused below).
             let lim = self.limit[i];
-            if s > lim {
-                s = lim;
-                saturated = true;
-            } else if s < -lim {
-                s = -lim;
-                saturated = true;
+            let within = s.abs() <= lim;
+            saturated |= !within;
+            if !within {
+                finite &= s.is_finite();
+                s = if s > lim { lim } else { -lim };
             }
             *ui = s;
         }
-        if !finite {
-            return Err(Error::NonFiniteState);
-        }
-        let present = y.iter().all(|v| v.is_finite());
+        // Every `x̂_j` and every `f_j` enters row 0's sum through a finite gain (checked at
+        // construction), and a non-finite term (`±∞`, or NaN, also `0·∞`) leaves every
+        // IEEE sum it enters non-finite: a finite command proves a finite input and a
+        // finite estimate (`e.w` is the input). Without an input (`I = 0`, no sum) the
+        // estimate is scanned.
+        let finite = if I == 0 { e.is_finite() } else { finite };
+        let Some(overruns) = overruns.filter(|_| finite && counted) else {
+            return Err(self.refusal(measured_force, counted, finite));
+        };
         let status = if !present {
             Status::MissingSample
         } else if overrun {
@@ -260,23 +283,33 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Controller<T, S, I
         } else {
             Status::Computed
         };
-        let overruns = match state.overruns.checked_add(u64::from(overrun)) {
-            Some(n) => n,
-            None => return Err(Error::StepCountOverflow),
-        };
-        let output = if status == Status::Computed {
-            u
-        } else {
-            state.output
-        };
+        if status == Status::Computed {
+            state.output = u;
+        }
         state.estimate = e;
-        state.output = output;
         state.overruns = overruns;
         Ok(Command {
-            force: output,
+            force: state.output,
             saturated,
             status,
         })
+    }
+
+    /// Why [`Controller::try_step`] refuses a step, in the order of its checks: a
+    /// non-finite input, then no room in the estimate's counters, then a non-finite
+    /// estimate or command, then no room in the count of overruns. Off the step's path.
+    #[cold]
+    #[inline(never)]
+    fn refusal(&self, measured_force: &SVector<T, I>, counted: bool, finite: bool) -> Error {
+        if !measured_force.iter().all(|v| v.is_finite()) {
+            Error::NonFiniteInput
+        } else if !counted {
+            Error::StepCountOverflow
+        } else if !finite {
+            Error::NonFiniteState
+        } else {
+            Error::StepCountOverflow
+        }
     }
 }
 
@@ -336,3 +369,228 @@ macro_rules! const_ctor {
 }
 const_ctor!(f32, from_parts_f32);
 const_ctor!(f64, from_parts_f64);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::observer::{Outputs, StateSpace};
+
+    /// The step as it was before the overhead was cut (observer's checked step on a copy,
+    /// the command scanned, `y` scanned for the status): the specification the fused
+    /// step must match bit for bit, errors and all. A regression oracle, not an
+    /// independent derivation.
+    fn reference<T: Real, const S: usize, const I: usize, const O: usize>(
+        c: &Controller<T, S, I, O>,
+        state: &mut ControlState<T, S, I>,
+        y: &SVector<T, O>,
+        measured_force: &SVector<T, I>,
+        overrun: bool,
+    ) -> Result<Command<T, I>, Error> {
+        let mut e = state.estimate;
+        c.observer.try_step(&mut e, measured_force, y)?;
+        // Each row summed from −0 in the order `try_step` sums it, checked, then clipped.
+        let sums: [T; I] = core::array::from_fn(|i| {
+            let s = (0..S).fold(-T::zero(), |s, j| s - c.gain_x[i][j] * e.x[j]);
+            (0..I).fold(s, |s, j| s - c.gain_u[i][j] * measured_force[j])
+        });
+        if !sums.iter().all(|s| s.is_finite()) {
+            return Err(Error::NonFiniteState);
+        }
+        let saturated = sums.iter().zip(&c.limit).any(|(s, &lim)| s.abs() > lim);
+        let u: [T; I] = core::array::from_fn(|i| {
+            let (s, lim) = (sums[i], c.limit[i]);
+            if s > lim {
+                lim
+            } else if s < -lim {
+                -lim
+            } else {
+                s
+            }
+        });
+        let status = match (y.iter().all(|v| v.is_finite()), overrun) {
+            (false, _) => Status::MissingSample,
+            (true, true) => Status::Overrun,
+            (true, false) => Status::Computed,
+        };
+        let overruns = match state.overruns.checked_add(u64::from(overrun)) {
+            Some(n) => n,
+            None => return Err(Error::StepCountOverflow),
+        };
+        let output = if status == Status::Computed {
+            u
+        } else {
+            state.output
+        };
+        state.estimate = e;
+        state.output = output;
+        state.overruns = overruns;
+        Ok(Command {
+            force: output,
+            saturated,
+            status,
+        })
+    }
+
+    /// Every value of a state or a result as bits (`f64` widening is exact).
+    fn bits<T: Real>(v: impl IntoIterator<Item = T>) -> impl Iterator<Item = u64> {
+        v.into_iter().map(|x| x.as_f64().to_bits())
+    }
+
+    fn same_state<T: Real, const S: usize, const I: usize>(
+        a: &ControlState<T, S, I>,
+        b: &ControlState<T, S, I>,
+    ) -> bool {
+        bits(a.estimate.x.iter().copied()).eq(bits(b.estimate.x.iter().copied()))
+            && bits(a.estimate.w.iter().copied()).eq(bits(b.estimate.w.iter().copied()))
+            && bits(a.output).eq(bits(b.output))
+            && (a.estimate.n, a.estimate.missing, a.overruns)
+                == (b.estimate.n, b.estimate.missing, b.overruns)
+    }
+
+    fn same_result<T: Real, const I: usize>(
+        a: &Result<Command<T, I>, Error>,
+        b: &Result<Command<T, I>, Error>,
+    ) -> bool {
+        match (a, b) {
+            (Ok(a), Ok(b)) => {
+                bits(a.force).eq(bits(b.force))
+                    && (a.saturated, a.status) == (b.saturated, b.status)
+            }
+            (Err(a), Err(b)) => a == b,
+            _ => false,
+        }
+    }
+
+    /// Values that exercise every branch: ordinary, beyond the limit, overflowing the
+    /// estimate, not finite.
+    fn pick<T: Real>(r: u64, scale: f64) -> T {
+        let v = match r % 16 {
+            0 => f64::NAN,
+            1 => f64::INFINITY,
+            2 => f64::NEG_INFINITY,
+            3 => 1.0e30,
+            4 => -T::MAX.as_f64(),
+            5 => 0.0,
+            6 => -0.0,
+            k => scale * (k as f64 - 11.0),
+        };
+        T::from_f64_rounded(v)
+    }
+
+    /// Runs the fused step and the reference side by side from the same states over a
+    /// pseudo-random sweep of inputs and starting counters, and counts the outcomes
+    /// (each must occur, or the sweep proves nothing).
+    fn sweep<T: Real, const S: usize, const I: usize, const O: usize>(
+        c: &Controller<T, S, I, O>,
+        rare: u32,
+    ) -> [u32; 5] {
+        let mut seen = [0u32; 5];
+        let mut r: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = || {
+            r ^= r << 13;
+            r ^= r >> 7;
+            r ^= r << 17;
+            r
+        };
+        let mut run = c.start_at_rest();
+        for k in 0..20_000u32 {
+            // Bad values rarely, so the runs also go long between refusals.
+            let mut draw = |scale| {
+                let v = next();
+                if v % u64::from(rare) == 0 {
+                    pick::<T>(v >> 8, scale)
+                } else {
+                    pick::<T>(7 + (v >> 8) % 9, scale)
+                }
+            };
+            let y = SVector::<T, O>::from_fn(|_, _| draw(0.3));
+            let f = SVector::<T, I>::from_fn(|_, _| draw(2.0));
+            let overrun = next() % 5 == 0;
+            // Now and then the counters at their limits (the count of missing samples
+            // never above the step count, as in any state `try_step` can reach).
+            let mut st = run;
+            match next() % 40 {
+                0 => st.estimate.n = u64::MAX,
+                1 => (st.estimate.n, st.estimate.missing) = (u64::MAX, u64::MAX),
+                2 => (st.estimate.n, st.estimate.missing) = (u64::MAX - 1, u64::MAX - 1),
+                3 => st.overruns = u64::MAX,
+                _ => {}
+            }
+            let mut a = st;
+            let mut b = st;
+            let ra = c.try_step(&mut a, &y, &f, overrun);
+            let rb = reference(c, &mut b, &y, &f, overrun);
+            assert!(
+                same_result(&ra, &rb) && same_state(&a, &b),
+                "step {k}: {ra:?} / {rb:?}"
+            );
+            if ra.is_err() {
+                assert!(
+                    same_state(&a, &st),
+                    "step {k}: a refused step changed the state"
+                );
+            }
+            seen[match ra {
+                Ok(Command {
+                    saturated: true, ..
+                }) => 0,
+                Ok(Command {
+                    status: Status::Computed,
+                    ..
+                }) => 1,
+                Ok(_) => 2,
+                Err(Error::NonFiniteState) => 3,
+                Err(_) => 4,
+            }] += 1;
+            // Restart from rest when the run has left every finite value behind.
+            run = if ra.is_ok() && a.estimate.x.iter().all(|x| x.as_f64().abs() < 1e3) {
+                a
+            } else {
+                c.start_at_rest()
+            };
+        }
+        seen
+    }
+
+    /// An SDOF (1 kg, 2 % damping at 1 Hz), its velocity measured, force in, `h` = 10 ms:
+    /// `I` inputs through `b`.
+    fn controller<T: Real, const I: usize, const Z: usize>(
+        b: [f64; I],
+        gain: [[f64; Z]; I],
+        limit: [f64; I],
+    ) -> Controller<T, 2, I, 1> {
+        let w = 2.0 * core::f64::consts::PI;
+        let ss = StateSpace::<1, 2, I>::from_rows_aem([[1.0]], [[0.04 * w]], [[w * w]], [b], 0.01)
+            .unwrap();
+        let meas = ss.outputs(&Outputs::velocities([[1.0]])).unwrap();
+        let obs = Observer::new(&ss, &meas, &SMatrix::from([[0.5, 3.0]])).unwrap();
+        Controller::new(obs, &SMatrix::<f64, Z, I>::from(gain).transpose(), &limit).unwrap()
+    }
+
+    /// The fused step against the step it replaced: the same commands, statuses, errors
+    /// and states, bit for bit, for one input with and without the delay, two inputs, and
+    /// none; `f32` and `f64`.
+    #[test]
+    fn fused_step_is_bit_identical_to_the_checked_composition() {
+        fn all<T: Real>() {
+            let one = sweep(&controller::<T, 1, 3>([1.0], [[40.0, 2.0, 0.3]], [50.0]), 6);
+            let direct = sweep(&controller::<T, 1, 2>([1.0], [[40.0, 2.0]], [50.0]), 6);
+            let two = sweep(
+                &controller::<T, 2, 4>(
+                    [1.0, -0.5],
+                    [[40.0, 2.0, 0.3, 0.0], [-10.0, 0.0, 0.0, 0.2]],
+                    [50.0, 10.0],
+                ),
+                6,
+            );
+            let none = sweep(&controller::<T, 0, 2>([], [], []), 6);
+            for (name, seen) in [("one", one), ("direct", direct), ("two", two)] {
+                assert!(seen.iter().all(|&n| n > 0), "{name}: {seen:?}");
+            }
+            // Without an input nothing saturates; the rest occurs.
+            assert!(none[1..].iter().all(|&n| n > 0), "none: {none:?}");
+        }
+        all::<f32>();
+        all::<f64>();
+    }
+}

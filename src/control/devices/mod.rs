@@ -141,6 +141,22 @@ impl Link {
     }
 }
 
+// A `Coupled` reaches its structure's vectors and matrices only through these two, at its
+// link's ends: `get`/`get_mut`, never an index that could panic in a step. `Coupled::new`
+// refuses a link out of range, so the `None` arms are never taken; each caller still
+// answers them with a refusal (a NaN force or deformation, which the stepper reports as
+// `Error::NonFiniteForce`; no tangent, no band), not with a wrong result.
+
+/// `*entry += x`; `false` (nothing changed) where there is no entry.
+fn add_to<T: Real>(entry: Option<&mut T>, x: T) -> bool {
+    entry.map(|e| *e += x).is_some()
+}
+
+/// `*entry -= x`; `false` (nothing changed) where there is no entry.
+fn sub_from<T: Real>(entry: Option<&mut T>, x: T) -> bool {
+    entry.map(|e| *e -= x).is_some()
+}
+
 /// A linear structure `M u'' + C u' + K u = p` of `N` degrees of freedom as a memoryless
 /// [`HistoryModel`] (`History = ()`), the structure of a [`Coupled`] model.
 ///
@@ -328,12 +344,15 @@ impl<T: Real, S: HistoryModel<T, N>, D: Device<T>, const N: usize> Coupled<T, S,
     }
 
     /// The device's deformation `bᵀx` of a displacement (or velocity) vector `x`. Cost: one
-    /// subtraction.
+    /// subtraction; no panic.
     pub fn deformation(&self, x: &SVector<T, N>) -> T {
-        match self.link.ends() {
-            (i, None) => x[i],
-            (i, Some(j)) => x[i] - x[j],
-        }
+        let (i, j) = self.link.ends();
+        let d = match (x.get(i), j.map(|j| x.get(j))) {
+            (Some(&xi), None) => Some(xi),
+            (Some(&xi), Some(Some(&xj))) => Some(xi - xj),
+            _ => None,
+        };
+        d.unwrap_or(T::from_f64_rounded(f64::NAN))
     }
 
     /// The force the device delivered at the end of the step that committed `history`
@@ -366,9 +385,10 @@ impl<T: Real, S: HistoryModel<T, N>, D: Device<T>, const N: usize> Coupled<T, S,
     ) -> Trial<T, N, (S::History, D::History)> {
         let mut force = st.force;
         let (i, j) = self.link.ends();
-        force[i] += dt.force;
-        if let Some(j) = j {
-            force[j] -= dt.force;
+        let placed = add_to(force.get_mut(i), dt.force)
+            && j.is_none_or(|j| sub_from(force.get_mut(j), dt.force));
+        if !placed {
+            force = SVector::repeat(T::from_f64_rounded(f64::NAN));
         }
         Trial {
             force,
@@ -420,11 +440,14 @@ impl<T: Real, S: HistoryModel<T, N>, D: Device<T>, const N: usize> HistoryModel<
             (&mut t.stiffness, dt.stiffness),
             (&mut t.damping, dt.damping),
         ] {
-            m[(i, i)] += x;
-            if let Some(j) = j {
-                m[(j, j)] += x;
-                m[(i, j)] -= x;
-                m[(j, i)] -= x;
+            let placed = add_to(m.get_mut((i, i)), x)
+                && j.is_none_or(|j| {
+                    add_to(m.get_mut((j, j)), x)
+                        && sub_from(m.get_mut((i, j)), x)
+                        && sub_from(m.get_mut((j, i)), x)
+                });
+            if !placed {
+                return None;
             }
         }
         Some(t)
@@ -445,7 +468,9 @@ impl<T: Real, S: HistoryModel<T, N>, D: Device<T>, const N: usize> HistoryModel<
             None => i == 0,
             Some(j) => i.abs_diff(j) == 1,
         };
-        if !banded {
+        // In range too (always, for a link `Coupled::new` took), before `tangent` is
+        // written: a `None` leaves it as it was.
+        if !(banded && i.max(j.unwrap_or(i)) < N) {
             return None;
         }
         let st = self
@@ -456,10 +481,12 @@ impl<T: Real, S: HistoryModel<T, N>, D: Device<T>, const N: usize> HistoryModel<
             (&mut tangent.stiffness, dt.stiffness),
             (&mut tangent.damping, dt.damping),
         ] {
-            band.diagonal[i] += x;
-            if let Some(j) = j {
-                band.diagonal[j] += x;
-                band.off[i.max(j)] -= x;
+            let placed = add_to(band.diagonal.get_mut(i), x)
+                && j.is_none_or(|j| {
+                    add_to(band.diagonal.get_mut(j), x) && sub_from(band.off.get_mut(i.max(j)), x)
+                });
+            if !placed {
+                return None;
             }
         }
         Some(self.combine(st, &dt))
@@ -471,4 +498,135 @@ crate::defmt_impls::format_impls! {
     impl[T: Real + Format, const N: usize] Format for LinearStructure<T, N> => |s|
         "LinearStructure {{ mass (columns): {}, damping (columns): {}, stiffness (columns): {} }}",
         s.mass.as_slice(), s.damping.as_slice(), s.stiffness.as_slice();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::SymTridiagonal;
+    use crate::hysteresis::{Bilinear, ShearBuilding};
+
+    /// A 3-storey shear building (300 kg, 3e5 N/m, storey dashpots of 400 N·s/m: its
+    /// tangent is tridiagonal) with a 50 N·s/m viscous damper at `link`, built past
+    /// `Coupled::new`'s check (a link it refuses too).
+    fn model(link: Link) -> Coupled<f64, ShearBuilding<f64, Bilinear<f64>, 3>, Viscous<f64>, 3> {
+        let c = 400.0;
+        let cc = [[2.0 * c, -c, 0.0], [-c, 2.0 * c, -c], [0.0, -c, c]];
+        let law = Bilinear::new(3e5, 1e12, 0.0).unwrap();
+        let building = ShearBuilding::new([300.0; 3], [law; 3], &cc).unwrap();
+        Coupled {
+            structure: building,
+            device: Viscous::new(50.0).unwrap(),
+            link,
+            h: 1e-3,
+            h64: 1e-3,
+            command: 0.0,
+        }
+    }
+
+    fn bands(x: f64) -> TridiagonalTangent<f64, 3> {
+        let b = SymTridiagonal {
+            diagonal: SVector::repeat(x),
+            off: SVector::repeat(x),
+        };
+        TridiagonalTangent {
+            mass: b,
+            stiffness: b,
+            damping: b,
+        }
+    }
+
+    /// Every link `Coupled::new` takes: the force, the tangent and the bands are the
+    /// structure's plus `b f`, `∂f/∂ḋ · b bᵀ` written out here by index from
+    /// `b = e_i − e_j`, bit for bit.
+    #[test]
+    fn coupled_places_the_device_at_its_link() {
+        let u = SVector::<f64, 3>::from([1e-3, -2e-3, 4e-3]);
+        let v = SVector::from([0.3, 0.1, -0.2]);
+        let c = 50.0;
+        for link in [
+            Link::Ground(0),
+            Link::Ground(2),
+            Link::Between(0, 1),
+            Link::Between(2, 1),
+            Link::Between(2, 0),
+        ] {
+            let m = model(link);
+            assert!(Coupled::new(m.structure, m.device, link, 1e-3).is_ok());
+            let (i, j) = link.ends();
+            let (d, rate) = match j {
+                None => (u[i], v[i]),
+                Some(j) => (u[i] - u[j], v[i] - v[j]),
+            };
+            assert_eq!(m.deformation(&u).to_bits(), d.to_bits());
+            let f = c * rate;
+            let h = m.initial_history();
+            let mut force = m.structure.trial(&h.0, &u, &v).force;
+            force[i] += f;
+            if let Some(j) = j {
+                force[j] -= f;
+            }
+            assert_eq!(m.trial(&h, &u, &v).force, force, "{link:?}");
+            let mut damping = m.structure.tangent(&h.0, &u, &v).unwrap().damping;
+            damping[(i, i)] += c;
+            if let Some(j) = j {
+                damping[(j, j)] += c;
+                damping[(i, j)] -= c;
+                damping[(j, i)] -= c;
+            }
+            assert_eq!(m.tangent(&h, &u, &v).unwrap().damping, damping, "{link:?}");
+            let mut band = bands(0.0);
+            let banded = m.trial_tridiagonal(&h, &u, &v, &mut band);
+            assert_eq!(
+                banded.is_some(),
+                matches!(
+                    link,
+                    Link::Ground(0) | Link::Between(0, 1) | Link::Between(2, 1)
+                )
+            );
+            if banded.is_some() {
+                assert_eq!(band.damping.to_matrix(), damping, "{link:?}");
+            }
+        }
+    }
+
+    /// A link out of range (which `Coupled::new` refuses, so only a literal builds it):
+    /// no index panics; the deformation and the force are NaN, there is no tangent and no
+    /// band (the bands untouched), and the stepper refuses the step with a typed error,
+    /// the state unchanged.
+    #[test]
+    fn a_link_out_of_range_is_refused_not_a_panic() {
+        let u = SVector::<f64, 3>::from([1e-3, -2e-3, 4e-3]);
+        let v = SVector::from([0.3, 0.1, -0.2]);
+        for link in [Link::Ground(3), Link::Between(3, 2), Link::Between(1, 7)] {
+            let m = model(link);
+            assert_eq!(
+                Coupled::new(m.structure, m.device, link, 1e-3).err(),
+                Some(Error::InvalidParameter(Param::Device))
+            );
+            let h = m.initial_history();
+            assert!(m.deformation(&u).is_nan());
+            assert!(m.trial(&h, &u, &v).force.iter().all(|f| f.is_nan()));
+            assert_eq!(m.tangent(&h, &u, &v), None);
+            let mut band = bands(7.0);
+            assert!(m.trial_tridiagonal(&h, &u, &v, &mut band).is_none());
+            assert_eq!(band, bands(7.0));
+            let stepper = m.nonlinear(NewtonSettings::default()).unwrap();
+            let z = SVector::zeros();
+            let mut state = crate::State {
+                u: z,
+                v: z,
+                a: z,
+                n: 0,
+            };
+            let mut history = h;
+            let before = (state, history);
+            assert_eq!(
+                stepper.try_step_with_history(&m, &mut state, &mut history, &SVector::repeat(1.0)),
+                Err(Error::NonFiniteForce),
+                "{link:?}"
+            );
+            assert_eq!((state, history), before);
+        }
+    }
 }
