@@ -776,3 +776,23 @@ fn active_mass_driver_reaches_its_static_equilibrium() {
     // The same force as the builder's load vector on the bare augmented structure.
     assert_eq!(amd.force, [-1.0, 1.0]);
 }
+
+/// A start with the command on does not charge the voltage filter in the stepper's
+/// start-up trial: the damper's history at `t = 0` holds the command (settled), and the
+/// start commits it unchanged (found by the Python binding: the start advanced the filter
+/// by one step, a one-step shift of the voltage, measured first order).
+#[test]
+fn passive_on_starts_with_the_filter_settled() {
+    let frame = LinearStructure::<f64, 1>::new(&[[98.3]], &[[175.0]], &[[6.84e5]]).unwrap();
+    let damper = MrDamper::<f64>::new(&MrParameters::DYKE_1996).unwrap();
+    let model = Coupled::passive_on(frame, damper, Link::Ground(0), 1e-3).unwrap();
+    let h0 = model.initial_history();
+    assert_eq!(h0.1.voltage, 2.25);
+    let stepper = model.nonlinear(NewtonSettings::default()).unwrap();
+    let zero = SVector::<f64, 1>::zeros();
+    let (_, h) = stepper
+        .start_with_history(&model, &zero, &zero, &zero, &h0)
+        .unwrap();
+    assert_eq!(h.1.voltage, 2.25, "the start advanced the filter");
+    assert_eq!(h.1.force, 0.0);
+}

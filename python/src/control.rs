@@ -577,11 +577,10 @@ fn mr_building_n<const N: usize, const S: usize>(job: &MrBuildingJob) -> Res<MrB
         0 => Link::Ground(0),
         j => Link::Between(j, j - 1),
     };
-    // Started at 0 V whatever the law: the start commits the device's trial history at
-    // rest, a trial over one step `h` with the held command, so a command held at the
-    // start would advance the voltage filter by one step before t = 0 (a one-step shift of
-    // the filter, an O(h) error: measured first order with the command on from the start).
-    // `"on"` holds V_max from the first step on.
+    // Started at 0 V whatever the law (the damper's filtered voltage 0 at t = 0, as the
+    // documented equations start): `"on"` holds V_max from the first step on, and the
+    // filter charges from there. (`Coupled::passive_on` would instead start with the
+    // filter settled at V_max.)
     let mut model = Coupled::passive_off(structure, damper, link, job.h)?;
     let clipped = ClippedOptimal::<f64, 1>::new(job.params.v_max)?;
     let stepper = model.nonlinear(NewtonSettings::default())?;

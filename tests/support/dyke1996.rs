@@ -220,8 +220,9 @@ pub fn rk4<const K: usize>(
 
 /// Runs the benchmark from rest over the record (and `extra` seconds after it) with RK4 of
 /// step `h` (s); `law(t, y, f)` returns the command voltage (V) held over the step that
-/// starts at `t` with state `y` and damper force `f` there. Returns the peaks (checked at
-/// every step's end, and at `t = 0`).
+/// starts at `t` with state `y` and damper force `f` there; the filtered voltage starts at
+/// the first command (held since long before `t = 0`). Returns the peaks (checked at every
+/// step's end, and at `t = 0`).
 pub fn simulate(
     s: &Structure,
     d: &Damper,
@@ -236,6 +237,9 @@ pub fn simulate(
     let mut p = Peaks::default();
     let mut t = 0.0;
     let mut v = law(0.0, &y, 0.0);
+    // The first command held since long before t = 0: the filtered voltage starts at it
+    // (0 V for the controllers, which command nothing at rest; V_max passive-on).
+    y[7] = v;
     for n in 0..steps {
         y = rk4(t, &y, h, |tt, yy| {
             rates(s, d, attached, rec.at(tt), yy, v).0

@@ -99,6 +99,17 @@ pub trait Device<T: Real> {
     /// The history at rest (zero deformation, zero command). Cost: O(1).
     fn initial_history(&self) -> Self::History;
 
+    /// The history at rest with `command` held since long before `t = 0` (zero
+    /// deformation; a damper's filtered voltage at the command): what
+    /// [`Coupled`]'s initial history holds, so that a start with the command on (e.g.
+    /// [`Coupled::passive_on`]) does not spend the stepper's start-up trial charging the
+    /// voltage filter. The default is [`Device::initial_history`] (a device without a
+    /// command state). Cost: O(1).
+    fn settled_history(&self, command: T) -> Self::History {
+        let _ = command;
+        self.initial_history()
+    }
+
     /// The range `[lowest, highest]` of the command (volts for a damper, newtons for an
     /// actuator); [`Coupled::set_command`] clips into it. Cost: O(1).
     fn command_limits(&self) -> (T, T);
@@ -403,10 +414,12 @@ impl<T: Real, S: HistoryModel<T, N>, D: Device<T>, const N: usize> HistoryModel<
 {
     type History = (S::History, D::History);
 
+    /// The structure's virgin history and the device settled at the current command
+    /// ([`Device::settled_history`]).
     fn initial_history(&self) -> Self::History {
         (
             self.structure.initial_history(),
-            self.device.initial_history(),
+            self.device.settled_history(self.command),
         )
     }
 

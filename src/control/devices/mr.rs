@@ -225,9 +225,14 @@ impl<T: Real> Device<T> for MrDamper<T> {
     type History = MrHistory<T>;
 
     fn initial_history(&self) -> MrHistory<T> {
+        self.settled_history(T::zero())
+    }
+
+    /// At rest with the filtered voltage at `command` (V): `z = 0`, no force at rest.
+    fn settled_history(&self, command: T) -> MrHistory<T> {
         MrHistory {
             z: self.core.z.initial_history(),
-            voltage: T::zero(),
+            voltage: command,
             force: T::zero(),
         }
     }
@@ -409,11 +414,17 @@ impl<T: Real> Device<T> for MrPhenomenological<T> {
 
     /// At rest: `y = ẏ = z = 0` at `x = 0`, 0 V, the accumulator's force `−k₁ x₀`.
     fn initial_history(&self) -> PhenomenologicalHistory<T> {
+        self.settled_history(T::zero())
+    }
+
+    /// At rest as [`initial_history`](Device::initial_history), the filtered voltage at
+    /// `command` (V).
+    fn settled_history(&self, command: T) -> PhenomenologicalHistory<T> {
         PhenomenologicalHistory {
             z: self.core.z.initial_history(),
             y: T::zero(),
             y_rate: T::zero(),
-            voltage: T::zero(),
+            voltage: command,
             force: -(self.k1 * self.x0),
         }
     }
