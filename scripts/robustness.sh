@@ -39,8 +39,9 @@ def fuzz_section(path):
         estimation="`InputModel` (from_parts, zero_dynamics), `InputStateGains` (solve, new), `InputStateObserver` (new, from_parts_f32/_f64), `InputStateFilter`, `DualGains`, `DualFilter` (new, from_parts_f32/_f64), `AugmentedModel`, `FixedLag` (new, from_parts_f32/_f64); S = 2, 4, O = 1 … 3",
         detection="`chi_square_quantile`, `normal_quantile`, `innovation_covariance`, `Whitener` (new, from_rows_f32/_f64), `Window`, `ChiSquareTest`, `Detector`, `Cusum`, `ModelBank`, `Observer::step_innovation`, `Kalman::try_step_innovation`",
         hybrid="`KrAlpha` (new, chen_ricles, from_rows_f32/_f64, from_rows_chen_ricles_f32/_f64), `hybrid::Split` (the same with `K_num`; start, start_with_acceleration, command, complete with NaN, infinite and specimen forces); N = 1, 2, 3; `hybrid::Actuator`, `Polynomial` (new, new_f32/_f64), `Adaptive` on command sequences with NaN and infinite values",
+        control="`Lqr` (from_parts on the plain and the delayed model: weights, gains, radius bound against nalgebra's eigenvalues), `Controller` (steps with NaN, infinite and extreme measurements and forces, missing samples, overruns), `MrDamper`, `Coupled` (passive_off, passive_on, set_command, the `Nonlinear` start and checked steps), `ClippedOptimal`",
     )
-    order = ["linear_family", "modal", "nonlinear", "hysteresis", "observer", "spectrum", "estimation", "detection", "hybrid"]
+    order = ["linear_family", "modal", "nonlinear", "hysteresis", "observer", "spectrum", "estimation", "detection", "hybrid", "control"]
     missing = [t for t in order if t not in runs]
     if missing:
         raise SystemExit(f"FAILED: fuzz/stats.txt has no run of {missing}")
