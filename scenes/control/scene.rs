@@ -45,19 +45,8 @@ pub const C: Rows<N> = [
     [-50.0, 100.0, -50.0],
     [0.0, -50.0, 50.0],
 ];
-/// The MR damper (Bouc–Wen, `n = 1`), SI units.
-pub const DAMPER: MrParameters = MrParameters {
-    c0a: 4.40,
-    c0b: 44.0,
-    alpha_a: 1.0872e5,
-    alpha_b: 4.9616e5,
-    gamma: 300.0,
-    beta: 300.0,
-    a: 1.2,
-    n: 1.0,
-    eta: 50.0,
-    v_max: 2.25,
-};
+/// The MR damper (Bouc–Wen, `n = 1`), SI units: the crate's named set of the benchmark.
+pub const DAMPER: MrParameters = MrParameters::DYKE_1996;
 
 /// Steps per second (Hz): the controller's sample rate and the emulated plant's step.
 pub const RATE: u64 = 1000;
