@@ -17,7 +17,7 @@ mod elcentro;
 mod scene;
 
 use dyke1996::{Attached, DAMPER, Record, STRUCTURE};
-use scene::{Case, Peaks};
+use scene::{Case, Peaks, worst};
 
 /// Samples of the record in the fast tests: 3 s of recorded time, 0.6 s of model time.
 const SHORT: usize = 151;
@@ -87,20 +87,6 @@ fn reference(case: Case, ag: &[f64], h: f64) -> Peaks {
         acceleration: p.acceleration,
         force: p.force,
     }
-}
-
-/// Largest relative difference of the displacement and drift peaks, of the acceleration
-/// peaks, and of the force peak.
-fn worst(a: &Peaks, b: &Peaks) -> [f64; 3] {
-    let rel = |x: f64, y: f64| if y > 0.0 { (x - y).abs() / y } else { x.abs() };
-    let mut w = [0.0_f64; 3];
-    for i in 0..3 {
-        w[0] = w[0].max(rel(a.displacement[i], b.displacement[i]));
-        w[0] = w[0].max(rel(a.drift[i], b.drift[i]));
-        w[1] = w[1].max(rel(a.acceleration[i], b.acceleration[i]));
-    }
-    w[2] = rel(a.force, b.force);
-    w
 }
 
 /// The highest natural frequency of the structure (rad/s), from its `K` and `M` (the

@@ -84,6 +84,20 @@ pub struct Peaks {
     pub force: f64,
 }
 
+/// Largest relative difference of the displacement and drift peaks, of the acceleration
+/// peaks, and of the force peak.
+pub fn worst(a: &Peaks, b: &Peaks) -> [f64; 3] {
+    let rel = |x: f64, y: f64| if y > 0.0 { (x - y).abs() / y } else { x.abs() };
+    let mut w = [0.0_f64; 3];
+    for i in 0..3 {
+        w[0] = w[0].max(rel(a.displacement[i], b.displacement[i]));
+        w[0] = w[0].max(rel(a.drift[i], b.drift[i]));
+        w[1] = w[1].max(rel(a.acceleration[i], b.acceleration[i]));
+    }
+    w[2] = rel(a.force, b.force);
+    w
+}
+
 /// The ground acceleration (m/s²) at model time `t`: the record `ag` (m/s², recorded every
 /// `dt` s) at `TIME_SCALE`, linear between samples, zero after.
 pub fn ground(ag: &[f64], dt: f64, t: f64) -> f64 {

@@ -14,7 +14,7 @@ mod scene;
 
 use std::fmt::Write as _;
 
-use scene::{Case, Peaks};
+use scene::{Case, Peaks, worst};
 
 const INTRO: &str = r#"# Semi-active control: the MR-damper benchmark of Dyke et al. (1996)
 
@@ -99,19 +99,6 @@ fn cells(p: &Peaks) -> String {
         p.acceleration[2],
         p.force
     )
-}
-
-/// Largest relative difference of displacements and drifts, of accelerations, of force.
-fn worst(a: &Peaks, b: &Peaks) -> [f64; 3] {
-    let rel = |x: f64, y: f64| if y > 0.0 { (x - y).abs() / y } else { x.abs() };
-    let mut w = [0.0_f64; 3];
-    for i in 0..3 {
-        w[0] = w[0].max(rel(a.displacement[i], b.displacement[i]));
-        w[0] = w[0].max(rel(a.drift[i], b.drift[i]));
-        w[1] = w[1].max(rel(a.acceleration[i], b.acceleration[i]));
-    }
-    w[2] = rel(a.force, b.force);
-    w
 }
 
 fn reference(case: Case, h: f64) -> Peaks {
