@@ -113,7 +113,7 @@ def shear_building(
     tolerance: float = 1e-10,
     energy: bool = True,
     histories: bool = True,
-) -> Dict[str, Union[F64, float, int]]:
+) -> Dict[str, Any]:
     """A hysteretic shear building (Nonlinear AEM stepper, Newton) over a record.
 
     masses: floor masses (kg), ground storey first; law: ``"bilinear"`` (params columns
@@ -185,7 +185,7 @@ def constant_ductility(
     tol: float = 1e-6,
     points_per_period: int = 40,
     threads: int = 1,
-) -> Dict[str, object]:
+) -> Dict[str, Any]:
     """Constant-ductility spectrum: the largest yield strength per unit mass (m/s²)
     giving the ductility target (> 1). Returns ``yield_acceleration``, ``elastic``
     (m/s²), ``bracket`` (``periods×2``, m/s²), ``bracket_ductility`` (``periods×2``),
@@ -330,3 +330,10 @@ def ida_fractiles(
 ) -> npt.NDArray[np.float64]:
     """Fractile IDA curves, intensity given drift: ``len(q) × len(drifts)``; NaN where
     censored curves decide the quantile."""
+
+def spectral_acceleration(record: F64, h: float, period: float, damping: float) -> float:
+    """The pseudo-spectral acceleration ``Sa = ω² max|u|`` (the record's units) of the
+    oscillator of ``period`` (s) and ``damping`` (ratio) under ``record`` (sampled every
+    h s), one period of free vibration after it: ``aemstep::ida::spectral_acceleration``.
+    Raises ``NonFiniteInput``, ``InvalidPeriod``, ``InvalidDamping``, ``InvalidTimeStep``,
+    ``NonFiniteState``, ``OperatorOverflow``. The GIL released."""

@@ -20,11 +20,12 @@ one task per worker thread). See docs/cluster.md in the repository.
 
 from __future__ import annotations
 
-from typing import Any, Dict, List, Sequence
+from typing import Any, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 import aemstep
+from aemstep import IdaCurve, frames
 
 ArrayLike = Any
 
@@ -48,37 +49,42 @@ def _map(client: Any, fn: Any, records: Sequence[ArrayLike], chunk: int, **kw: A
     shared = client.scatter([kw], broadcast=True, hash=False)[0] if kw else None
     futures = client.map(_call, [fn] * len(parts), parts, [shared] * len(parts), pure=False)
     out: List[Any] = []
-    for part in client.gather(futures):
+    parts_out: List[List[Any]] = client.gather(futures)
+    for part in parts_out:
         out.extend(part)
     return out
 
 
 def _call(fn: Any, recs: List[np.ndarray], kw: Any) -> List[Any]:
-    return fn(recs, **(kw or {}))
+    out: List[Any] = fn(recs, **(kw or {}))
+    return out
 
 
 # The single-record (or chunk) calls, run on the workers: exactly the serial API.
 
 
-def _spectra(recs, periods, damping, h, scheme, free_vibration, threads):
+def _spectra(
+    recs: List[np.ndarray], periods: np.ndarray, damping: ArrayLike, h: float, scheme: str,
+    free_vibration: bool, threads: int,
+) -> List[Tuple[np.ndarray, ...]]:
     s = aemstep.spectra(periods, damping, h, recs, scheme=scheme,
                         free_vibration=free_vibration, threads=threads)
     return [tuple(x[i] for x in s[1:]) for i in range(len(recs))]
 
 
-def _constant_strength(recs, **kw):
+def _constant_strength(recs: List[np.ndarray], **kw: Any) -> List["aemstep.ConstantStrength"]:
     return [aemstep.constant_strength(ground_acceleration=r, **kw) for r in recs]
 
 
-def _constant_ductility(recs, **kw):
+def _constant_ductility(recs: List[np.ndarray], **kw: Any) -> List["aemstep.ConstantDuctility"]:
     return [aemstep.constant_ductility(ground_acceleration=r, **kw) for r in recs]
 
 
-def _ida_stripes(recs, **kw):
+def _ida_stripes(recs: List[np.ndarray], **kw: Any) -> List[IdaCurve]:
     return aemstep.ida_stripes(recs, **kw)
 
 
-def _ida_hunt_fill(recs, **kw):
+def _ida_hunt_fill(recs: List[np.ndarray], **kw: Any) -> List[IdaCurve]:
     return aemstep.ida_hunt_fill(recs, **kw)
 
 
@@ -86,8 +92,8 @@ def spectra(
     client: Any,
     periods: ArrayLike,
     damping: ArrayLike,
-    h: float,
-    records: Sequence[ArrayLike],
+    h: Optional[float] = None,
+    records: Any = None,
     *,
     scheme: str = "exact",
     free_vibration: bool = True,
@@ -96,7 +102,9 @@ def spectra(
 ) -> "aemstep.Spectrum":
     """``aemstep.spectra`` of ``records`` (m/s², sampled every ``h`` s) on the cluster:
     ``sd`` (m), ``sv`` (m/s), ``sa``, ``psa`` (m/s²), ``psv`` (m/s), each
-    ``records×periods``, bit for bit the serial result."""
+    ``records×periods``, bit for bit the serial result. ``records`` may be a pandas
+    ``DataFrame`` (one column a record; ``h`` then from its time index if ``None``)."""
+    records, h = frames.records_in(records, h)
     periods = np.ascontiguousarray(periods, dtype=np.float64)
     rows = _map(client, _spectra, records, chunk, periods=periods, damping=damping,
                 h=float(h), scheme=scheme, free_vibration=bool(free_vibration),
@@ -161,10 +169,11 @@ def ida_stripes(
     chunk: int = 1,
     threads: int = 1,
     **building: Any,
-) -> List[Dict[str, Any]]:
+) -> List[IdaCurve]:
     """``aemstep.ida_stripes`` on the cluster, one task per record (or ``chunk``):
     ``building`` is its keyword arguments (``masses``, ``law``, ``params``, ``c``,
-    ``collapse_drift``, …; not ``progress``). The curves are the serial ones, bit for bit."""
+    ``collapse_drift``, ``intensity``, ``period``, ``damping``, …; not ``progress``). The
+    ``IdaCurve`` list is the serial one, bit for bit."""
     building.pop("progress", None)
     return _map(client, _ida_stripes, records, chunk, h=float(h),
                 intensities=np.ascontiguousarray(intensities, dtype=np.float64),
@@ -179,10 +188,11 @@ def ida_hunt_fill(
     chunk: int = 1,
     threads: int = 1,
     **settings: Any,
-) -> List[Dict[str, Any]]:
+) -> List[IdaCurve]:
     """``aemstep.ida_hunt_fill`` on the cluster, one task per record (or ``chunk``):
     ``settings`` is its keyword arguments (building, hunt-and-fill, collapse; not
-    ``progress``). Each record's trace is independent: the serial curves, bit for bit."""
+    ``progress``; ``intensity``, ``period``, ``damping`` as ``ida_stripes``). Each record's
+    trace (and measure) is independent: the serial ``IdaCurve`` list, bit for bit."""
     settings.pop("progress", None)
     return _map(client, _ida_hunt_fill, records, chunk, h=float(h), threads=int(threads),
                 **settings)

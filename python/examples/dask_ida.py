@@ -81,8 +81,8 @@ def main(address=None):
     if cluster is not None:
         cluster.close()
     same = all(
-        np.array_equal(a["drift"], b["drift"]) and np.array_equal(a["drift"], c["drift"])
-        and a["collapse"] == b["collapse"] == c["collapse"]
+        np.array_equal(a.drift, b.drift) and np.array_equal(a.drift, c.drift)
+        and a.collapse == b.collapse == c.collapse
         for a, b, c in zip(serial, par, threaded)
     )
     runs = len(records) * len(scales)

@@ -544,7 +544,28 @@ fn ida_fractiles<'py>(
     Ok(out2(py, out.as_slice().to_vec(), levels.len()))
 }
 
+/// `spectral_acceleration(record, h, period, damping)`: the pseudo-spectral acceleration
+/// `Sa = ω² max|u|` (the record's units) of the damped oscillator of `period` (s) and
+/// `damping` (ratio) under `record` (sampled every `h` s), with one period of free
+/// vibration after it: `aemstep::ida::spectral_acceleration`, the intensity measure
+/// `Sa(T₁)` of the IDA calls. The GIL is released during the pass (one oscillator over the
+/// record). Raises `NonFiniteInput` for a sample that is not finite, `InvalidPeriod`,
+/// `InvalidDamping`, `InvalidTimeStep`, `NonFiniteState`, `OperatorOverflow`.
+#[pyfunction]
+fn spectral_acceleration(
+    py: Python<'_>,
+    record: PyReadonlyArray1<'_, f64>,
+    h: f64,
+    period: f64,
+    damping: f64,
+) -> PyResult<f64> {
+    let rec = read1(&record);
+    py.detach(|| ida::spectral_acceleration(&rec, h, period, damping))
+        .map_err(|e| Fail::from(e).raise(py))
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(spectral_acceleration, m)?)?;
     m.add_function(wrap_pyfunction!(ida_stripes, m)?)?;
     m.add_function(wrap_pyfunction!(ida_hunt_fill, m)?)?;
     m.add_function(wrap_pyfunction!(ida_fractiles, m)?)?;

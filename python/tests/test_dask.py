@@ -68,12 +68,19 @@ def test_ida_equals_the_serial_run(client, elcentro):
          ad.ida_stripes(client, recs, dt, [0.5, 1.0, 2.0], collapse_drift=0.015, **b)),
         (aemstep.ida_hunt_fill(recs, dt, collapse_drift=0.015, **b),
          ad.ida_hunt_fill(client, recs, dt, collapse_drift=0.015, chunk=2, **b)),
+        # driven by Sa(T1): each record's measure is computed on its worker
+        (aemstep.ida_stripes(recs, dt, [3.0, 6.0], collapse_drift=0.015, intensity="sa",
+                             period=0.6, **b),
+         ad.ida_stripes(client, recs, dt, [3.0, 6.0], collapse_drift=0.015, intensity="sa",
+                        period=0.6, **b)),
     ]:
         assert len(serial) == len(par) == len(recs)
         for a, c in zip(serial, par):
+            assert isinstance(c, aemstep.IdaCurve)  # typed, through pickle
             for key in ("intensity", "drift", "collapsed"):
-                np.testing.assert_array_equal(a[key], c[key])
-            assert a["collapse"] == c["collapse"] and a["error"] == c["error"]
+                np.testing.assert_array_equal(getattr(a, key), getattr(c, key))
+            assert a.collapse == c.collapse and a.error == c.error
+            assert a.measure == c.measure and a.record_intensity == c.record_intensity
     assert ad.ida_stripes(client, [], dt, [0.5], **b) == []
 
 

@@ -44,19 +44,19 @@ def test_stripes_equal_direct_shear_building_runs_bitwise(elcentro):
     assert len(curves) == len(recs)
     seen_collapse = False
     for rec, cur in zip(recs, curves):
-        assert cur["intensity"].tolist() == sorted(ims)
+        assert cur.intensity.tolist() == sorted(ims)
         direct = np.array([direct_peak(rec, dt, s) for s in sorted(ims)])
         # Same start, same steps, same drift rule: equal to the last bit (measured: 0 ulp).
-        np.testing.assert_array_equal(cur["drift"], direct)
-        np.testing.assert_array_equal(cur["collapsed"], direct >= collapse)
-        assert cur["error"] == [None] * len(ims)
-        if cur["collapsed"].any():
+        np.testing.assert_array_equal(cur.drift, direct)
+        np.testing.assert_array_equal(cur.collapsed, direct >= collapse)
+        assert cur.error == [None] * len(ims)
+        if cur.collapsed.any():
             seen_collapse = True
-            first = int(np.argmax(cur["collapsed"]))
-            lo = cur["intensity"][first - 1] if first > 0 else 0.0
-            assert cur["collapse"] == (lo, cur["intensity"][first])
+            first = int(np.argmax(cur.collapsed))
+            lo = cur.intensity[first - 1] if first > 0 else 0.0
+            assert cur.collapse == (lo, cur.intensity[first])
         else:
-            assert cur["collapse"] is None
+            assert cur.collapse is None
     assert seen_collapse, "the test should exercise a collapse by drift"
 
 
@@ -67,9 +67,9 @@ def test_failed_runs_collapse_or_abort(elcentro):
     cur = aemstep.ida_stripes(recs[:1], dt, [0.01, 3.0], **b, **newton)[0]
     with pytest.raises(aemstep.NotConverged):
         direct_peak(recs[0], dt, 3.0, **newton)
-    assert cur["drift"][0] == direct_peak(recs[0], dt, 0.01, **newton)
-    assert cur["drift"][1] == np.inf and cur["collapsed"].tolist() == [False, True]
-    assert cur["error"] == [None, "NotConverged"] and cur["collapse"] == (0.01, 3.0)
+    assert cur.drift[0] == direct_peak(recs[0], dt, 0.01, **newton)
+    assert cur.drift[1] == np.inf and cur.collapsed.tolist() == [False, True]
+    assert cur.error == [None, "NotConverged"] and cur.collapse == (0.01, 3.0)
     with pytest.raises(aemstep.NotConverged):
         aemstep.ida_stripes(recs[:1], dt, [0.01, 3.0], on_failure="abort", **b, **newton)
 
@@ -81,16 +81,16 @@ def test_hunt_fill_brackets_the_collapse_of_direct_runs(elcentro):
         recs, dt, collapse_drift=collapse, runs=runs, resolution=resolution, **building()
     )
     for rec, cur in zip(recs, curves):
-        im = cur["intensity"]
+        im = cur.intensity
         assert 1 <= im.shape[0] <= runs
         assert np.all(np.diff(im) > 0)  # sorted, distinct
-        lo, hi = cur["collapse"]  # every record of the suite collapses below 2.1
+        lo, hi = cur.collapse  # every record of the suite collapses below 2.1
         assert 0 <= lo < hi and hi - lo <= resolution
         # The bracket by direct runs: no collapse at lo, collapse at hi.
         assert lo == 0.0 or direct_peak(rec, dt, lo) < collapse
         assert direct_peak(rec, dt, hi) >= collapse
         # The points are the direct runs at their intensities.
-        np.testing.assert_array_equal(cur["drift"], [direct_peak(rec, dt, s) for s in im])
+        np.testing.assert_array_equal(cur.drift, [direct_peak(rec, dt, s) for s in im])
 
 
 def test_results_do_not_depend_on_the_thread_count(elcentro):
@@ -104,8 +104,8 @@ def test_results_do_not_depend_on_the_thread_count(elcentro):
         two = f(recs, dt, threads=2, **kw, **b)
         for a, c in zip(one, two):
             for key in ("intensity", "drift", "collapsed"):
-                np.testing.assert_array_equal(a[key], c[key])
-            assert a["collapse"] == c["collapse"]
+                np.testing.assert_array_equal(getattr(a, key), getattr(c, key))
+            assert a.collapse == c.collapse
 
 
 def hand_intensity_at(cur, level):
@@ -113,7 +113,7 @@ def hand_intensity_at(cur, level):
     its non-collapsing points below its lowest collapse, from the origin, linear."""
     if level <= 0:
         return 0.0
-    im, e, col = cur["intensity"], cur["drift"], cur["collapsed"]
+    im, e, col = cur.intensity, cur.drift, cur.collapsed
     cap = im[col].min() if col.any() else np.inf
     keep = ~col & (im < cap)
     x = np.concatenate([[0.0], im[keep]])
@@ -125,15 +125,20 @@ def hand_intensity_at(cur, level):
     return x[-1]  # past its last point: the flatline of a collapsed curve
 
 
+def curve(intensity, drift, collapsed):
+    """A hand-made IdaCurve (no run errors; collapse left to ida_fractiles)."""
+    return aemstep.IdaCurve(intensity, drift, collapsed, [None] * len(intensity), None)
+
+
 def test_fractiles_equal_a_numpy_hand_computation():
     curves = [
-        dict(intensity=np.array([0.2, 0.4, 0.6, 0.8]), drift=np.array([0.004, 0.009, 0.02, np.inf]),
+        curve(intensity=np.array([0.2, 0.4, 0.6, 0.8]), drift=np.array([0.004, 0.009, 0.02, np.inf]),
              collapsed=np.array([False, False, False, True])),
-        dict(intensity=np.array([0.1, 0.3, 0.5]), drift=np.array([0.003, 0.011, 0.03]),
+        curve(intensity=np.array([0.1, 0.3, 0.5]), drift=np.array([0.003, 0.011, 0.03]),
              collapsed=np.array([False, False, True])),
-        dict(intensity=np.array([0.25, 0.5, 1.0, 1.2]), drift=np.array([0.002, 0.006, 0.015, 0.05]),
+        curve(intensity=np.array([0.25, 0.5, 1.0, 1.2]), drift=np.array([0.002, 0.006, 0.015, 0.05]),
              collapsed=np.array([False, False, False, False])),
-        dict(intensity=np.array([0.3, 0.6, 0.9]), drift=np.array([0.005, 0.012, np.inf]),
+        curve(intensity=np.array([0.3, 0.6, 0.9]), drift=np.array([0.005, 0.012, np.inf]),
              collapsed=np.array([False, False, True])),
     ]
     levels = np.array([0.0, 0.001, 0.005, 0.01, 0.02, 0.04])
@@ -149,10 +154,10 @@ def test_fractiles_equal_a_numpy_hand_computation():
 
 
 def test_fractiles_nan_where_censored_curves_decide():
-    never = dict(intensity=np.array([0.5, 1.0]), drift=np.array([0.001, 0.002]),
-                 collapsed=np.array([False, False]))
-    reached = dict(intensity=np.array([0.5, 1.0]), drift=np.array([0.01, 0.02]),
-                   collapsed=np.array([False, False]))
+    never = curve(intensity=np.array([0.5, 1.0]), drift=np.array([0.001, 0.002]),
+                  collapsed=np.array([False, False]))
+    reached = curve(intensity=np.array([0.5, 1.0]), drift=np.array([0.01, 0.02]),
+                    collapsed=np.array([False, False]))
     f = aemstep.ida_fractiles([never, reached], [0.015], q=(0.0, 1.0))
     # q=0: the reached curve's 0.75 is below the censored one's "> 1.0": known. q=1: not.
     assert f[0, 0] == 0.75 and np.isnan(f[1, 0])
