@@ -23,7 +23,12 @@ accelerations in m/s² (``G`` converts from g).
   readers).
 - ``ida_stripes``, ``ida_hunt_fill``, ``ida_fractiles``: incremental dynamic analysis of
   the yielding shear building over a suite of records, on threads, with a progress bar.
+  ``IdaCurve`` results; the intensity a scale factor, the PGA or ``Sa(T₁)``
+  (``spectral_acceleration``).
 - ``aemstep.distributed``: the batch functions on a Dask cluster (imported on use).
+- ``aemstep.frames``: the ``.time`` axis of history results and their optional pandas /
+  xarray output (``to_pandas()``, ``to_xarray()``); ``aemstep.plot``: spectra and IDA
+  curves with matplotlib (imported on use).
 
 Every ``aemstep::Error`` variant of the Rust library is an exception of the same name
 (``aemstep.NotConverged``, ``aemstep.InvalidTimeStep``, …), subclass of ``AemstepError``
@@ -36,11 +41,11 @@ See docs/python.md in the repository.
 from __future__ import annotations
 
 import os
-from typing import Any, Callable, List, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from . import _aemstep
+from . import _aemstep, frames
 from ._aemstep import (  # noqa: F401  (re-exported)
     CHUNK,
     ERROR_VARIANTS,
@@ -121,12 +126,15 @@ def _per_period(x: ArrayLike, count: int, name: str) -> np.ndarray:
 # Linear models.
 
 
-class LinearResponse(NamedTuple):
-    """Histories of a linear run, each ``steps×n``, row 0 the initial state."""
-
+class _LinearResponse(NamedTuple):
     u: np.ndarray  #: displacements (m; relative to the ground under ground acceleration)
     v: np.ndarray  #: velocities (m/s)
     a: np.ndarray  #: accelerations (m/s²; relative)
+
+
+class LinearResponse(_LinearResponse, frames.History):
+    """Histories of a linear run, each ``steps×n``, row 0 the initial state; ``time``
+    (s) the time of each row, ``to_pandas()``/``to_xarray()`` tables (``frames.History``)."""
 
 
 SCHEMES = ("aem", "modal", "newmark", "generalized_alpha", "hht", "exact")
@@ -179,7 +187,7 @@ def linear_response(
     u, v, a = _aemstep.linear_response(
         m, c, k, float(h), p, u0, v0, scheme, beta, gamma, rho_inf, alpha, int(modes)
     )
-    return LinearResponse(u, v, a)
+    return frames.timed(LinearResponse(u, v, a), h, u.shape[0])
 
 
 # ---------------------------------------------------------------------------------------
@@ -199,10 +207,7 @@ class Energy(NamedTuple):
     initial: float  #: E0, kinetic plus recoverable at the start
 
 
-class BuildingResponse(NamedTuple):
-    """A yielding building's run. Histories ``steps×n`` (floor ``i``, ground storey first);
-    with ``histories=False`` they are ``None`` and only the peaks and counts are kept."""
-
+class _BuildingResponse(NamedTuple):
     u: Optional[np.ndarray]  #: floor displacements relative to the ground (m)
     v: Optional[np.ndarray]  #: floor velocities (m/s)
     a: Optional[np.ndarray]  #: floor accelerations relative to the ground (m/s²)
@@ -212,6 +217,12 @@ class BuildingResponse(NamedTuple):
     iterations: Optional[np.ndarray]  #: Newton iterations of each step
     peak_drift: float = float("nan")  #: max of peak_drifts, the peak absolute storey drift (m)
     total_iterations: int = 0  #: Newton iterations over the whole run
+
+
+class BuildingResponse(_BuildingResponse, frames.History):
+    """A yielding building's run. Histories ``steps×n`` (floor ``i``, ground storey first);
+    with ``histories=False`` they are ``None`` and only the peaks and counts are kept.
+    ``time`` (s): the time of each sample of the record (also without histories)."""
 
 
 LAWS = ("bilinear", "bouc_wen", "bilinear_friction")
@@ -286,7 +297,7 @@ def shear_building(
     if energy:
         e = d["energy"]
         account = Energy(e[:, 0], e[:, 1], e[:, 2], e[:, 3], e[:, 4], e[:, 5], d["initial_energy"])
-    return BuildingResponse(
+    return frames.timed(BuildingResponse(
         d.get("u"),
         d.get("v"),
         d.get("a"),
@@ -296,7 +307,7 @@ def shear_building(
         d.get("iterations"),
         d["peak_drift"],
         d["total_iterations"],
-    )
+    ), h, len(ground_acceleration))
 
 
 # ---------------------------------------------------------------------------------------
@@ -313,6 +324,14 @@ class Spectrum(NamedTuple):
     sa: np.ndarray  #: peak absolute acceleration (m/s²)
     psv: np.ndarray  #: pseudo-velocity ω·sd (m/s)
     psa: np.ndarray  #: pseudo-acceleration ω²·sd (m/s²)
+
+    def to_pandas(self) -> Any:
+        """A ``pandas.DataFrame`` indexed by period (``frames.spectrum_to_pandas``)."""
+        return frames.spectrum_to_pandas(self)
+
+    def to_xarray(self) -> Any:
+        """An ``xarray.Dataset`` on period (``frames.spectrum_to_xarray``)."""
+        return frames.spectrum_to_xarray(self)
 
 
 Progress = Union[bool, Callable[[int, int], Any], None]
@@ -342,8 +361,8 @@ def _progress(progress: Progress, total: int) -> Tuple[Callable[[int], None], Ca
 def spectra(
     periods: ArrayLike,
     damping: ArrayLike,
-    h: float,
-    records: Sequence[ArrayLike],
+    h: Optional[float] = None,
+    records: Union[Sequence[ArrayLike], Any] = None,
     *,
     scheme: str = "exact",
     free_vibration: bool = True,
@@ -357,7 +376,10 @@ def spectra(
     (m/s², each 1-D, any lengths). Results are bit for bit those of one thread.
     ``progress``: a callable ``progress(done, total)`` or ``True`` for a tqdm bar (if tqdm
     is installed); the records then run in batches, the GIL released during each.
+    ``records`` may be a pandas ``DataFrame``, one column a record; ``h`` may then be
+    ``None``, taken from its uniformly spaced time index (s, or timedeltas).
     """
+    records, h = frames.records_in(records, h)
     periods = _vec(periods, "periods")
     damping = _per_period(damping, periods.shape[0], "damping")
     recs = [_vec(r, "a record") for r in records]
@@ -553,13 +575,15 @@ def constant_ductility(
 # Observers.
 
 
-class Estimate(NamedTuple):
-    """State estimates, ``steps×n``, relative to the ground."""
-
+class _Estimate(NamedTuple):
     u: np.ndarray  #: displacements (m)
     v: np.ndarray  #: velocities (m/s)
     drifts: np.ndarray  #: storey drifts u_i − u_{i−1} (m)
     gain: np.ndarray  #: steady-state gain (2n×sensors; empty for the Kalman filter)
+
+
+class Estimate(_Estimate, frames.History):
+    """State estimates, ``steps×n``, relative to the ground; ``time`` (s) of each row."""
 
 
 def observe(
@@ -599,7 +623,7 @@ def observe(
         float(sigma_y),
         bool(kalman),
     )
-    return Estimate(u, v, np.diff(u, axis=1, prepend=0.0), gain)
+    return frames.timed(Estimate(u, v, np.diff(u, axis=1, prepend=0.0), gain), h, u.shape[0])
 
 # ---------------------------------------------------------------------------------------
 # Vibration control.
@@ -751,7 +775,7 @@ DYKE_1996 = {
 MR_PARAMETERS = ("c0a", "c0b", "alpha_a", "alpha_b", "gamma", "beta", "a", "n", "eta", "v_max")
 
 
-def _mr_params(params: Optional[dict]) -> List[float]:
+def _mr_params(params: Optional[Dict[str, float]]) -> List[float]:
     p = dict(DYKE_1996)
     if params is not None:
         unknown = set(params) - set(MR_PARAMETERS)
@@ -761,12 +785,15 @@ def _mr_params(params: Optional[dict]) -> List[float]:
     return [float(p[name]) for name in MR_PARAMETERS]
 
 
-class DamperResponse(NamedTuple):
-    """An MR damper driven by a motion (``mr_damper_response``), one value per sample."""
-
+class _DamperResponse(NamedTuple):
     force: np.ndarray  #: the damper force (N)
     z: np.ndarray  #: the Bouc–Wen variable (m)
     voltage: np.ndarray  #: the filtered voltage u (V)
+
+
+class DamperResponse(_DamperResponse, frames.History):
+    """An MR damper driven by a motion (``mr_damper_response``), one value per sample;
+    ``time`` (s) of each sample."""
 
 
 def mr_damper_response(
@@ -774,7 +801,7 @@ def mr_damper_response(
     xdot: ArrayLike,
     voltage: Union[float, ArrayLike],
     h: float,
-    params: Optional[dict] = None,
+    params: Optional[Dict[str, float]] = None,
 ) -> DamperResponse:
     """The force of the Bouc–Wen MR damper of Dyke et al. (1996) (``aemstep::control::MrDamper``)
     driven by a displacement ``x`` (m) and velocity ``xdot`` (m/s) history sampled every
@@ -790,16 +817,18 @@ def mr_damper_response(
     if v.ndim == 0:
         v = np.full(xs.shape[0], float(v))
     f, z, u = _aemstep.mr_damper_response(xs, _vec(xdot, "xdot"), _vec(v, "voltage"), float(h), _mr_params(params))
-    return DamperResponse(f, z, u)
+    return frames.timed(DamperResponse(f, z, u), h, f.shape[0])
 
 
-class ControlledResponse(NamedTuple):
-    """A building with one MR damper (``mr_building``)."""
-
+class _ControlledResponse(NamedTuple):
     u: np.ndarray  #: displacements relative to the ground (m), steps×n
     v: np.ndarray  #: velocities (m/s), steps×n
     force: np.ndarray  #: the damper force (N), one value per sample
     command: np.ndarray  #: the voltage held from each sample on (V)
+
+
+class ControlledResponse(_ControlledResponse, frames.History):
+    """A building with one MR damper (``mr_building``); ``time`` (s) of each row."""
 
 
 MR_LAWS = ("off", "on", "clipped")
@@ -815,7 +844,7 @@ def mr_building(
     storey: int = 0,
     law: str = "off",
     gain: Optional[ArrayLike] = None,
-    params: Optional[dict] = None,
+    params: Optional[Dict[str, float]] = None,
 ) -> ControlledResponse:
     """A linear building (``m``, ``c``, ``k``: kg, N·s/m, N/m, ``n×n``) with one MR damper
     (Dyke et al. 1996; ``params`` as in ``mr_damper_response``) in storey ``storey`` (0:
@@ -848,7 +877,7 @@ def mr_building(
         law,
         kk,
     )
-    return ControlledResponse(u, v, f, cmd)
+    return frames.timed(ControlledResponse(u, v, f, cmd), h, u.shape[0])
 
 
 # ---------------------------------------------------------------------------------------
@@ -883,7 +912,15 @@ def read_column(path_or_text: Union[str, "os.PathLike[str]"], dt: float) -> Tupl
     return values, float(dt)
 
 
-from ._ida import ida_fractiles, ida_hunt_fill, ida_stripes  # noqa: E402
+from ._ida import (  # noqa: E402  (re-exported: `name as name` for mypy --strict)
+    INTENSITY_MEASURES as INTENSITY_MEASURES,
+    IdaCurve as IdaCurve,
+    ida_fractiles as ida_fractiles,
+    ida_hunt_fill as ida_hunt_fill,
+    ida_stripes as ida_stripes,
+    spectral_acceleration as spectral_acceleration,
+)
+from . import plot as plot  # noqa: E402  (matplotlib imported on use)
 
 __all__ = [
     "G",
@@ -934,4 +971,9 @@ __all__ = [
     "ida_stripes",
     "ida_hunt_fill",
     "ida_fractiles",
+    "IdaCurve",
+    "INTENSITY_MEASURES",
+    "spectral_acceleration",
+    "frames",
+    "plot",
 ] + list(ERROR_VARIANTS)
