@@ -78,9 +78,16 @@ CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}" bash scripts/wheel.sh "$dist
     fail "scripts/wheel.sh (the manylinux wheel and sdist of python/)"
 python3 -m venv "$venv" || fail "python3 -m venv (Debian: apt-get install python3-venv)"
 "$venv/bin/pip" install -q --upgrade "pip>=23" || fail "pip upgrade in the fresh venv"
-# dask[distributed] and tqdm: the cluster and progress-bar tests (optional at run time).
-"$venv/bin/pip" install -q "numpy>=1.21" "pytest>=7" "dask[distributed]>=2023.1" "tqdm>=4.60" ||
-    fail "pip install numpy pytest dask[distributed] tqdm"
+# dask[distributed] and tqdm: the cluster and progress-bar tests (optional at run time);
+# pandas, xarray, matplotlib: the table and plot tests (optional at run time); mypy: the
+# type check below. Pinned: a new release must not change the verdict unseen.
+"$venv/bin/pip" install -q "numpy>=1.21" "pytest>=7" "dask[distributed]>=2023.1" "tqdm>=4.60" \
+    "pandas==3.1.1" "xarray==2026.9.0" "matplotlib==3.11.2" "mypy==2.4.1" ||
+    fail "pip install numpy pytest dask[distributed] tqdm pandas xarray matplotlib mypy"
+# The package's exports and the native module's stub, type-checked as a user's strict
+# project sees them (python/pyproject.toml [tool.mypy]: strict; untyped optional imports).
+"$venv/bin/python" -m mypy --strict --config-file python/pyproject.toml python/aemstep ||
+    fail "mypy --strict python/aemstep (the package's types)"
 # PATH without any directory holding cargo or rustc: the install and the tests see no Rust.
 norust="$venv/bin"
 IFS=: read -r -a dirs <<<"$PATH"
