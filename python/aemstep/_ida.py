@@ -287,6 +287,12 @@ def ida_fractiles(
     default (linear) quantile. ``NaN`` where the quantile depends on curves that never
     collapsed nor reached the level (censored). Returns ``len(q) × len(drifts)``.
     """
+    for i, c in enumerate(curves):
+        if not all(hasattr(c, f) for f in ("intensity", "drift", "collapsed")):
+            raise TypeError(
+                f"curve {i}: ida_fractiles takes the IdaCurve results of ida_stripes / "
+                f"ida_hunt_fill (fields intensity, drift, collapsed), got {type(c).__name__}"
+            )
     levels = np.ascontiguousarray(drifts, dtype=np.float64).reshape(-1)
     qs = np.ascontiguousarray(q, dtype=np.float64).reshape(-1)
     out = _aemstep.ida_fractiles(

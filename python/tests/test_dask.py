@@ -60,6 +60,18 @@ def test_inelastic_spectra_equal_the_serial_run(client, elcentro):
     assert len(cs) == len(cd) == len(recs)
 
 
+def test_spectra_of_a_dataframe_equal_the_serial_run(client, elcentro):
+    pd = pytest.importorskip("pandas")
+    recs, dt = suite(elcentro)
+    n = min(r.shape[0] for r in recs)
+    df = pd.DataFrame({f"r{i}": r[:n] for i, r in enumerate(recs)}, index=np.arange(n) * dt)
+    periods = np.linspace(0.05, 3.0, 8)
+    serial = aemstep.spectra(periods, 0.05, dt, [r[:n] for r in recs], threads=1)
+    par = ad.spectra(client, periods, 0.05, records=df)  # h from the index
+    for x, y in zip(serial, par):
+        np.testing.assert_array_equal(x, y)
+
+
 def test_ida_equals_the_serial_run(client, elcentro):
     recs, dt = suite(elcentro)
     b = building()

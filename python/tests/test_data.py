@@ -114,6 +114,8 @@ def test_ida_results_are_typed_and_pickle(elcentro):
     assert np.array_equal(back.drift, cur.drift) and back.collapse == cur.collapse
     f = aemstep.ida_fractiles(curves, [0.001], q=(0.5,))
     assert f.shape == (1, 1)
+    with pytest.raises(TypeError, match="IdaCurve"):  # the dicts of earlier versions
+        aemstep.ida_fractiles([cur._asdict()], [0.001])
 
 
 # ---------------------------------------------------------------------------------------
