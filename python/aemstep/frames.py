@@ -1,5 +1,7 @@
 """Time axes and tables: the ``.time`` axis of every history result, and optional pandas
-and xarray output (``to_pandas()``, ``to_xarray()``).
+and xarray output (``to_pandas()``, ``to_xarray()`` methods, and ``to_pandas(result)`` /
+``to_xarray(result)`` for every result of the package, the inelastic spectra and RotD
+included).
 
 pandas and xarray are not dependencies of ``aemstep``: they are imported when a
 ``to_pandas``/``to_xarray`` method runs, and a clear ``ImportError`` says what to install
@@ -115,34 +117,88 @@ def timed(result: H, h: float, samples: int) -> H:
     return result
 
 
-_QUANTITIES = ("sd", "sv", "sa", "psv", "psa")
+def _per_period(result: Any) -> Tuple[Any, List[Tuple[str, Any, Any]]]:
+    """``(periods, [(name, key, column)])`` of a result with a ``periods`` field: every
+    field with one value per period (arrays ``periods``, lists of that length), a
+    ``records×periods`` array as one column per record (key the record), a
+    ``periods×k`` array as one column per ``k`` (key ``k``); scalars left out."""
+    periods = np.asarray(result.periods)
+    count = periods.shape[0]
+    cols: List[Tuple[str, Any, Any]] = []
+    for name in result._fields:
+        if name == "periods":
+            continue
+        x = getattr(result, name)
+        if isinstance(x, list) and len(x) == count:
+            cols.append((name, "", x))
+        elif isinstance(x, np.ndarray) and x.ndim == 1 and x.shape[0] == count:
+            cols.append((name, "", x))
+        elif isinstance(x, np.ndarray) and x.ndim == 2 and x.shape[1] == count:
+            cols.extend((name, r, x[r]) for r in range(x.shape[0]))
+        elif isinstance(x, np.ndarray) and x.ndim == 2 and x.shape[0] == count:
+            cols.extend((name, j, x[:, j]) for j in range(x.shape[1]))
+    return periods, cols
 
 
 def spectrum_to_pandas(s: Any) -> Any:
-    """A ``Spectrum`` as a ``pandas.DataFrame`` indexed by ``period`` (s): columns ``sd``,
-    ``sv``, ``sa``, ``psv``, ``psa`` for one record; ``(quantity, record)`` columns (a
-    two-level ``MultiIndex``, records numbered in input order) for ``records×periods``."""
+    """A spectrum result (``Spectrum``, ``RotDSpectrum``, ``ConstantStrength``,
+    ``ConstantDuctility``) as a ``pandas.DataFrame`` indexed by ``period`` (s): one column
+    per quantity (``sd``, ``sv``, … for one record), ``(quantity, record)`` columns (a
+    two-level ``MultiIndex``, records numbered in input order) for ``records×periods``
+    arrays, ``(quantity, end)`` for ``periods×2`` brackets; scalar fields left out."""
     pd = _pandas()
-    index = pd.Index(np.asarray(s.periods), name="period")
-    first = np.asarray(s.sd)
-    if first.ndim == 1:
-        return pd.DataFrame({q: np.asarray(getattr(s, q)) for q in _QUANTITIES}, index=index)
-    cols = {
-        (q, r): np.asarray(getattr(s, q))[r] for q in _QUANTITIES for r in range(first.shape[0])
-    }
+    periods, cols = _per_period(s)
+    index = pd.Index(periods, name="period")
     if not cols:
         return pd.DataFrame(index=index)
-    return pd.DataFrame(cols, index=index)
+    if all(key == "" for _, key, _ in cols):
+        return pd.DataFrame({name: x for name, _, x in cols}, index=index)
+    return pd.DataFrame({(name, key): x for name, key, x in cols}, index=index)
 
 
 def spectrum_to_xarray(s: Any) -> Any:
-    """A ``Spectrum`` as an ``xarray.Dataset``: variables ``sd``, ``sv``, ``sa``, ``psv``,
-    ``psa`` on dimensions ``("period",)`` or ``("record", "period")``, coordinate
+    """A spectrum result as an ``xarray.Dataset``: one variable per quantity on
+    ``("period",)``, ``("record", "period")`` or ``("period", "end")``, coordinate
     ``period`` (s)."""
     xr = _xarray()
-    dims = ("period",) if np.asarray(s.sd).ndim == 1 else ("record", "period")
-    data = {q: (dims, np.asarray(getattr(s, q))) for q in _QUANTITIES}
-    return xr.Dataset(data, coords={"period": np.asarray(s.periods)})
+    periods = np.asarray(s.periods)
+    count = periods.shape[0]
+    data: dict[str, Tuple[Tuple[str, ...], Any]] = {}
+    for name in s._fields:
+        x = getattr(s, name)
+        if name == "periods" or not isinstance(x, (np.ndarray, list)):
+            continue
+        a = np.asarray(x)
+        if a.ndim == 1 and a.shape[0] == count:
+            data[name] = (("period",), a)
+        elif a.ndim == 2 and a.shape[1] == count:
+            data[name] = (("record", "period"), a)
+        elif a.ndim == 2 and a.shape[0] == count:
+            data[name] = (("period", "end"), a)
+    return xr.Dataset(data, coords={"period": periods})
+
+
+def to_pandas(result: Any) -> Any:
+    """Any result of the package as a ``pandas.DataFrame``: a history's
+    ``to_pandas()``, a spectrum result's ``spectrum_to_pandas``, an ``IdaCurve``'s
+    ``to_pandas()``, a list of ``IdaCurve`` as ``ida_to_pandas``."""
+    if isinstance(result, list) and result and all(hasattr(c, "record_intensity") for c in result):
+        return ida_to_pandas(result)
+    if hasattr(result, "to_pandas"):
+        return result.to_pandas()
+    if hasattr(result, "periods"):
+        return spectrum_to_pandas(result)
+    raise TypeError(f"no table for a {type(result).__name__}")
+
+
+def to_xarray(result: Any) -> Any:
+    """Any history or spectrum result as an ``xarray.Dataset`` (``History.to_xarray``,
+    ``spectrum_to_xarray``)."""
+    if hasattr(result, "to_xarray"):
+        return result.to_xarray()
+    if hasattr(result, "periods"):
+        return spectrum_to_xarray(result)
+    raise TypeError(f"no Dataset for a {type(result).__name__}")
 
 
 def ida_to_pandas(curves: Sequence[Any]) -> Any:

@@ -184,8 +184,19 @@ def test_to_pandas_and_to_xarray(elcentro):
     assert np.array_equal(many.to_pandas()[("sd", 1)].to_numpy(), many.sd[1])
     assert many.to_xarray()["psa"].dims == ("record", "period")
 
+    cd = aemstep.constant_ductility(periods, 0.05, dt, ag[:500], 4.0)
+    cdt = aemstep.frames.to_pandas(cd)
+    assert np.array_equal(cdt[("reduction", "")].to_numpy(), cd.reduction)
+    assert np.array_equal(cdt[("bracket", 1)].to_numpy(), cd.bracket[:, 1])
+    assert list(cdt[("outcome", "")]) == cd.outcome and ("passes", "") not in cdt.columns
+    cdx = aemstep.frames.to_xarray(cd)
+    assert cdx["bracket"].dims == ("period", "end")
+    rd = aemstep.rotd(periods, 0.05, dt, ag[:500], ag[500:1000])
+    assert np.array_equal(aemstep.frames.to_pandas(rd)["psa50"].to_numpy(), rd.psa50)
+
     recs, rdt = suite(elcentro)
     curves = aemstep.ida_stripes(recs, rdt, [0.5, 1.0], **building())
+    assert aemstep.frames.to_pandas(curves).equals(aemstep.frames.ida_to_pandas(curves))
     long = aemstep.frames.ida_to_pandas(curves)
     assert len(long) == 6 and list(long["record"]) == [0, 0, 1, 1, 2, 2]
     assert np.array_equal(long["drift"].to_numpy(), np.concatenate([c.drift for c in curves]))
