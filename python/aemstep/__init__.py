@@ -239,6 +239,10 @@ class BuildingResponse(NamedTuple):
 
 LAWS = ("bilinear", "bouc_wen", "bilinear_friction")
 
+#: The largest Newton budget a step may have (``max_iterations``): a larger one could keep
+#: one step (which Ctrl-C cannot split) busy for hours.
+MAX_NEWTON_ITERATIONS = 10_000
+
 
 def shear_building(
     masses: ArrayLike,
@@ -270,7 +274,8 @@ def shear_building(
     ``law="bilinear_friction"`` adds a friction damper with slip force ``fs`` (N) and
     regularization velocity ``vr`` (m/s). Newton: at most ``max_iterations`` a step,
     relative ``tolerance``; a step that does not converge raises ``NotConverged`` (its
-    ``.step`` attribute says which). ``energy=False`` skips the energy account (about one
+    ``.step`` attribute says which); ``max_iterations`` above ``MAX_NEWTON_ITERATIONS``
+    raises ``InvalidArgument``. ``energy=False`` skips the energy account (about one
     more law evaluation per storey a step) for the bare stepping speed.
 
     ``histories=False`` keeps no per-step arrays: ``u``, ``v``, ``a``, ``drifts`` and
@@ -300,7 +305,7 @@ def shear_building(
         _mat(c, "c"),
         float(h),
         _vec(ground_acceleration, "ground_acceleration"),
-        _count(max_iterations, "max_iterations", 2**32 - 1),
+        _count(max_iterations, "max_iterations", MAX_NEWTON_ITERATIONS),
         float(tolerance),
         bool(energy),
         bool(histories),
@@ -941,6 +946,7 @@ __all__ = [
     "ROTD_ANGLES",
     "SCHEMES",
     "LAWS",
+    "MAX_NEWTON_ITERATIONS",
     "ERROR_VARIANTS",
     "AemstepError",
     "ShapeError",

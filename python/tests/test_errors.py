@@ -152,6 +152,10 @@ def test_invalid_parameter_and_material_name_the_rule():
                                                           k=1e8, fy=1e5, max_iterations=-3)),
         ("max_iterations", lambda: aemstep.shear_building([1e5], [[0.0]], 0.01, np.zeros(10),
                                                           k=1e8, fy=1e5, max_iterations=2**40)),
+        # The Newton budget is capped: a step Ctrl-C cannot split never runs for hours.
+        ("max_iterations", lambda: aemstep.shear_building([1e5], [[0.0]], 0.01, np.zeros(10),
+                                                          k=1e8, fy=1e5,
+                                                          max_iterations=aemstep.MAX_NEWTON_ITERATIONS + 1)),
         ("sensors", lambda: aemstep.observe(ONE, ONE, ONE, 0.01, np.zeros(3), np.zeros((3, 1)), [-1],
                                             sigma_f=1.0, sigma_y=1.0)),
         ("sensors", lambda: aemstep.lqg(np.eye(2), np.eye(2), np.eye(2), [1.0, 0.0], 0.01, [-2],
