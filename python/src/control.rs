@@ -22,7 +22,7 @@ use std::sync::atomic::AtomicBool;
 
 use crate::{
     Fail, Res, SIZES, at, buffer, fits, interruptible, matrix, out1, out2, read1, read2, rows,
-    shape, square, stopped,
+    shape, square, stopped, work_units,
 };
 
 /// The largest state size of a design model (`lqr`): 12 (a 6-storey building's `[u; v]`;
@@ -540,7 +540,7 @@ fn mr_damper_response<'py>(
         }
         Ok((f, z, u))
     };
-    let (f, z, u) = interruptible(py, run)?;
+    let (f, z, u) = interruptible(py, work_units(x.len(), 16, 1), run)?;
     Ok((out1(py, f), out1(py, z), out1(py, u)))
 }
 
@@ -713,7 +713,9 @@ fn mr_building<'py>(
         })
     };
     let job = prepare().map_err(|f| f.raise(py))?;
-    let (u, v, f, cmd) = interruptible(py, |stop| by_size!(n, mr_building_n(&job, stop)))?;
+    let (u, v, f, cmd) = interruptible(py, work_units(job.ag.len(), n, 2), |stop| {
+        by_size!(n, mr_building_n(&job, stop))
+    })?;
     Ok((out2(py, u, n), out2(py, v, n), out1(py, f), out1(py, cmd)))
 }
 
