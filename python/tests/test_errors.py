@@ -272,3 +272,13 @@ def test_linear_and_observer_outputs_too_large_are_memory_errors():
         aemstep.observe(ONE, ONE, ONE, 0.01, ag, y, [0], sigma_f=1.0, sigma_y=1.0)
     with pytest.raises(MemoryError, match="mr_building"):
         aemstep.mr_building(ONE, ONE, ONE, ag, 0.01)
+
+
+def test_invalid_argument_pickles_with_its_argument():
+    import pickle
+
+    with pytest.raises(aemstep.InvalidArgument) as info:
+        aemstep.read_at2(5)
+    back = pickle.loads(pickle.dumps(info.value))
+    assert type(back) is aemstep.InvalidArgument and back.argument == "path_or_text"
+    assert str(back) == str(info.value)
