@@ -32,8 +32,12 @@ accelerations in m/s² (``G`` converts from g).
 
 Every ``aemstep::Error`` variant of the Rust library is an exception of the same name
 (``aemstep.NotConverged``, ``aemstep.InvalidTimeStep``, …), subclass of ``AemstepError``
-(a ``ValueError``); ``ShapeError`` is a wrong array shape, ``UnsupportedSize`` a number of
-degrees of freedom the package is not compiled for (``SIZES``).
+(a ``ValueError``); ``ShapeError`` is a wrong array shape (its message names the argument
+and the shape expected), ``UnsupportedSize`` a number of degrees of freedom the package is
+not compiled for (``SIZES``), ``InvalidArgument`` an argument outside its rule (a negative
+count, a file descriptor where a path or text is expected; ``.argument`` names it). An
+output too large for the machine's memory raises ``MemoryError`` before anything is
+allocated; Ctrl-C stops a long call within about 0.1 s (``KeyboardInterrupt``).
 
 See docs/python.md in the repository.
 """
@@ -49,6 +53,7 @@ from . import _aemstep, frames
 from ._aemstep import (  # noqa: F401  (re-exported)
     CHUNK,
     ERROR_VARIANTS,
+    InvalidArgument,
     MAX_CONTROL_INPUTS,
     MAX_DESIGN_STATES,
     MAX_SENSORS,
@@ -111,14 +116,30 @@ def _mat(x: ArrayLike, name: str) -> np.ndarray:
     return np.ascontiguousarray(a)
 
 
-def _per_period(x: ArrayLike, count: int, name: str) -> np.ndarray:
-    """A scalar broadcast to every period, or one value per period."""
+def _count(x: Any, name: str, high: int = 2**63 - 1) -> int:
+    """An integer argument checked in ``0..=high``: ``InvalidArgument`` naming it, not an
+    ``OverflowError`` from the native call."""
+    try:
+        v = int(x)
+    except (TypeError, ValueError):
+        v = None
+    if v is None or v != x or not 0 <= v <= high:
+        e = InvalidArgument(f"{name} must be an integer in [0, {high}], got {x!r}")
+        e.argument = name
+        raise e
+    return v
+
+
+def _per_period(x: ArrayLike, count: int, name: str, per: str = "period") -> np.ndarray:
+    """A scalar broadcast to every period (or storey: ``per``), or one value per period."""
     a = np.asarray(x, dtype=np.float64)
     if a.ndim == 0:
         return np.full(count, float(a))
     a = np.ascontiguousarray(a)
     if a.shape != (count,):
-        raise ShapeError(f"{name} must be a scalar or have one value per period ({count})")
+        raise ShapeError(
+            f"{name} must be a scalar or have one value per {per} ({count},), got shape {a.shape}"
+        )
     return a
 
 
@@ -173,6 +194,8 @@ def linear_response(
     """
     m, c, k = _mat(m, "m"), _mat(c, "c"), _mat(k, "k")
     n = m.shape[0]
+    if m.shape != (n, n):
+        raise ShapeError(f"m must be square (n x n), got shape {m.shape}")
     if (p is None) == (ground_acceleration is None):
         raise ShapeError("give exactly one of p and ground_acceleration")
     if p is None:
@@ -185,7 +208,7 @@ def linear_response(
     u0 = np.zeros(n) if u0 is None else _vec(u0, "u0")
     v0 = np.zeros(n) if v0 is None else _vec(v0, "v0")
     u, v, a = _aemstep.linear_response(
-        m, c, k, float(h), p, u0, v0, scheme, beta, gamma, rho_inf, alpha, int(modes)
+        m, c, k, float(h), p, u0, v0, scheme, beta, gamma, rho_inf, alpha, _count(modes, "modes")
     )
     return frames.timed(LinearResponse(u, v, a), h, u.shape[0])
 
@@ -227,6 +250,10 @@ class BuildingResponse(_BuildingResponse, frames.History):
 
 LAWS = ("bilinear", "bouc_wen", "bilinear_friction")
 
+#: The largest Newton budget a step may have (``max_iterations``): a larger one could keep
+#: one step (which Ctrl-C cannot split) busy for hours.
+MAX_NEWTON_ITERATIONS = 10_000
+
 
 def shear_building(
     masses: ArrayLike,
@@ -258,7 +285,8 @@ def shear_building(
     ``law="bilinear_friction"`` adds a friction damper with slip force ``fs`` (N) and
     regularization velocity ``vr`` (m/s). Newton: at most ``max_iterations`` a step,
     relative ``tolerance``; a step that does not converge raises ``NotConverged`` (its
-    ``.step`` attribute says which). ``energy=False`` skips the energy account (about one
+    ``.step`` attribute says which); ``max_iterations`` above ``MAX_NEWTON_ITERATIONS``
+    raises ``InvalidArgument``. ``energy=False`` skips the energy account (about one
     more law evaluation per storey a step) for the bare stepping speed.
 
     ``histories=False`` keeps no per-step arrays: ``u``, ``v``, ``a``, ``drifts`` and
@@ -271,16 +299,16 @@ def shear_building(
     """
     masses = _vec(masses, "masses")
     count = masses.shape[0]
-    cols = [k, fy, alpha]
+    cols = [("k", k), ("fy", fy), ("alpha", alpha)]
     if law == "bouc_wen":
-        cols += [beta, gamma, n]
+        cols += [("beta", beta), ("gamma", gamma), ("n", n)]
     elif law == "bilinear_friction":
         if fs is None or vr is None:
             raise ShapeError("law='bilinear_friction' needs fs (N) and vr (m/s)")
-        cols += [fs, vr]
+        cols += [("fs", fs), ("vr", vr)]
     elif law != "bilinear":
         raise ValueError(f"unknown law {law!r}: one of {LAWS}")
-    params = np.column_stack([_per_period(x, count, "a storey parameter") for x in cols])
+    params = np.column_stack([_per_period(x, count, name, "storey") for name, x in cols])
     d = _aemstep.shear_building(
         masses,
         law,
@@ -288,7 +316,7 @@ def shear_building(
         _mat(c, "c"),
         float(h),
         _vec(ground_acceleration, "ground_acceleration"),
-        int(max_iterations),
+        _count(max_iterations, "max_iterations", MAX_NEWTON_ITERATIONS),
         float(tolerance),
         bool(energy),
         bool(histories),
@@ -618,7 +646,7 @@ def observe(
         float(h),
         _vec(ground_acceleration, "ground_acceleration"),
         _mat(meas, "measured"),
-        [int(s) for s in sensors],
+        [_count(s, "sensors") for s in sensors],
         float(sigma_f),
         float(sigma_y),
         bool(kalman),
@@ -734,7 +762,7 @@ def lqg(
     ``RiccatiNotConverged``, ``NotStabilizing``, ``UnsupportedSize``, …"""
     if sensed not in SENSED:
         raise ValueError(f"unknown sensed {sensed!r}: one of {SENSED}")
-    sensors = [int(s) for s in sensors]
+    sensors = [_count(s, "sensors") for s in sensors]
     vv = np.asarray(v, dtype=np.float64)
     if vv.ndim == 0:
         vv = float(vv) * np.eye(len(sensors))
@@ -872,7 +900,7 @@ def mr_building(
         _mat(k, "k"),
         _vec(ground_acceleration, "ground_acceleration"),
         float(h),
-        int(storey),
+        _count(storey, "storey"),
         _mr_params(params),
         law,
         kk,
@@ -884,17 +912,41 @@ def mr_building(
 # Records.
 
 
-def _text(path_or_text: Union[str, "os.PathLike[str]"]) -> str:
-    """The text itself (a ``str`` with a line break), else the file's text (UTF-8)."""
+def _text(path_or_text: Union[str, bytes, "os.PathLike[str]"]) -> str:
+    """One rule for what a record reader takes: a ``str`` with a line break is the text
+    itself; ``bytes`` are the file's content (UTF-8); any other ``str`` or ``os.PathLike``
+    is a path, read as UTF-8. Anything else (an ``int`` file descriptor above all) raises
+    ``InvalidArgument``; bytes that are not UTF-8 raise ``MalformedRecord`` with the
+    ``.line`` (1-based) of the first bad byte."""
     if isinstance(path_or_text, str) and "\n" in path_or_text:
         return path_or_text
-    with open(path_or_text, encoding="utf-8") as f:
-        return f.read()
+    if isinstance(path_or_text, (bytes, bytearray)):
+        raw = bytes(path_or_text)
+    elif isinstance(path_or_text, (str, os.PathLike)):
+        with open(path_or_text, "rb") as f:
+            raw = f.read()
+    else:
+        e = InvalidArgument(
+            "path_or_text must be a path (str or os.PathLike), the record's text (a str with a"
+            f" line break) or its bytes, never a file descriptor; got {type(path_or_text).__name__}"
+        )
+        e.argument = "path_or_text"
+        raise e
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as u:
+        line = raw.count(b"\n", 0, u.start) + 1
+        e = MalformedRecord(
+            f"malformed record: the bytes are not UTF-8 (byte {u.start}, line {line})"
+        )
+        e.line = line
+        raise e from None
 
 
-def read_at2(path_or_text: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, float]:
+def read_at2(path_or_text: Union[str, bytes, "os.PathLike[str]"]) -> Tuple[np.ndarray, float]:
     """A PEER NGA ``.AT2`` record (a path, or the text itself: a ``str`` with a line
-    break): ``(accelerations in the file's units (g), dt in s)``. Multiply by ``G`` for
+    break, or the file's ``bytes``; never a file descriptor: ``InvalidArgument``):
+    ``(accelerations in the file's units (g), dt in s)``. Multiply by ``G`` for
     m/s². Parsed by the library's reader (``aemstep::records``): a header without a
     readable ``NPTS``/``DT``, a value that is not a number, or more or fewer values than
     ``NPTS`` raise ``MalformedRecord`` (its ``.line`` is the 1-based line)."""
@@ -902,7 +954,7 @@ def read_at2(path_or_text: Union[str, "os.PathLike[str]"]) -> Tuple[np.ndarray, 
     return values, dt
 
 
-def read_column(path_or_text: Union[str, "os.PathLike[str]"], dt: float) -> Tuple[np.ndarray, float]:
+def read_column(path_or_text: Union[str, bytes, "os.PathLike[str]"], dt: float) -> Tuple[np.ndarray, float]:
     """A one-column record (one number a line; blank lines and ``#`` comments ignored), a
     path or the text itself (a ``str`` with a line break), sampled every ``dt`` s (not in
     the file): ``(values in the file's units, dt)``. Raises ``InvalidTimeStep`` for a
@@ -931,10 +983,12 @@ __all__ = [
     "ROTD_ANGLES",
     "SCHEMES",
     "LAWS",
+    "MAX_NEWTON_ITERATIONS",
     "ERROR_VARIANTS",
     "AemstepError",
     "ShapeError",
     "UnsupportedSize",
+    "InvalidArgument",
     "LinearResponse",
     "linear_response",
     "Energy",

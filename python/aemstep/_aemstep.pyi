@@ -41,6 +41,11 @@ class ShapeError(AemstepError):
 class UnsupportedSize(ShapeError):
     """A number of degrees of freedom or sensors outside those compiled in."""
 
+class InvalidArgument(AemstepError):
+    """An argument outside its rule (a negative count, a file descriptor for a path)."""
+
+    argument: str  # the argument's name
+
 class NonFiniteInput(AemstepError): ...
 class InvalidTimeStep(AemstepError): ...
 class SingularEffectiveMatrix(AemstepError): ...

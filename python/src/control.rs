@@ -18,7 +18,12 @@ use aemstep::{Error, NewtonSettings};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use crate::{Fail, Res, SIZES, at, matrix, out1, out2, read1, read2, rows, shape, square};
+use std::sync::atomic::AtomicBool;
+
+use crate::{
+    Fail, Res, SIZES, at, buffer, fits, interruptible, matrix, out1, out2, read1, read2, rows,
+    shape, square, stopped, work_units,
+};
 
 /// The largest state size of a design model (`lqr`): 12 (a 6-storey building's `[u; v]`;
 /// with the computation delay the design has `S + I` states).
@@ -493,7 +498,7 @@ fn mr_damper_response<'py>(
     Bound<'py, PyArray1<f64>>,
 )> {
     let (x, xdot, voltage) = (read1(&x), read1(&xdot), read1(&voltage));
-    let run = || -> Res<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+    let run = |stop: &AtomicBool| -> Res<(Vec<f64>, Vec<f64>, Vec<f64>)> {
         if x.is_empty() || xdot.len() != x.len() || voltage.len() != x.len() {
             return shape(format!(
                 "x, xdot and voltage must have one value per sample (at least one), got {}, {} and {}",
@@ -513,11 +518,7 @@ fn mr_damper_response<'py>(
             return Err(Fail::Lib(Error::NonFiniteInput, Some(0)));
         }
         let steps = x.len();
-        let (mut f, mut z, mut u) = (
-            Vec::with_capacity(steps),
-            Vec::with_capacity(steps),
-            Vec::with_capacity(steps),
-        );
+        let (mut f, mut z, mut u) = (buffer(steps, 1)?, buffer(steps, 1)?, buffer(steps, 1)?);
         let mut keep = |hist: &aemstep::control::MrHistory<f64>| {
             f.push(damper.delivered_force(hist));
             z.push(hist.z.z);
@@ -525,6 +526,7 @@ fn mr_damper_response<'py>(
         };
         keep(&hist);
         for n in 1..steps {
+            stopped(stop, n)?;
             let v = voltage[n - 1];
             if !(x[n].is_finite() && xdot[n].is_finite() && v.is_finite()) {
                 return Err(Fail::Lib(Error::NonFiniteInput, Some(n)));
@@ -538,7 +540,7 @@ fn mr_damper_response<'py>(
         }
         Ok((f, z, u))
     };
-    let (f, z, u) = py.detach(run).map_err(|f| f.raise(py))?;
+    let (f, z, u) = interruptible(py, work_units(x.len(), 16, 1), run)?;
     Ok((out1(py, f), out1(py, z), out1(py, u)))
 }
 
@@ -569,7 +571,10 @@ struct MrBuildingJob {
 /// sample.
 type MrBuildingOut = (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>);
 
-fn mr_building_n<const N: usize, const S: usize>(job: &MrBuildingJob) -> Res<MrBuildingOut> {
+fn mr_building_n<const N: usize, const S: usize>(
+    job: &MrBuildingJob,
+    stop: &AtomicBool,
+) -> Res<MrBuildingOut> {
     let structure =
         LinearStructure::<f64, N>::new(&rows::<N>(&job.m), &rows::<N>(&job.c), &rows::<N>(&job.k))?;
     let damper = MrDamper::<f64>::new(&job.params)?;
@@ -603,13 +608,14 @@ fn mr_building_n<const N: usize, const S: usize>(job: &MrBuildingJob) -> Res<MrB
         model.set_command(on).map_err(at(0))?;
     }
     let (mut u, mut v, mut f, mut cmd) = (
-        Vec::with_capacity(steps * N),
-        Vec::with_capacity(steps * N),
-        Vec::with_capacity(steps),
-        Vec::with_capacity(steps),
+        buffer(steps, N)?,
+        buffer(steps, N)?,
+        buffer(steps, 1)?,
+        buffer(steps, 1)?,
     );
     for n in 0..steps {
         if n > 0 {
+            stopped(stop, n)?;
             stepper
                 .try_step_with_history(&model, &mut s, &mut hist, &load(job.ag[n]))
                 .map_err(at(n))?;
@@ -671,6 +677,12 @@ fn mr_building<'py>(
 )> {
     let n = m.as_array().dim().0;
     let prepare = || -> Res<MrBuildingJob> {
+        // The histories (u, v: steps×n; force, command), checked before allocating.
+        let steps = ag.as_array().dim();
+        fits(
+            "mr_building",
+            &[(steps, n), (steps, n), (steps, 1), (steps, 1)],
+        )?;
         let ag = read1(&ag);
         if ag.is_empty() {
             return shape("ag must have at least one sample".into());
@@ -701,9 +713,9 @@ fn mr_building<'py>(
         })
     };
     let job = prepare().map_err(|f| f.raise(py))?;
-    let (u, v, f, cmd) = py
-        .detach(|| by_size!(n, mr_building_n(&job)))
-        .map_err(|f| f.raise(py))?;
+    let (u, v, f, cmd) = interruptible(py, work_units(job.ag.len(), n, 2), |stop| {
+        by_size!(n, mr_building_n(&job, stop))
+    })?;
     Ok((out2(py, u, n), out2(py, v, n), out1(py, f), out1(py, cmd)))
 }
 

@@ -6,30 +6,25 @@
 //! **Progress without the GIL.** The library calls its progress callback on the worker
 //! threads, where Python must not be called. The batch runs instead on a scoped background
 //! thread (which drives the library's pool) while the Python thread waits with the GIL
-//! released, waking every [`POLL`] to read an atomic counter, call the user's
+//! released, waking every [`POLL`](crate::POLL) to read an atomic counter, call the user's
 //! `progress(done, total)` and check for signals (Ctrl-C). A raised exception (from the
 //! callback or a `KeyboardInterrupt`) sets a cancel flag that makes every later run of the
 //! batch return at once; the exception is raised when the batch has wound down. The runs
 //! and their order are the library's: the curves are those of the serial run, bit for bit.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Condvar, Mutex};
-use std::time::Duration;
 
 use aemstep::hysteresis::{HistoryModel, Law, ShearBuilding};
 use aemstep::ida::{self, Collapse, Curve, HuntFill, OnFailure, Point};
 use aemstep::nalgebra::SVector;
 use aemstep::{Error, NewtonSettings, Nonlinear, Param};
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::laws::{self, WithLaws};
 use crate::{Fail, Res, SIZES, out1, out2, read1, read2, rows, shape, square};
-
-/// How often the waiting Python thread reports progress and checks for signals.
-const POLL: Duration = Duration::from_millis(100);
 
 /// Steps between two looks at the cancel flag within a run.
 const CANCEL_EVERY: usize = 1024;
@@ -164,8 +159,9 @@ fn batch_n<const N: usize, const S: usize>(
     )
 }
 
-/// Runs the batch on a background thread, the GIL released except at each [`POLL`], where
-/// `progress(done, total)` is called (when `done` moved) and signals are checked.
+/// Runs the batch on a background thread (the crate's [`polled`](crate::polled)), the GIL
+/// released except at each poll, where `progress(done, total)` is called (when `done`
+/// moved) and signals are checked.
 fn run_polled(
     py: Python<'_>,
     job: &IdaJob,
@@ -174,57 +170,23 @@ fn run_polled(
     let n = job.masses.len();
     let total = job.total();
     let done = AtomicUsize::new(0);
-    let cancel = AtomicBool::new(false);
-    let finished = (Mutex::new(false), Condvar::new());
     let tick = |d: usize, _total: usize| {
         done.fetch_max(d, Ordering::Relaxed);
     };
-    std::thread::scope(|scope| {
-        let worker = scope.spawn(|| {
-            let out = by_size!(n, batch_n(job, &tick, &cancel));
-            let (lock, cv) = &finished;
-            *lock.lock().unwrap_or_else(|e| e.into_inner()) = true;
-            cv.notify_all();
-            out
-        });
-        let mut reported = 0usize;
-        let mut raised: Option<PyErr> = None;
-        loop {
-            let over = py.detach(|| {
-                let (lock, cv) = &finished;
-                let guard = lock.lock().unwrap_or_else(|e| e.into_inner());
-                let (guard, _) = cv
-                    .wait_timeout_while(guard, POLL, |f| !*f)
-                    .unwrap_or_else(|e| e.into_inner());
-                *guard
-            });
-            if raised.is_none() {
-                let d = done.load(Ordering::Relaxed);
-                let call = match progress {
-                    Some(f) if d != reported => f.call1((d, total)).map(|_| ()),
-                    _ => Ok(()),
-                };
-                reported = d;
-                if let Err(e) = call.and_then(|()| py.check_signals()) {
-                    cancel.store(true, Ordering::Relaxed);
-                    raised = Some(e);
-                }
-            }
-            if over {
-                break;
-            }
-        }
-        let out = py.detach(|| worker.join());
-        if let Some(e) = raised {
-            return Err(e);
-        }
-        match out {
-            Ok(r) => r.map_err(|f| f.raise(py)),
-            Err(_) => Err(PyRuntimeError::new_err(
-                "aemstep: the IDA worker thread panicked",
-            )),
-        }
-    })
+    let mut reported = 0usize;
+    crate::polled(
+        py,
+        |cancel| by_size!(n, batch_n(job, &tick, cancel)),
+        || {
+            let d = done.load(Ordering::Relaxed);
+            let call = match progress {
+                Some(f) if d != reported => f.call1((d, total)).map(|_| ()),
+                _ => Ok(()),
+            };
+            reported = d;
+            call
+        },
+    )
 }
 
 fn on_failure_of(s: &str) -> PyResult<OnFailure> {

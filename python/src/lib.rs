@@ -34,9 +34,12 @@ use aemstep::{
 };
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
 
 /// The numbers of degrees of freedom (storeys) the package is compiled for.
 pub const SIZES: [usize; 13] = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 12, 15, 20];
@@ -70,6 +73,13 @@ pyo3::create_exception!(
     UnsupportedSize,
     ShapeError,
     "A number of degrees of freedom or sensors outside those compiled in."
+);
+pyo3::create_exception!(
+    aemstep,
+    InvalidArgument,
+    AemstepError,
+    "An argument outside its rule (e.g. a negative count, a file descriptor for a path); \
+     `.argument` names it."
 );
 
 /// One Python exception per `aemstep::Error` variant, same name, subclass of
@@ -105,6 +115,7 @@ macro_rules! variants {
             m.add("AemstepError", py.get_type::<AemstepError>())?;
             m.add("ShapeError", py.get_type::<ShapeError>())?;
             m.add("UnsupportedSize", py.get_type::<UnsupportedSize>())?;
+            m.add("InvalidArgument", py.get_type::<InvalidArgument>())?;
             $(m.add(stringify!($name), py.get_type::<$name>())?;)*
             m.add("ERROR_VARIANTS", vec![$(stringify!($name)),*])?;
             Ok(())
@@ -144,11 +155,17 @@ variants!(
     NotStabilizing,
 );
 
-/// Why a run stopped: a library error (at a step, if a step failed) or a bad argument.
+/// Why a run stopped: a library error (at a step, if a step failed), a bad argument, an
+/// output too large for memory, or the caller's interrupt.
 enum Fail {
     Lib(Error, Option<usize>),
     Shape(String),
     Size(String),
+    /// `MemoryError`: the outputs would not fit (checked before allocating).
+    Memory(String),
+    /// The run saw its stop flag (Ctrl-C on the Python thread); the signal's own
+    /// `KeyboardInterrupt` is what the caller gets.
+    Cancelled,
 }
 
 impl From<Error> for Fail {
@@ -182,6 +199,8 @@ impl Fail {
             }
             Fail::Shape(m) => ShapeError::new_err(m),
             Fail::Size(m) => UnsupportedSize::new_err(m),
+            Fail::Memory(m) => PyMemoryError::new_err(m),
+            Fail::Cancelled => PyKeyboardInterrupt::new_err("aemstep: the run was interrupted"),
         }
     }
 }
@@ -215,6 +234,155 @@ macro_rules! by_size {
             ))),
         }
     };
+}
+
+// ---------------------------------------------------------------------------------------
+// Long calls: off the Python thread, answering Ctrl-C; outputs sized before allocating.
+
+/// How often the waiting Python thread checks for signals (and reports progress).
+pub(crate) const POLL: Duration = Duration::from_millis(100);
+
+/// Steps between two looks at the stop flag within a run: 64 steps are 5 µs to 10 ms of
+/// work (a one-DOF linear step; a 20-storey Newton step at the 10 000-iteration budget the
+/// Python wrapper allows), so Ctrl-C is answered within a second however slow the steps.
+pub(crate) const STOP_EVERY: usize = 64;
+
+/// `Err(Fail::Cancelled)` at every [`STOP_EVERY`]-th step `n` once `stop` is set: the
+/// run's cheap look at its stop flag (one relaxed load per 64 steps).
+pub(crate) fn stopped(stop: &AtomicBool, n: usize) -> Res<()> {
+    if n.is_multiple_of(STOP_EVERY) && stop.load(Ordering::Relaxed) {
+        Err(Fail::Cancelled)
+    } else {
+        Ok(())
+    }
+}
+
+/// Runs `work` on a scoped worker thread while the Python thread waits with the GIL
+/// released, waking every [`POLL`] (or at once when `work` ends) to call `poll` (with the
+/// GIL: e.g. a progress callback) and check for signals. An exception from either (Ctrl-C's
+/// `KeyboardInterrupt`) sets the stop flag `work` is handed — its loops look at it through
+/// [`stopped`] — and is raised once the worker has returned: no thread outlives the call.
+/// A panic in `work` is a `RuntimeError`. Cost: one thread spawn (tens of µs) a call.
+pub(crate) fn polled<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce(&AtomicBool) -> Res<T> + Send,
+    mut poll: impl FnMut() -> PyResult<()>,
+) -> PyResult<T> {
+    let stop = AtomicBool::new(false);
+    let finished = (Mutex::new(false), Condvar::new());
+    /// Marks the worker finished however it ends (a panic included).
+    struct Done<'a>(&'a (Mutex<bool>, Condvar));
+    impl Drop for Done<'_> {
+        fn drop(&mut self) {
+            let (lock, cv) = self.0;
+            *lock.lock().unwrap_or_else(|e| e.into_inner()) = true;
+            cv.notify_all();
+        }
+    }
+    std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            let _done = Done(&finished);
+            work(&stop)
+        });
+        let mut raised: Option<PyErr> = None;
+        loop {
+            let over = py.detach(|| {
+                let (lock, cv) = &finished;
+                let guard = lock.lock().unwrap_or_else(|e| e.into_inner());
+                let (guard, _) = cv
+                    .wait_timeout_while(guard, POLL, |f| !*f)
+                    .unwrap_or_else(|e| e.into_inner());
+                *guard
+            });
+            if raised.is_none()
+                && let Err(e) = poll().and_then(|()| py.check_signals())
+            {
+                stop.store(true, Ordering::Relaxed);
+                raised = Some(e);
+            }
+            if over {
+                break;
+            }
+        }
+        let out = py.detach(|| worker.join());
+        if let Some(e) = raised {
+            return Err(e);
+        }
+        match out {
+            Ok(r) => r.map_err(|f| f.raise(py)),
+            Err(_) => Err(PyRuntimeError::new_err(
+                "aemstep: the worker thread panicked",
+            )),
+        }
+    })
+}
+
+/// Work units (about a multiply-add each: `steps · n²`, `steps · n³` for an observer)
+/// below which a call runs on the Python thread with the GIL released and no worker: a few
+/// ms at most, shorter than the wait for Ctrl-C, and no thread spawn and hand-over (about
+/// 70 µs a call on the 2-core machine) in loops of short calls.
+pub(crate) const INLINE_WORK: usize = 1 << 18;
+
+/// [`polled`] with nothing to report: a long call that answers Ctrl-C. A call of at most
+/// [`INLINE_WORK`] units of `work_units` runs inline instead (the GIL released, never
+/// stopped: it ends sooner than a poll would come).
+pub(crate) fn interruptible<T: Send>(
+    py: Python<'_>,
+    work_units: usize,
+    work: impl FnOnce(&AtomicBool) -> Res<T> + Send,
+) -> PyResult<T> {
+    if work_units <= INLINE_WORK {
+        return py
+            .detach(|| work(&AtomicBool::new(false)))
+            .map_err(|f| f.raise(py));
+    }
+    polled(py, work, || Ok(()))
+}
+
+/// `steps · n^power` work units for [`interruptible`], saturating.
+pub(crate) fn work_units(steps: usize, n: usize, power: u32) -> usize {
+    steps.saturating_mul(n.saturating_pow(power))
+}
+
+/// The machine's memory and swap (bytes) from `/proc/meminfo`, if readable.
+fn memory_limit() -> Option<u128> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kb = |key: &str| -> Option<u128> {
+        let line = info.lines().find(|l| l.starts_with(key))?;
+        line[key.len()..].split_whitespace().next()?.parse().ok()
+    };
+    Some((kb("MemTotal:")? + kb("SwapTotal:").unwrap_or(0)) * 1024)
+}
+
+/// Checks, before anything is allocated, that `float64` arrays of `(rows, cols)` each fit:
+/// their sizes multiplied and summed without overflow, the total within the address space
+/// and the machine's memory and swap. `MemoryError` naming `what` otherwise.
+pub(crate) fn fits(what: &str, arrays: &[(usize, usize)]) -> Res<()> {
+    let total = arrays
+        .iter()
+        .try_fold(0u128, |t, &(r, c)| t.checked_add(r as u128 * c as u128 * 8));
+    let limit = memory_limit()
+        .unwrap_or(isize::MAX as u128)
+        .min(isize::MAX as u128);
+    match total {
+        Some(t) if t <= limit => Ok(()),
+        _ => Err(Fail::Memory(format!(
+            "{what}: the outputs would take {} bytes, more than this machine's {limit} bytes of memory",
+            total.map_or_else(|| "more than 2^128".to_string(), |t| t.to_string())
+        ))),
+    }
+}
+
+/// An empty `Vec` with room for `rows × cols` values, or `MemoryError` (the size checked,
+/// the allocation `try_reserve_exact`: never an abort).
+pub(crate) fn buffer(rows: usize, cols: usize) -> Res<Vec<f64>> {
+    let mut v = Vec::new();
+    rows.checked_mul(cols)
+        .and_then(|n| v.try_reserve_exact(n).ok())
+        .ok_or_else(|| {
+            Fail::Memory(format!("{rows}x{cols} float64 values do not fit in memory"))
+        })?;
+    Ok(v)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -293,17 +461,13 @@ struct LinearJob {
 /// The histories `u, v, a` (row-major, steps × n).
 type Histories = (Vec<f64>, Vec<f64>, Vec<f64>);
 
-fn drive<const N: usize, S>(sys: &S, job: &LinearJob) -> Res<Histories>
+fn drive<const N: usize, S>(sys: &S, job: &LinearJob, stop: &AtomicBool) -> Res<Histories>
 where
     S: Stepper<f64, N, Input = SVector<f64, N>>,
 {
     let steps = job.p.len() / N;
     let load = |n: usize| vector::<N>(&job.p[n * N..(n + 1) * N]);
-    let (mut u, mut v, mut a) = (
-        Vec::with_capacity(steps * N),
-        Vec::with_capacity(steps * N),
-        Vec::with_capacity(steps * N),
-    );
+    let (mut u, mut v, mut a) = (buffer(steps, N)?, buffer(steps, N)?, buffer(steps, N)?);
     let mut keep = |s: &S::State| {
         let f = sys.full_state(s);
         u.extend_from_slice(f.u().as_slice());
@@ -315,6 +479,7 @@ where
         .map_err(at(0))?;
     keep(&s);
     for n in 1..steps {
+        stopped(stop, n)?;
         sys.try_step_with_previous_input(&mut s, &load(n - 1), &load(n))
             .map_err(at(n))?;
         keep(&s);
@@ -322,7 +487,7 @@ where
     Ok((u, v, a))
 }
 
-fn linear_n<const N: usize, const S: usize>(job: &LinearJob) -> Res<Histories> {
+fn linear_n<const N: usize, const S: usize>(job: &LinearJob, stop: &AtomicBool) -> Res<Histories> {
     let (m, c, k) = (
         matrix::<N>(&job.m),
         matrix::<N>(&job.c),
@@ -330,26 +495,32 @@ fn linear_n<const N: usize, const S: usize>(job: &LinearJob) -> Res<Histories> {
     );
     let h = job.h;
     match job.scheme {
-        LinearScheme::Aem => drive::<N, _>(&Linear::<f64, N>::new(&m, &c, &k, h)?, job),
-        LinearScheme::Newmark(beta, gamma) => {
-            drive::<N, _>(&Newmark::<f64, N>::new(&m, &c, &k, h, beta, gamma)?, job)
-        }
-        LinearScheme::GeneralizedAlpha(rho) => {
-            drive::<N, _>(&GeneralizedAlpha::<f64, N>::new(&m, &c, &k, h, rho)?, job)
-        }
-        LinearScheme::Hht(alpha) => {
-            drive::<N, _>(&GeneralizedAlpha::<f64, N>::hht(&m, &c, &k, h, alpha)?, job)
-        }
-        LinearScheme::Exact => drive::<N, _>(&Exact::<f64, N>::new(&m, &c, &k, h)?, job),
+        LinearScheme::Aem => drive::<N, _>(&Linear::<f64, N>::new(&m, &c, &k, h)?, job, stop),
+        LinearScheme::Newmark(beta, gamma) => drive::<N, _>(
+            &Newmark::<f64, N>::new(&m, &c, &k, h, beta, gamma)?,
+            job,
+            stop,
+        ),
+        LinearScheme::GeneralizedAlpha(rho) => drive::<N, _>(
+            &GeneralizedAlpha::<f64, N>::new(&m, &c, &k, h, rho)?,
+            job,
+            stop,
+        ),
+        LinearScheme::Hht(alpha) => drive::<N, _>(
+            &GeneralizedAlpha::<f64, N>::hht(&m, &c, &k, h, alpha)?,
+            job,
+            stop,
+        ),
+        LinearScheme::Exact => drive::<N, _>(&Exact::<f64, N>::new(&m, &c, &k, h)?, job, stop),
         LinearScheme::Modal(r) => match r {
             // Every mode, or the R lowest: R in 1..=MAX_TRUNCATED_MODES (a copy of the
             // modal stepper per (n, R), so the list is short; R > n is the library's error).
-            0 => modal_run::<N, N>(job),
-            r if r == N => modal_run::<N, N>(job),
+            0 => modal_run::<N, N>(job, stop),
+            r if r == N => modal_run::<N, N>(job, stop),
             r if r > N => Err(Error::InvalidModeSelection.into()),
-            1 => modal_run::<N, 1>(job),
-            2 => modal_run::<N, 2>(job),
-            3 => modal_run::<N, 3>(job),
+            1 => modal_run::<N, 1>(job, stop),
+            2 => modal_run::<N, 2>(job, stop),
+            3 => modal_run::<N, 3>(job, stop),
             r => Err(Fail::Size(format!(
                 "{r} modes of {N}: this build keeps 1 to {MAX_TRUNCATED_MODES} modes or all of them"
             ))),
@@ -359,7 +530,7 @@ fn linear_n<const N: usize, const S: usize>(job: &LinearJob) -> Res<Histories> {
 
 /// The `R` lowest modes of the job's model, the loads as `N` inputs (`B = I`), the DOFs as
 /// outputs; the full state rebuilt from the modes at every step.
-fn modal_run<const N: usize, const R: usize>(job: &LinearJob) -> Res<Histories> {
+fn modal_run<const N: usize, const R: usize>(job: &LinearJob, stop: &AtomicBool) -> Res<Histories> {
     let eye = SMatrix::<f64, N, N>::identity();
     let modal = Modal::<f64, N, R, N, N>::new(
         &matrix::<N>(&job.m),
@@ -369,7 +540,7 @@ fn modal_run<const N: usize, const R: usize>(job: &LinearJob) -> Res<Histories> 
         &eye,
         job.h,
     )?;
-    drive::<N, _>(&modal, job)
+    drive::<N, _>(&modal, job, stop)
 }
 
 /// Step the linear model `M u'' + C u' + K u = p(t)` over a load history.
@@ -425,6 +596,9 @@ fn linear_response<'py>(
     };
     let run = || -> Res<(LinearJob, usize)> {
         let n = m.as_array().dim().0;
+        // The copy of `p` and the three histories, checked before anything is allocated.
+        let steps = p.as_array().dim().0;
+        fits("linear_response", &[(steps, n); 4])?;
         let job = LinearJob {
             m: square(&m, n, "m")?,
             c: square(&c, n, "c")?,
@@ -449,9 +623,9 @@ fn linear_response<'py>(
         Ok((job, n))
     };
     let (job, n) = run().map_err(|f| f.raise(py))?;
-    let (u, v, a) = py
-        .detach(|| by_size!(n, linear_n(&job)))
-        .map_err(|f| f.raise(py))?;
+    let (u, v, a) = interruptible(py, work_units(job.p.len() / n.max(1), n, 2), |stop| {
+        by_size!(n, linear_n(&job, stop))
+    })?;
     Ok((out2(py, u, n), out2(py, v, n), out2(py, a, n)))
 }
 
@@ -491,7 +665,11 @@ struct BuildingOut {
     total_iterations: u64,
 }
 
-fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) -> Res<BuildingOut> {
+fn building_run<const N: usize, L: Law<f64>>(
+    laws: [L; N],
+    job: &BuildingJob,
+    stop: &AtomicBool,
+) -> Res<BuildingOut> {
     let masses: [f64; N] = core::array::from_fn(|i| job.masses[i]);
     let building = ShearBuilding::<f64, L, N>::new(masses, laws, &rows::<N>(&job.c))?;
     let stepper = Nonlinear::<f64, N>::new(job.h, job.settings)?;
@@ -508,12 +686,12 @@ fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) ->
     // memory handed to numpy as it is (no copy on the way out).
     let kept = if job.histories { steps } else { 0 };
     let mut o = BuildingOut {
-        u: Vec::with_capacity(kept * N),
-        v: Vec::with_capacity(kept * N),
-        a: Vec::with_capacity(kept * N),
-        drifts: Vec::with_capacity(kept * N),
-        energy: Vec::with_capacity(if job.energy { kept.max(1) * 6 } else { 0 }),
-        iterations: Vec::with_capacity(kept),
+        u: buffer(kept, N)?,
+        v: buffer(kept, N)?,
+        a: buffer(kept, N)?,
+        drifts: buffer(kept, N)?,
+        energy: buffer(if job.energy { kept.max(1) } else { 0 }, 6)?,
+        iterations: buffer(kept, 1)?,
         initial_energy: account.as_ref().map_or(f64::NAN, |e| e.initial),
         peak_drifts: Vec::new(),
         total_iterations: 0,
@@ -555,6 +733,7 @@ fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) ->
         o.energy.extend_from_slice(&row(e));
     }
     for n in 1..steps {
+        stopped(stop, n)?;
         let p = building.ground_load(job.ag[n]);
         let previous = history;
         let report = stepper
@@ -576,15 +755,19 @@ fn building_run<const N: usize, L: Law<f64>>(laws: [L; N], job: &BuildingJob) ->
 }
 
 /// The storey laws from the parameter rows (`laws.rs`), then the run.
-fn building_n<const N: usize, const S: usize>(law: &str, job: &BuildingJob) -> Res<BuildingOut> {
-    struct Run<'a>(&'a BuildingJob);
+fn building_n<const N: usize, const S: usize>(
+    law: &str,
+    job: &BuildingJob,
+    stop: &AtomicBool,
+) -> Res<BuildingOut> {
+    struct Run<'a>(&'a BuildingJob, &'a AtomicBool);
     impl<const N: usize> laws::WithLaws<N> for Run<'_> {
         type Out = BuildingOut;
         fn run<L: Law<f64> + Send + Sync>(self, laws: [L; N]) -> Res<BuildingOut> {
-            building_run::<N, L>(laws, self.0)
+            building_run::<N, L>(laws, self.0, self.1)
         }
     }
-    laws::with_laws::<N, _>(law, &job.params, job.width, Run(job))
+    laws::with_laws::<N, _>(law, &job.params, job.width, Run(job, stop))
 }
 
 /// Step a hysteretic shear building (`ShearBuilding` with the `Nonlinear` AEM stepper and
@@ -636,6 +819,21 @@ fn shear_building<'py>(
                 "params must be {n}x{width} for law {law:?} and {n} storeys, got {r}x{cols}"
             ));
         }
+        // The histories (u, v, a, drifts, iterations, energy) checked before allocating.
+        let steps = ag.as_array().dim();
+        let kept = if histories { steps } else { 0 };
+        let rows = if energy { kept.max(1) } else { 0 };
+        fits(
+            "shear_building",
+            &[
+                (kept, n),
+                (kept, n),
+                (kept, n),
+                (kept, n),
+                (kept, 1),
+                (rows, 6),
+            ],
+        )?;
         let ag = read1(&ag);
         if ag.is_empty() {
             return shape("ag must have at least one sample".into());
@@ -656,9 +854,9 @@ fn shear_building<'py>(
         ))
     };
     let (job, n) = prepare().map_err(|f| f.raise(py))?;
-    let o = py
-        .detach(|| by_size!(n, building_n(law, &job)))
-        .map_err(|f| f.raise(py))?;
+    let o = interruptible(py, work_units(job.ag.len(), n, 2), |stop| {
+        by_size!(n, building_n(law, &job, stop))
+    })?;
     let d = PyDict::new(py);
     let peak = o.peak_drifts.iter().fold(0.0f64, |m, &x| m.max(x));
     d.set_item("peak_drifts", out1(py, o.peak_drifts))?;
@@ -1092,7 +1290,10 @@ struct ObserveJob {
 /// (2n × sensors; empty for the Kalman filter).
 type ObserveOut = (Vec<f64>, Vec<f64>);
 
-fn observe_no<const N: usize, const S: usize, const O: usize>(job: &ObserveJob) -> Res<ObserveOut> {
+fn observe_no<const N: usize, const S: usize, const O: usize>(
+    job: &ObserveJob,
+    stop: &AtomicBool,
+) -> Res<ObserveOut> {
     let (m, c, k) = (
         matrix::<N>(&job.m),
         matrix::<N>(&job.c),
@@ -1114,7 +1315,7 @@ fn observe_no<const N: usize, const S: usize, const O: usize>(job: &ObserveJob) 
     let steps = job.ag.len();
     let w = |n: usize| SVector::<f64, 1>::from([job.ag[n]]);
     let y = |n: usize| SVector::<f64, O>::from_column_slice(&job.y[n * O..(n + 1) * O]);
-    let mut x = Vec::with_capacity(steps * S);
+    let mut x = buffer(steps, S)?;
     if job.kalman {
         let filter = Kalman::<f64, S, 1, O>::new(&model, &meas, &q, &r)?;
         let mut s = filter
@@ -1122,6 +1323,7 @@ fn observe_no<const N: usize, const S: usize, const O: usize>(job: &ObserveJob) 
             .map_err(at(0))?;
         x.extend_from_slice(s.estimate().x().as_slice());
         for n in 1..steps {
+            stopped(stop, n)?;
             filter.try_step(&mut s, &w(n), &y(n)).map_err(at(n))?;
             x.extend_from_slice(s.estimate().x().as_slice());
         }
@@ -1132,6 +1334,7 @@ fn observe_no<const N: usize, const S: usize, const O: usize>(job: &ObserveJob) 
         let mut e = obs.start_at_rest(&w(0)).map_err(at(0))?;
         x.extend_from_slice(e.x().as_slice());
         for n in 1..steps {
+            stopped(stop, n)?;
             obs.try_step(&mut e, &w(n), &y(n)).map_err(at(n))?;
             x.extend_from_slice(e.x().as_slice());
         }
@@ -1139,11 +1342,14 @@ fn observe_no<const N: usize, const S: usize, const O: usize>(job: &ObserveJob) 
     }
 }
 
-fn observe_n<const N: usize, const S: usize>(job: &ObserveJob) -> Res<ObserveOut> {
+fn observe_n<const N: usize, const S: usize>(
+    job: &ObserveJob,
+    stop: &AtomicBool,
+) -> Res<ObserveOut> {
     match job.sensors.len() {
-        1 => observe_no::<N, S, 1>(job),
-        2 if N >= 2 => observe_no::<N, S, 2>(job),
-        3 if N >= 3 => observe_no::<N, S, 3>(job),
+        1 => observe_no::<N, S, 1>(job, stop),
+        2 if N >= 2 => observe_no::<N, S, 2>(job, stop),
+        3 if N >= 3 => observe_no::<N, S, 3>(job, stop),
         o => Err(Fail::Size(format!(
             "{o} sensors on {N} floors: this build takes 1 to {} sensors, at most one per floor",
             MAX_SENSORS.min(N)
@@ -1187,6 +1393,9 @@ fn observe<'py>(
 )> {
     let prepare = || -> Res<(ObserveJob, usize)> {
         let n = m.as_array().dim().0;
+        // The estimate (2n a step) and its split into u and v, checked before allocating.
+        let steps = ag.as_array().dim();
+        fits("observe", &[(steps, 2 * n), (steps, n), (steps, n)])?;
         let ag = read1(&ag);
         let (y, r, cols) = read2(&measured);
         if ag.is_empty() || r != ag.len() || cols != sensors.len() {
@@ -1224,11 +1433,14 @@ fn observe<'py>(
         ))
     };
     let (job, n) = prepare().map_err(|f| f.raise(py))?;
-    let (x, gain) = py
-        .detach(|| by_size!(n, observe_n(&job)))
-        .map_err(|f| f.raise(py))?;
+    let (x, gain) = interruptible(py, work_units(job.ag.len(), n, 3), |stop| {
+        by_size!(n, observe_n(&job, stop))
+    })?;
     let steps = job.ag.len();
-    let (mut u, mut v) = (Vec::with_capacity(steps * n), Vec::with_capacity(steps * n));
+    let (mut u, mut v) = (
+        buffer(steps, n).map_err(|f| f.raise(py))?,
+        buffer(steps, n).map_err(|f| f.raise(py))?,
+    );
     for row in x.chunks(2 * n) {
         u.extend_from_slice(&row[..n]);
         v.extend_from_slice(&row[n..]);

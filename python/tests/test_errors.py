@@ -126,3 +126,159 @@ def test_empty_and_degenerate_inputs_raise_typed_errors_never_crash():
     bad = ag.copy()
     bad[5] = np.nan
     assert np.all(np.isfinite(aemstep.spectrum([0.5, 1.0], 0.05, 0.02, bad).sd))
+
+
+# ---------------------------------------------------------------------------------------
+# Errors that say which argument and which rule (issue 34).
+
+
+def test_invalid_parameter_and_material_name_the_rule():
+    with pytest.raises(aemstep.InvalidParameter) as info:
+        aemstep.linear_response(ONE, ONE, ONE, 0.01, p=np.zeros((3, 1)), scheme="generalized_alpha",
+                                rho_inf=2.0)
+    assert (info.value.parameter, str(info.value)) == ("RhoInf", "invalid parameter: rho_inf must be in [0, 1]")
+    with pytest.raises(aemstep.InvalidMaterial) as info:
+        aemstep.shear_building([1e5], [[0.0]], 0.01, np.zeros(10), k=1e8, fy=1e5, alpha=1.5)
+    assert info.value.parameter == "PostYieldRatio"
+    assert str(info.value) == "invalid material: the post-yield ratio alpha must be in [0, 1)"
+
+
+@pytest.mark.parametrize(
+    "argument, call",
+    [
+        ("modes", lambda: aemstep.linear_response(ONE, ONE, ONE, 0.01, p=np.zeros((3, 1)),
+                                                  scheme="modal", modes=-1)),
+        ("max_iterations", lambda: aemstep.shear_building([1e5], [[0.0]], 0.01, np.zeros(10),
+                                                          k=1e8, fy=1e5, max_iterations=-3)),
+        ("max_iterations", lambda: aemstep.shear_building([1e5], [[0.0]], 0.01, np.zeros(10),
+                                                          k=1e8, fy=1e5, max_iterations=2**40)),
+        # The Newton budget is capped: a step Ctrl-C cannot split never runs for hours.
+        ("max_iterations", lambda: aemstep.shear_building([1e5], [[0.0]], 0.01, np.zeros(10),
+                                                          k=1e8, fy=1e5,
+                                                          max_iterations=aemstep.MAX_NEWTON_ITERATIONS + 1)),
+        ("sensors", lambda: aemstep.observe(ONE, ONE, ONE, 0.01, np.zeros(3), np.zeros((3, 1)), [-1],
+                                            sigma_f=1.0, sigma_y=1.0)),
+        ("sensors", lambda: aemstep.lqg(np.eye(2), np.eye(2), np.eye(2), [1.0, 0.0], 0.01, [-2],
+                                        q=np.eye(4), r=1.0, w=np.eye(4), v=1.0)),
+        ("storey", lambda: aemstep.mr_building(ONE, ONE, ONE, np.zeros(5), 0.01, storey=-1)),
+        ("modes", lambda: aemstep.linear_response(ONE, ONE, ONE, 0.01, p=np.zeros((3, 1)),
+                                                  scheme="modal", modes=1.5)),
+    ],
+)
+def test_negative_or_huge_counts_name_the_argument(argument, call):
+    with pytest.raises(aemstep.InvalidArgument) as info:
+        call()
+    assert info.value.argument == argument
+    assert str(info.value).startswith(f"{argument} must be an integer in [0, ")
+    assert not isinstance(info.value, OverflowError)
+
+
+@pytest.mark.parametrize(
+    "fragment, call",
+    [
+        ("m must be square (n x n), got shape (2, 3)",
+         lambda: aemstep.linear_response(np.ones((2, 3)), np.eye(2), np.eye(2), 0.01,
+                                         ground_acceleration=np.zeros(4))),
+        ("influence must have length 2",
+         lambda: aemstep.linear_response(np.eye(2), np.eye(2), np.eye(2), 0.01,
+                                         ground_acceleration=np.zeros(4), influence=[1.0, 1.0, 1.0])),
+        ("fy must be a scalar or have one value per storey (2,), got shape (3,)",
+         lambda: aemstep.shear_building([1e5, 1e5], np.zeros((2, 2)), 0.01, np.zeros(4), k=1e8,
+                                        fy=[1.0, 2.0, 3.0])),
+        ("k must be 2x2, got 3x3",
+         lambda: aemstep.observe(np.eye(2), np.eye(2), np.eye(3), 0.01, np.zeros(3), np.zeros((3, 1)), [0],
+                                 sigma_f=1.0, sigma_y=1.0)),
+        ("measured must be 3 x 1",
+         lambda: aemstep.observe(np.eye(2), np.eye(2), np.eye(2), 0.01, np.zeros(3), np.zeros((4, 1)), [0],
+                                 sigma_f=1.0, sigma_y=1.0)),
+    ],
+)
+def test_wrong_shapes_are_shape_errors_naming_the_argument(fragment, call):
+    with pytest.raises(aemstep.ShapeError) as info:
+        call()
+    assert fragment in str(info.value)
+
+
+AT2 = "title\nline 2\nline 3\nNPTS=   3, DT=   .0100 SEC\n  0.1 0.2 0.3\n"
+
+
+def test_read_at2_takes_a_path_text_or_bytes_never_a_file_descriptor(tmp_path):
+    f = tmp_path / "r.AT2"
+    f.write_text(AT2)
+    for source in (AT2, AT2.encode(), f, str(f)):
+        acc, dt = aemstep.read_at2(source)
+        assert dt == 0.01 and list(acc) == [0.1, 0.2, 0.3]
+    for fd in (0, 5, 3.0, None):
+        with pytest.raises(aemstep.InvalidArgument) as info:
+            aemstep.read_at2(fd)
+        assert info.value.argument == "path_or_text"
+        assert "never a file descriptor" in str(info.value)
+    with pytest.raises(aemstep.InvalidArgument):
+        aemstep.read_column(5, 0.01)
+
+
+def test_non_utf8_bytes_are_a_malformed_record_at_their_line(tmp_path):
+    raw = AT2.encode().replace(b"0.2", b"0.\xff2")
+    f = tmp_path / "bad.AT2"
+    f.write_bytes(raw)
+    for source in (raw, f):
+        with pytest.raises(aemstep.MalformedRecord) as info:
+            aemstep.read_at2(source)
+        assert info.value.line == 5
+        assert "not UTF-8" in str(info.value) and "line 5" in str(info.value)
+    with pytest.raises(aemstep.MalformedRecord) as info:
+        aemstep.read_column(b"0.1\n\xc3\n", 0.01)
+    assert info.value.line == 2
+
+
+# ---------------------------------------------------------------------------------------
+# Sizes checked before allocating (issue 34): MemoryError, never an abort.
+
+
+def machine_memory():
+    """MemTotal + SwapTotal (bytes), the limit the native calls check against."""
+    try:
+        info = dict(line.split(":", 1) for line in open("/proc/meminfo"))
+    except OSError:
+        pytest.skip("no /proc/meminfo")
+    kb = lambda key: int(info.get(key, "0 kB").split()[0])  # noqa: E731
+    return (kb("MemTotal") + kb("SwapTotal")) * 1024
+
+
+def test_a_shear_building_too_large_for_memory_is_a_memory_error():
+    # 20 storeys: u, v, a and drifts are 4·20·8 = 640 bytes a step; the record (zeros,
+    # pages never touched) is 1/80 of the machine's memory, its histories more than all.
+    steps = machine_memory() // 640 + 1
+    ag = np.zeros(steps)
+    with pytest.raises(MemoryError, match="shear_building: the outputs would take"):
+        aemstep.shear_building(np.ones(20), np.zeros((20, 20)), 0.01, ag, k=1e8, fy=1e5)
+    # Without histories nothing a step is kept: the same record is no longer too large
+    # (stopped at once here by a bad parameter, after the size check).
+    with pytest.raises(aemstep.InvalidMaterial):
+        aemstep.shear_building(np.ones(20), np.zeros((20, 20)), 0.01, ag, k=1e8, fy=-1.0,
+                               histories=False)
+
+
+def test_linear_and_observer_outputs_too_large_are_memory_errors():
+    limit = machine_memory()
+    # p (a third of the memory, zero pages never touched) and three histories like it.
+    steps = limit // 3 // 8 + 1
+    p = np.zeros((steps, 1))
+    with pytest.raises(MemoryError, match="linear_response"):
+        aemstep.linear_response(ONE, ONE, ONE, 0.01, p=p)
+    ag = np.zeros(limit // 32 + 1)
+    y = np.zeros((ag.size, 1))
+    with pytest.raises(MemoryError, match="observe"):
+        aemstep.observe(ONE, ONE, ONE, 0.01, ag, y, [0], sigma_f=1.0, sigma_y=1.0)
+    with pytest.raises(MemoryError, match="mr_building"):
+        aemstep.mr_building(ONE, ONE, ONE, ag, 0.01)
+
+
+def test_invalid_argument_pickles_with_its_argument():
+    import pickle
+
+    with pytest.raises(aemstep.InvalidArgument) as info:
+        aemstep.read_at2(5)
+    back = pickle.loads(pickle.dumps(info.value))
+    assert type(back) is aemstep.InvalidArgument and back.argument == "path_or_text"
+    assert str(back) == str(info.value)

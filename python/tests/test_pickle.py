@@ -13,7 +13,7 @@ import aemstep
 ONE = np.ones((1, 1))
 
 #: Every exception class the package raises: the base, the shape errors, one per variant.
-CLASSES = ["AemstepError", "ShapeError", "UnsupportedSize", *aemstep.ERROR_VARIANTS]
+CLASSES = ["AemstepError", "ShapeError", "UnsupportedSize", "InvalidArgument", *aemstep.ERROR_VARIANTS]
 
 
 def record(bad_at=None, steps=10):

@@ -34,4 +34,4 @@ def test_stub_functions_match_the_extension():
 
 def test_stub_classes_are_the_exceptions():
     classes = {n.name for n in stub_tree().body if isinstance(n, ast.ClassDef)}
-    assert classes == set(aemstep.ERROR_VARIANTS) | {"AemstepError", "ShapeError", "UnsupportedSize"}
+    assert classes == set(aemstep.ERROR_VARIANTS) | {"AemstepError", "ShapeError", "UnsupportedSize", "InvalidArgument"}
