@@ -60,9 +60,9 @@ def _call(fn: Any, recs: List[np.ndarray], kw: Any) -> List[Any]:
 # The single-record (or chunk) calls, run on the workers: exactly the serial API.
 
 
-def _spectra(recs, periods, damping, h, scheme, free_vibration, threads):
+def _spectra(recs, periods, damping, h, scheme, free_vibration, threads, nan="raise"):
     s = aemstep.spectra(periods, damping, h, recs, scheme=scheme,
-                        free_vibration=free_vibration, threads=threads)
+                        free_vibration=free_vibration, threads=threads, nan=nan)
     return [tuple(x[i] for x in s[1:]) for i in range(len(recs))]
 
 
@@ -93,18 +93,22 @@ def spectra(
     free_vibration: bool = True,
     chunk: int = 1,
     threads: int = 1,
+    nan: str = "raise",
 ) -> "aemstep.Spectrum":
     """``aemstep.spectra`` of ``records`` (m/s², sampled every ``h`` s) on the cluster:
     ``sd`` (m), ``sv`` (m/s), ``sa``, ``psa`` (m/s²), ``psv`` (m/s), each
-    ``records×periods``, bit for bit the serial result."""
+    ``records×periods``, and ``skipped`` per record, bit for bit the serial result.
+    ``nan`` as ``aemstep.spectra`` (``NonFiniteInput`` raised from the worker)."""
     periods = np.ascontiguousarray(periods, dtype=np.float64)
     rows = _map(client, _spectra, records, chunk, periods=periods, damping=damping,
                 h=float(h), scheme=scheme, free_vibration=bool(free_vibration),
-                threads=int(threads))
+                threads=int(threads), nan=nan)
     if not rows:
         empty = np.zeros((0, periods.shape[0]))
-        return aemstep.Spectrum(periods, empty, empty, empty, empty, empty)
-    return aemstep.Spectrum(periods, *(np.stack([r[q] for r in rows]) for q in range(5)))
+        return aemstep.Spectrum(periods, empty, empty, empty, empty, empty,
+                                np.zeros(0, dtype=np.int64))
+    return aemstep.Spectrum(periods, *(np.stack([r[q] for r in rows]) for q in range(5)),
+                            np.array([r[5] for r in rows], dtype=np.int64))
 
 
 def constant_strength(
@@ -119,12 +123,13 @@ def constant_strength(
     points_per_period: int = 40,
     chunk: int = 1,
     threads: int = 1,
+    nan: str = "raise",
 ) -> List["aemstep.ConstantStrength"]:
     """``aemstep.constant_strength`` of every record (m/s²) on the cluster: one
     ``ConstantStrength`` per record (ductility for the reduction factors ``R``)."""
     return _map(client, _constant_strength, records, chunk, periods=periods,
                 damping=damping, h=float(h), reduction=reduction, alpha=float(alpha),
-                points_per_period=int(points_per_period), threads=int(threads))
+                points_per_period=int(points_per_period), threads=int(threads), nan=nan)
 
 
 def constant_ductility(
@@ -142,6 +147,7 @@ def constant_ductility(
     points_per_period: int = 40,
     chunk: int = 1,
     threads: int = 1,
+    nan: str = "raise",
 ) -> List["aemstep.ConstantDuctility"]:
     """``aemstep.constant_ductility`` of every record (m/s²) on the cluster: one
     ``ConstantDuctility`` per record (yield strength per unit mass, m/s², for the target
@@ -149,7 +155,7 @@ def constant_ductility(
     return _map(client, _constant_ductility, records, chunk, periods=periods,
                 damping=damping, h=float(h), target=float(target), alpha=float(alpha),
                 points=int(points), lowest=float(lowest), tol=float(tol),
-                points_per_period=int(points_per_period), threads=int(threads))
+                points_per_period=int(points_per_period), threads=int(threads), nan=nan)
 
 
 def ida_stripes(

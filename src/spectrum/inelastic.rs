@@ -789,6 +789,40 @@ impl<T: Real, const P: usize> Yielding<T, P> {
         target: T,
         search: &Search,
     ) -> Result<ConstantDuctility<T, P>, Error> {
+        self.constant_ductility_while(record, target, search, &mut || true)
+    }
+
+    /// [`Yielding::constant_ductility`], asking `go_on()` before each record pass after
+    /// the elastic one: when it returns `false` the search stops there, and every
+    /// oscillator not finished reports [`Outcome::NotConverged`] with the bracket reached
+    /// (as when the pass budget runs out). For a caller that must stop a long search: a
+    /// time budget, or an interrupt from the user (the Python package answers Ctrl-C this
+    /// way). With `go_on` always `true`, the same result, bit for bit.
+    ///
+    /// Errors: as [`Yielding::constant_ductility`]. Cost: as it, plus one call of `go_on`
+    /// a pass.
+    ///
+    /// ```
+    /// use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
+    /// let y = Yielding::<f64, 2>::new([0.3, 1.0], [0.05; 2], 0.0, 0.01)?;
+    /// let rec: Vec<f64> = (0..500).map(|n| 3.0 * (5.0 * n as f64 * 0.01).sin()).collect();
+    /// // stop after 3 passes: the elastic one and 2 of the search
+    /// let mut left = 2;
+    /// let cd = y.constant_ductility_while(&rec, 4.0, &Search::DEFAULT, &mut || {
+    ///     left -= 1;
+    ///     left >= 0
+    /// })?;
+    /// assert_eq!(cd.passes, 3);
+    /// assert!(cd.outcome.iter().all(|&o| o == Outcome::NotConverged));
+    /// # Ok::<(), aemstep::Error>(())
+    /// ```
+    pub fn constant_ductility_while(
+        &self,
+        record: &[T],
+        target: T,
+        search: &Search,
+        go_on: &mut dyn FnMut() -> bool,
+    ) -> Result<ConstantDuctility<T, P>, Error> {
         let eps = T::default_epsilon().as_f64();
         let mu_t = target.as_f64();
         if !(mu_t.is_finite() && mu_t > 1.0) {
@@ -816,7 +850,7 @@ impl<T: Real, const P: usize> Yielding<T, P> {
         }
         let mut passes = 1u32;
         let max_passes = search.points as u32 + 2 * 64;
-        while s.iter().any(|r| r.outcome.is_none()) && passes < max_passes {
+        while s.iter().any(|r| r.outcome.is_none()) && passes < max_passes && go_on() {
             let trial: [T; P] = core::array::from_fn(|p| {
                 if s[p].outcome.is_none() {
                     T::from_f64_rounded(s[p].x)
