@@ -397,8 +397,9 @@ def spectra(
                 )
             except NonFiniteInput as e:
                 # the record's index in ``records``, not in its batch
-                if hasattr(e, "record"):
-                    e.record += done
+                rec = getattr(e, "record", None)
+                if rec is not None:
+                    setattr(e, "record", rec + done)
                 raise
             done += len(b)
             update(done)

@@ -34,6 +34,7 @@ class AemstepError(ValueError):
     """Base of every aemstep error."""
 
     step: int  # set when a step failed: its index (0: the start)
+    record: int  # NonFiniteInput from spectra/rotd: the record's index (rotd: 0 ax, 1 ay)
 
 class ShapeError(AemstepError):
     """An array has the wrong shape or length."""
