@@ -615,7 +615,10 @@ pub fn fractiles(curves: &[Curve], edp: &[f64], q: &[f64]) -> Result<Fractiles, 
 ///
 /// Errors: as [`spectrum::Bank::new`](crate::spectrum::Bank::new)
 /// ([`Error::InvalidPeriod`], [`Error::InvalidDamping`], [`Error::InvalidTimeStep`]);
-/// [`Error::NonFiniteInput`] if a sample is not finite; [`Error::NonFiniteState`] if finite
+/// [`Error::NonFiniteInput`] if a sample is not finite (the bank's default
+/// [`NonFinite::Refuse`](crate::spectrum::NonFinite) policy, as every record-level spectrum
+/// call: [`spectrum::first_non_finite`](crate::spectrum::first_non_finite) gives the
+/// sample's index); [`Error::NonFiniteState`] if finite
 /// samples make the response overflow, [`Error::OperatorOverflow`] if `ω² max|u|` does
 /// ([`spectrum::Bank::response`](crate::spectrum::Bank::response));
 /// [`Error::InvalidTimeStep`] if one period is more than
@@ -637,9 +640,6 @@ pub fn spectral_acceleration(
     period: f64,
     damping: f64,
 ) -> Result<f64, Error> {
-    if record.iter().any(|a| !a.is_finite()) {
-        return Err(Error::NonFiniteInput);
-    }
     let bank = crate::spectrum::Bank::<f64, 1>::new([period], [damping], h)?;
     let r = bank.response(record)?;
     let sa = bank.psa(r.sd())[0];

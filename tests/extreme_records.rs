@@ -118,8 +118,12 @@ fn bank_try_step_leaves_the_response_unchanged_on_overflow() {
     let before = r;
     assert_eq!(b.try_step(&mut r, rec[101]), Err(Error::NonFiniteState));
     assert_eq!(r, before);
-    // a non-finite sample is still skipped and counted, not an error
-    assert_eq!(b.try_step(&mut r, f64::NAN), Ok(()));
+    // a non-finite sample is refused by default, the response unchanged; skipped and
+    // counted when the bank is asked to skip
+    assert_eq!(b.try_step(&mut r, f64::NAN), Err(Error::NonFiniteInput));
+    assert_eq!(r, before);
+    let skipping = b.with_non_finite(aemstep::spectrum::NonFinite::Skip);
+    assert_eq!(skipping.try_step(&mut r, f64::NAN), Ok(()));
     assert_eq!(r.skipped(), 1);
 }
 
@@ -154,7 +158,13 @@ fn yielding_try_step_leaves_the_response_unchanged_on_overflow() {
     let before = r;
     assert_eq!(b.try_step(&mut r, rec[100]), Err(Error::NonFiniteState));
     assert_eq!(r, before);
-    assert_eq!(b.try_step(&mut r, f64::INFINITY), Ok(()));
+    assert_eq!(
+        b.try_step(&mut r, f64::INFINITY),
+        Err(Error::NonFiniteInput)
+    );
+    assert_eq!(r, before);
+    let skipping = b.with_non_finite(aemstep::spectrum::NonFinite::Skip);
+    assert_eq!(skipping.try_step(&mut r, f64::INFINITY), Ok(()));
     assert_eq!(r.skipped(), 1);
 }
 

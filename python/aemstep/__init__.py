@@ -12,6 +12,13 @@ accelerations in m/s² (``G`` converts from g).
 - ``spectrum``, ``spectra``, ``rotd``: elastic response spectra of one record, of many
   records on threads, RotD50/RotD100 of two components.
 - ``constant_strength``, ``constant_ductility``: inelastic spectra.
+
+  A record with a NaN or infinite sample raises ``NonFiniteInput`` (``.step``: the
+  sample's index; ``.record`` too for ``spectra``/``rotd``), as ``linear_response`` and
+  ``shear_building`` do; ``nan="skip"`` holds the last finite sample in its place instead
+  and the result's ``skipped`` counts them. These calls answer Ctrl-C within a fraction of
+  a second (``KeyboardInterrupt``). ``observe`` is different by design: a NaN measurement
+  is a missing one, skipped.
 - ``observe``: a steady-state (Kalman-gain) observer or a Kalman filter of a building's
   state from measured floor accelerations.
 - ``zero_order_hold``, ``lqr``, ``lqg``: the sampled design model of a building, the
@@ -352,6 +359,9 @@ class Spectrum(NamedTuple):
     sa: np.ndarray  #: peak absolute acceleration (m/s²)
     psv: np.ndarray  #: pseudo-velocity ω·sd (m/s)
     psa: np.ndarray  #: pseudo-acceleration ω²·sd (m/s²)
+    #: non-finite samples skipped (``nan="skip"``; 0 otherwise): an int (``spectrum``) or
+    #: one per record (``spectra``)
+    skipped: Union[int, np.ndarray] = 0
 
     def to_pandas(self) -> Any:
         """A ``pandas.DataFrame`` indexed by period (``frames.spectrum_to_pandas``)."""
@@ -396,6 +406,7 @@ def spectra(
     free_vibration: bool = True,
     threads: int = 0,
     progress: Progress = None,
+    nan: str = "raise",
 ) -> Spectrum:
     """Elastic spectra of many records on ``threads`` threads (0: every core).
 
@@ -406,6 +417,12 @@ def spectra(
     is installed); the records then run in batches, the GIL released during each.
     ``records`` may be a pandas ``DataFrame``, one column a record; ``h`` may then be
     ``None``, taken from its uniformly spaced time index (s, or timedeltas).
+
+    ``nan``: a NaN or infinite sample raises ``NonFiniteInput`` (``"raise"``, the default;
+    ``.step`` is the sample's index in its record, ``.record`` the record's index), or is
+    skipped (``"skip"``: the last finite sample held in its place, ``0`` before any; time
+    still advances, so later samples stay on their times), the count per record in
+    ``skipped``. Ctrl-C stops the call within a fraction of a second (``KeyboardInterrupt``).
     """
     records, h = frames.records_in(records, h)
     periods = _vec(periods, "periods")
@@ -422,18 +439,28 @@ def spectra(
     done = 0
     try:
         for b in batches:
-            parts.append(
-                _aemstep.spectra(periods, damping, float(h), b, scheme, free_vibration, threads)
-            )
+            try:
+                parts.append(
+                    _aemstep.spectra(
+                        periods, damping, float(h), b, scheme, free_vibration, threads, nan
+                    )
+                )
+            except NonFiniteInput as e:
+                # the record's index in ``records``, not in its batch
+                rec = getattr(e, "record", None)
+                if rec is not None:
+                    setattr(e, "record", rec + done)
+                raise
             done += len(b)
             update(done)
     finally:
         close()
     if not parts:
         empty = np.zeros((0, periods.shape[0]))
-        return Spectrum(periods, empty, empty, empty, empty, empty)
+        return Spectrum(periods, empty, empty, empty, empty, empty, np.zeros(0, dtype=np.int64))
     cols = [np.concatenate([p[q] for p in parts]) for q in range(5)]
-    return Spectrum(periods, *cols)
+    skipped = np.concatenate([np.asarray(p[5], dtype=np.int64) for p in parts])
+    return Spectrum(periods, *cols, skipped)
 
 
 def spectrum(
@@ -445,8 +472,11 @@ def spectrum(
     scheme: str = "exact",
     free_vibration: bool = True,
     threads: int = 1,
+    nan: str = "raise",
 ) -> Spectrum:
-    """Elastic spectra of one record: as ``spectra`` with one record, one value per period."""
+    """Elastic spectra of one record: as ``spectra`` with one record, one value per period;
+    ``skipped`` an int. ``nan="raise"`` (default: ``NonFiniteInput`` with ``.step``) or
+    ``"skip"``, as ``spectra``."""
     s = spectra(
         periods,
         damping,
@@ -455,8 +485,9 @@ def spectrum(
         scheme=scheme,
         free_vibration=free_vibration,
         threads=threads,
+        nan=nan,
     )
-    return Spectrum(s.periods, *(x[0] for x in s[1:]))
+    return Spectrum(s.periods, *(x[0] for x in s[1:6]), int(np.asarray(s.skipped)[0]))
 
 
 class RotDSpectrum(NamedTuple):
@@ -467,6 +498,8 @@ class RotDSpectrum(NamedTuple):
     rotd100: np.ndarray  #: largest over the angles (m)
     psa50: np.ndarray  #: ω²·rotd50 (m/s²)
     psa100: np.ndarray  #: ω²·rotd100 (m/s²)
+    #: non-finite samples skipped in ``(ax, ay)`` (``nan="skip"``; ``(0, 0)`` otherwise)
+    skipped: Tuple[int, int] = (0, 0)
 
 
 def rotd(
@@ -479,9 +512,12 @@ def rotd(
     scheme: str = "exact",
     free_vibration: bool = True,
     threads: int = 0,
+    nan: str = "raise",
 ) -> RotDSpectrum:
     """RotD50 and RotD100 of the components ``ax``, ``ay`` (m/s², same length, sample
-    interval ``h`` s); ``periods`` (s), ``damping`` as ``spectra``."""
+    interval ``h`` s); ``periods`` (s), ``damping``, ``nan`` as ``spectra`` (under
+    ``"raise"``, ``.record`` is 0 for ``ax``, 1 for ``ay``; under ``"skip"`` each component
+    holds its own last finite sample)."""
     periods = _vec(periods, "periods")
     damping = _per_period(damping, periods.shape[0], "damping")
     out = _aemstep.rotd(
@@ -493,8 +529,9 @@ def rotd(
         scheme,
         free_vibration,
         int(threads),
+        nan,
     )
-    return RotDSpectrum(periods, *out)
+    return RotDSpectrum(periods, *out[:4], (int(out[4][0]), int(out[4][1])))
 
 
 # ---------------------------------------------------------------------------------------
@@ -509,6 +546,7 @@ class ConstantStrength(NamedTuple):
     yield_acceleration: np.ndarray  #: f_y/m = elastic/R (m/s²)
     ductility: np.ndarray  #: μ = max|u| / u_y
     plastic_work: np.ndarray  #: hysteretic work per unit mass (m²/s²)
+    skipped: int = 0  #: non-finite samples skipped (``nan="skip"``; 0 otherwise)
 
 
 def constant_strength(
@@ -521,11 +559,13 @@ def constant_strength(
     alpha: float = 0.0,
     points_per_period: int = 40,
     threads: int = 0,
+    nan: str = "raise",
 ) -> ConstantStrength:
     """Ductility demand of bilinear oscillators (post-yield ratio ``alpha``, 0:
     elastic–perfectly plastic) whose strength is the elastic strength over ``reduction``
     (R, scalar or per period). ``periods`` (s), ``damping`` (ratio), ``h`` (s), record in
-    m/s². Sub-steps: at least ``points_per_period`` per initial period."""
+    m/s². Sub-steps: at least ``points_per_period`` per initial period. ``nan`` as
+    ``spectra``: ``"raise"`` (``NonFiniteInput`` with ``.step``) or ``"skip"``."""
     periods = _vec(periods, "periods")
     count = periods.shape[0]
     out = _aemstep.constant_strength(
@@ -537,8 +577,9 @@ def constant_strength(
         _per_period(reduction, count, "reduction"),
         int(points_per_period),
         int(threads),
+        nan,
     )
-    return ConstantStrength(periods, *out)
+    return ConstantStrength(periods, *out[:4], int(out[4]))
 
 
 class ConstantDuctility(NamedTuple):
@@ -552,6 +593,7 @@ class ConstantDuctility(NamedTuple):
     bracket_ductility: np.ndarray  #: μ at the bracket's ends (periods×2)
     outcome: List[str]  #: "converged", "no_crossing" or "not_converged" per period
     passes: int  #: record passes of the slowest bank
+    skipped: int = 0  #: non-finite samples skipped (``nan="skip"``; 0 otherwise)
 
 
 def constant_ductility(
@@ -567,11 +609,13 @@ def constant_ductility(
     tol: float = 1e-6,
     points_per_period: int = 40,
     threads: int = 0,
+    nan: str = "raise",
 ) -> ConstantDuctility:
     """The largest yield strength per unit mass (m/s²) giving the ductility ``target``
     (> 1) at each period: a geometric grid of ``points`` strengths from the elastic one
     down to ``lowest`` times it brackets the largest crossing, a safeguarded false
-    position refines it to ``tol`` (relative, on the strength)."""
+    position refines it to ``tol`` (relative, on the strength). ``nan`` as ``spectra``:
+    ``"raise"`` (``NonFiniteInput`` with ``.step``) or ``"skip"``."""
     periods = _vec(periods, "periods")
     d = _aemstep.constant_ductility(
         periods,
@@ -585,6 +629,7 @@ def constant_ductility(
         float(tol),
         int(points_per_period),
         int(threads),
+        nan,
     )
     ay = d["yield_acceleration"]
     return ConstantDuctility(
@@ -596,6 +641,7 @@ def constant_ductility(
         d["bracket_ductility"],
         list(d["outcome"]),
         int(d["passes"]),
+        int(d["skipped"]),
     )
 
 

@@ -34,6 +34,7 @@ class AemstepError(ValueError):
     """Base of every aemstep error."""
 
     step: int  # set when a step failed: its index (0: the start)
+    record: int  # NonFiniteInput from spectra/rotd: the record's index (rotd: 0 ax, 1 ay)
 
 class ShapeError(AemstepError):
     """An array has the wrong shape or length."""
@@ -144,11 +145,13 @@ def spectra(
     scheme: str = "exact",
     free_vibration: bool = True,
     threads: int = 1,
-) -> Tuple[F64, F64, F64, F64, F64]:
+    nan: str = "raise",
+) -> Tuple[F64, F64, F64, F64, F64, List[int]]:
     """Elastic spectra of records (m/s², sample interval h s) at periods (s,
     non-decreasing) with damping ratios (one per period), on threads (0: all cores; bit
     for bit the same on any count). Returns (sd m, sv m/s, sa m/s², psv m/s, psa m/s²),
-    each ``records×periods``.
+    each ``records×periods``, and the samples skipped per record. nan: "raise"
+    (NonFiniteInput with .step and .record) or "skip".
     """
 
 def rotd(
@@ -160,9 +163,10 @@ def rotd(
     scheme: str = "exact",
     free_vibration: bool = True,
     threads: int = 1,
-) -> Tuple[F64, F64, F64, F64]:
+    nan: str = "raise",
+) -> Tuple[F64, F64, F64, F64, Tuple[int, int]]:
     """RotD50/RotD100 of two components (m/s²): (rotd50 m, rotd100 m, psa50 m/s²,
-    psa100 m/s²), one value per period."""
+    psa100 m/s²), one value per period, and the samples skipped in (ax, ay)."""
 
 def constant_strength(
     periods: F64,
@@ -173,10 +177,12 @@ def constant_strength(
     reduction: F64,
     points_per_period: int = 40,
     threads: int = 1,
-) -> Tuple[F64, F64, F64, F64]:
+    nan: str = "raise",
+) -> Tuple[F64, F64, F64, F64, int]:
     """Constant-strength spectrum of bilinear oscillators (post-yield ratio alpha in
     [0, 1)): strength = elastic / reduction (R per period). Returns (elastic m/s²,
-    yield_acceleration m/s², ductility, plastic_work m²/s²) per period."""
+    yield_acceleration m/s², ductility, plastic_work m²/s²) per period and the samples
+    skipped."""
 
 def constant_ductility(
     periods: F64,
@@ -190,11 +196,12 @@ def constant_ductility(
     tol: float = 1e-6,
     points_per_period: int = 40,
     threads: int = 1,
+    nan: str = "raise",
 ) -> Dict[str, Any]:
     """Constant-ductility spectrum: the largest yield strength per unit mass (m/s²)
     giving the ductility target (> 1). Returns ``yield_acceleration``, ``elastic``
     (m/s²), ``bracket`` (``periods×2``, m/s²), ``bracket_ductility`` (``periods×2``),
-    ``outcome`` (list of str), ``passes`` (int)."""
+    ``outcome`` (list of str), ``passes`` (int), ``skipped`` (int)."""
 
 def observe(
     m: F64,

@@ -65,10 +65,10 @@ def _call(fn: Any, recs: List[np.ndarray], kw: Any) -> List[Any]:
 
 def _spectra(
     recs: List[np.ndarray], periods: np.ndarray, damping: ArrayLike, h: float, scheme: str,
-    free_vibration: bool, threads: int,
+    free_vibration: bool, threads: int, nan: str = "raise",
 ) -> List[Tuple[np.ndarray, ...]]:
     s = aemstep.spectra(periods, damping, h, recs, scheme=scheme,
-                        free_vibration=free_vibration, threads=threads)
+                        free_vibration=free_vibration, threads=threads, nan=nan)
     return [tuple(x[i] for x in s[1:]) for i in range(len(recs))]
 
 
@@ -99,20 +99,25 @@ def spectra(
     free_vibration: bool = True,
     chunk: int = 1,
     threads: int = 1,
+    nan: str = "raise",
 ) -> "aemstep.Spectrum":
     """``aemstep.spectra`` of ``records`` (m/s², sampled every ``h`` s) on the cluster:
     ``sd`` (m), ``sv`` (m/s), ``sa``, ``psa`` (m/s²), ``psv`` (m/s), each
-    ``records×periods``, bit for bit the serial result. ``records`` may be a pandas
-    ``DataFrame`` (one column a record; ``h`` then from its time index if ``None``)."""
+    ``records×periods``, and ``skipped`` per record, bit for bit the serial result.
+    ``records`` may be a pandas ``DataFrame`` (one column a record; ``h`` then from its
+    time index if ``None``). ``nan`` as ``aemstep.spectra`` (``NonFiniteInput`` raised
+    from the worker)."""
     records, h = frames.records_in(records, h)
     periods = np.ascontiguousarray(periods, dtype=np.float64)
     rows = _map(client, _spectra, records, chunk, periods=periods, damping=damping,
                 h=float(h), scheme=scheme, free_vibration=bool(free_vibration),
-                threads=int(threads))
+                threads=int(threads), nan=nan)
     if not rows:
         empty = np.zeros((0, periods.shape[0]))
-        return aemstep.Spectrum(periods, empty, empty, empty, empty, empty)
-    return aemstep.Spectrum(periods, *(np.stack([r[q] for r in rows]) for q in range(5)))
+        return aemstep.Spectrum(periods, empty, empty, empty, empty, empty,
+                                np.zeros(0, dtype=np.int64))
+    return aemstep.Spectrum(periods, *(np.stack([r[q] for r in rows]) for q in range(5)),
+                            np.array([r[5] for r in rows], dtype=np.int64))
 
 
 def constant_strength(
@@ -127,12 +132,13 @@ def constant_strength(
     points_per_period: int = 40,
     chunk: int = 1,
     threads: int = 1,
+    nan: str = "raise",
 ) -> List["aemstep.ConstantStrength"]:
     """``aemstep.constant_strength`` of every record (m/s²) on the cluster: one
     ``ConstantStrength`` per record (ductility for the reduction factors ``R``)."""
     return _map(client, _constant_strength, records, chunk, periods=periods,
                 damping=damping, h=float(h), reduction=reduction, alpha=float(alpha),
-                points_per_period=int(points_per_period), threads=int(threads))
+                points_per_period=int(points_per_period), threads=int(threads), nan=nan)
 
 
 def constant_ductility(
@@ -150,6 +156,7 @@ def constant_ductility(
     points_per_period: int = 40,
     chunk: int = 1,
     threads: int = 1,
+    nan: str = "raise",
 ) -> List["aemstep.ConstantDuctility"]:
     """``aemstep.constant_ductility`` of every record (m/s²) on the cluster: one
     ``ConstantDuctility`` per record (yield strength per unit mass, m/s², for the target
@@ -157,7 +164,7 @@ def constant_ductility(
     return _map(client, _constant_ductility, records, chunk, periods=periods,
                 damping=damping, h=float(h), target=float(target), alpha=float(alpha),
                 points=int(points), lowest=float(lowest), tol=float(tol),
-                points_per_period=int(points_per_period), threads=int(threads))
+                points_per_period=int(points_per_period), threads=int(threads), nan=nan)
 
 
 def ida_stripes(

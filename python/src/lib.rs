@@ -879,6 +879,49 @@ fn shear_building<'py>(
 // ---------------------------------------------------------------------------------------
 // Spectra: periods in banks of CHUNK.
 
+/// Samples stepped between two looks at the cancel flag (a few ms of the slowest bank).
+const CANCEL_CHUNK: usize = 4096;
+
+/// The non-finite-sample policy named by `nan`: `"raise"` (the default) or `"skip"`.
+fn non_finite_of(nan: &str) -> PyResult<aemstep::spectrum::NonFinite> {
+    match nan {
+        "raise" => Ok(aemstep::spectrum::NonFinite::Refuse),
+        "skip" => Ok(aemstep::spectrum::NonFinite::Skip),
+        other => Err(PyValueError::new_err(format!(
+            "unknown nan policy {other:?}: \"raise\" or \"skip\""
+        ))),
+    }
+}
+
+/// Under `"raise"`, the first record (of `records`, in order) with a non-finite sample:
+/// `NonFiniteInput` with `.step` (the sample's index) and `.record` (the record's).
+fn refuse_non_finite(
+    py: Python<'_>,
+    policy: aemstep::spectrum::NonFinite,
+    records: &[&[f64]],
+) -> PyResult<()> {
+    if policy == aemstep::spectrum::NonFinite::Skip {
+        return Ok(());
+    }
+    for (i, rec) in records.iter().enumerate() {
+        if let Some(k) = aemstep::spectrum::first_non_finite(rec) {
+            let err = Fail::Lib(Error::NonFiniteInput, Some(k)).raise(py);
+            let _ = err.value(py).setattr("record", i);
+            return Err(err);
+        }
+    }
+    Ok(())
+}
+
+/// A library error of a record-level call on `record`: `NonFiniteInput` gets the index of
+/// the sample refused (`.step`), the library's [`first_non_finite`](aemstep::spectrum::first_non_finite).
+fn on_record(record: &[f64]) -> impl Fn(Error) -> Fail + '_ {
+    move |e| match e {
+        Error::NonFiniteInput => Fail::Lib(e, aemstep::spectrum::first_non_finite(record)),
+        e => Fail::Lib(e, None),
+    }
+}
+
 /// Periods and damping checked (same length, periods non-decreasing) and cut into banks of
 /// `CHUNK`, the last padded with copies of the last period.
 fn chunks(periods: &[f64], damping: &[f64]) -> Res<Vec<([f64; CHUNK], [f64; CHUNK])>> {
@@ -930,14 +973,17 @@ type Spectrum = [Vec<f64>; 5];
 /// records (s); `records` — a list of 1-D arrays of ground acceleration (m/s²); `scheme` —
 /// `"exact"` (piecewise exact, default) or `"aem"`; `free_vibration` — continue each
 /// record in free vibration for one longest period (catches late peaks); `threads` —
-/// threads of the work-stealing pool (0: all cores). Results are bit for bit the same on
-/// any thread count.
+/// threads of the work-stealing pool (0: all cores); `nan` — `"raise"` (a non-finite
+/// sample raises `NonFiniteInput` with `.step`, its index, and `.record`) or `"skip"`
+/// (held at the last finite sample, counted). Results are bit for bit the same on any
+/// thread count. Ctrl-C stops the call within a fraction of a second.
 ///
-/// Returns `(sd, sv, sa, psv, psa)`, each `records×periods`: peak relative displacement
-/// (m), peak relative velocity (m/s), peak absolute acceleration (m/s²), pseudo-velocity
-/// `ω·sd` (m/s), pseudo-acceleration `ω²·sd` (m/s²).
+/// Returns `(sd, sv, sa, psv, psa, skipped)`, each `records×periods`, and the skipped
+/// samples per record: peak relative displacement (m), peak relative velocity (m/s), peak
+/// absolute acceleration (m/s²), pseudo-velocity `ω·sd` (m/s), pseudo-acceleration `ω²·sd`
+/// (m/s²).
 #[pyfunction]
-#[pyo3(signature = (periods, damping, h, records, scheme="exact", free_vibration=true, threads=1))]
+#[pyo3(signature = (periods, damping, h, records, scheme="exact", free_vibration=true, threads=1, nan="raise"))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn spectra<'py>(
     py: Python<'py>,
@@ -948,22 +994,30 @@ fn spectra<'py>(
     scheme: &str,
     free_vibration: bool,
     threads: usize,
+    nan: &str,
 ) -> PyResult<(
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
     Bound<'py, PyArray2<f64>>,
+    Vec<u64>,
 )> {
     let scheme = scheme_of(scheme)?;
+    let policy = non_finite_of(nan)?;
     let periods = read1(&periods);
     let damping = read1(&damping);
     let records: Vec<Vec<f64>> = records.iter().map(read1).collect();
+    let slices: Vec<&[f64]> = records.iter().map(|r| r.as_slice()).collect();
+    refuse_non_finite(py, policy, &slices)?;
     let np = periods.len();
-    let run = || -> Res<Vec<Spectrum>> {
+    let run = |cancel: &std::sync::atomic::AtomicBool| -> Res<(Vec<Spectrum>, Vec<u64>)> {
         let banks = chunks(&periods, &damping)?
             .into_iter()
-            .map(|(t, z)| Bank::<f64, CHUNK>::with(t, z, h, scheme, Substeps::AUTO))
+            .map(|(t, z)| {
+                Bank::<f64, CHUNK>::with(t, z, h, scheme, Substeps::AUTO)
+                    .map(|b| b.with_non_finite(policy))
+            })
             .collect::<Result<Vec<_>, _>>()?;
         // One longest period of free vibration for every bank: the result of a period
         // does not depend on the bank it falls in.
@@ -975,13 +1029,26 @@ fn spectra<'py>(
         let jobs: Vec<(usize, usize)> = (0..records.len())
             .flat_map(|r| (0..banks.len()).map(move |b| (r, b)))
             .collect();
+        let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
         let parts = batch::map(&jobs, threads, |&(r, b)| {
             let bank = &banks[b];
             let mut resp = bank.at_rest();
-            for &a in &records[r] {
-                bank.step(&mut resp, a);
+            // Unchecked steps (non-finite samples were refused above, or are skipped and
+            // counted), the cancel flag looked at between chunks.
+            for chunk in records[r].chunks(CANCEL_CHUNK) {
+                if stop() {
+                    break;
+                }
+                for &a in chunk {
+                    bank.step(&mut resp, a);
+                }
             }
-            bank.free_vibration(&mut resp, fv);
+            let mut left = fv;
+            while left > 0 && !stop() {
+                let n = left.min(CANCEL_CHUNK as u32);
+                bank.free_vibration(&mut resp, n);
+                left -= n;
+            }
             let sd = *resp.sd();
             let part = (sd, *resp.sv(), *resp.sa(), bank.psv(&sd), bank.psa(&sd));
             // A finite sample that overflowed the response stays non-finite to the end
@@ -989,14 +1056,16 @@ fn spectra<'py>(
             if !resp.is_finite() {
                 Err(Error::NonFiniteState)
             } else if part.3.iter().chain(&part.4).all(|x| x.is_finite()) {
-                Ok(part)
+                Ok((part, resp.skipped()))
             } else {
                 Err(Error::OperatorOverflow)
             }
         });
         let mut out: Vec<Spectrum> = (0..records.len()).map(|_| Default::default()).collect();
+        let mut skipped = vec![0u64; records.len()];
         for (&(r, _), part) in jobs.iter().zip(parts) {
-            let part = part?;
+            let (part, s) = part?;
+            skipped[r] = s;
             let o = &mut out[r];
             o[0].extend_from_slice(&part.0);
             o[1].extend_from_slice(&part.1);
@@ -1007,26 +1076,28 @@ fn spectra<'py>(
         for o in &mut out {
             o.iter_mut().for_each(|v| v.truncate(np));
         }
-        Ok(out)
+        Ok((out, skipped))
     };
-    let out = py.detach(run).map_err(|f| f.raise(py))?;
+    let (out, skipped) = polled(py, run, || Ok(()))?;
     let take = |q: usize| {
         let v: Vec<f64> = out.iter().flat_map(|o| o[q].iter().copied()).collect();
         out2(py, v, np)
     };
-    Ok((take(0), take(1), take(2), take(3), take(4)))
+    Ok((take(0), take(1), take(2), take(3), take(4), skipped))
 }
 
 /// RotD50 and RotD100 of two horizontal components.
 ///
 /// Arguments: `periods` (s, non-decreasing), `damping` (one ratio per period), `h` (s),
 /// `ax`, `ay` — the two components (m/s², same length and sample interval), `scheme`,
-/// `free_vibration`, `threads` as `spectra`. Rotation angles: 180 (1°).
+/// `free_vibration`, `threads`, `nan` as `spectra` (under `"raise"`, `.record` is 0 for
+/// `ax`, 1 for `ay`). Rotation angles: 180 (1°).
 ///
-/// Returns `(rotd50, rotd100, psa50, psa100)`: spectral displacements (m), the median and
-/// the largest over the angles, and their pseudo-accelerations `ω²·sd` (m/s²).
+/// Returns `(rotd50, rotd100, psa50, psa100, skipped)`: spectral displacements (m), the
+/// median and the largest over the angles, their pseudo-accelerations `ω²·sd` (m/s²), and
+/// the samples skipped in each component `(ax, ay)`.
 #[pyfunction]
-#[pyo3(signature = (periods, damping, h, ax, ay, scheme="exact", free_vibration=true, threads=1))]
+#[pyo3(signature = (periods, damping, h, ax, ay, scheme="exact", free_vibration=true, threads=1, nan="raise"))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn rotd<'py>(
     py: Python<'py>,
@@ -1038,16 +1109,20 @@ fn rotd<'py>(
     scheme: &str,
     free_vibration: bool,
     threads: usize,
+    nan: &str,
 ) -> PyResult<(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
+    (u64, u64),
 )> {
     let scheme = scheme_of(scheme)?;
+    let policy = non_finite_of(nan)?;
     let (periods, damping, ax, ay) = (read1(&periods), read1(&damping), read1(&ax), read1(&ay));
+    refuse_non_finite(py, policy, &[&ax, &ay])?;
     let np = periods.len();
-    let run = || -> Res<[Vec<f64>; 4]> {
+    let run = |cancel: &std::sync::atomic::AtomicBool| -> Res<([Vec<f64>; 4], (u64, u64))> {
         if ax.len() != ay.len() {
             return shape(format!(
                 "ax ({}) and ay ({}) must have the same length",
@@ -1057,43 +1132,59 @@ fn rotd<'py>(
         }
         let banks = chunks(&periods, &damping)?
             .into_iter()
-            .map(|(t, z)| Bank::<f64, CHUNK>::with(t, z, h, scheme, Substeps::AUTO))
+            .map(|(t, z)| {
+                Bank::<f64, CHUNK>::with(t, z, h, scheme, Substeps::AUTO)
+                    .map(|b| b.with_non_finite(policy))
+            })
             .collect::<Result<Vec<_>, _>>()?;
         let fv = if free_vibration {
             banks.last().map_or(0, |b| b.free_vibration_samples())
         } else {
             0
         };
+        let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
         let angles = RotD::<f64, ROTD_ANGLES>::new();
         let parts = batch::map(&banks, threads, |bank| {
             let mut r = angles.at_rest(bank);
-            for (&x, &y) in ax.iter().zip(&ay) {
-                angles.step(bank, &mut r, x, y);
+            for (cx, cy) in ax.chunks(CANCEL_CHUNK).zip(ay.chunks(CANCEL_CHUNK)) {
+                if stop() {
+                    break;
+                }
+                for (&x, &y) in cx.iter().zip(cy) {
+                    angles.step(bank, &mut r, x, y);
+                }
             }
-            angles.free_vibration(bank, &mut r, fv);
+            let mut left = fv;
+            while left > 0 && !stop() {
+                let n = left.min(CANCEL_CHUNK as u32);
+                angles.free_vibration(bank, &mut r, n);
+                left -= n;
+            }
             let (d50, d100) = (r.rotd50(), r.rotd100());
             let part = (d50, d100, bank.psa(&d50), bank.psa(&d100));
             if !r.is_finite() {
                 Err(Error::NonFiniteState)
             } else if part.2.iter().chain(&part.3).all(|x| x.is_finite()) {
-                Ok(part)
+                Ok((part, (r.x().skipped(), r.y().skipped())))
             } else {
                 Err(Error::OperatorOverflow)
             }
         });
         let mut out: [Vec<f64>; 4] = Default::default();
+        let mut skipped = (0, 0);
         for p in parts {
-            let p = p?;
+            let (p, s) = p?;
+            skipped = s;
             out[0].extend_from_slice(&p.0);
             out[1].extend_from_slice(&p.1);
             out[2].extend_from_slice(&p.2);
             out[3].extend_from_slice(&p.3);
         }
         out.iter_mut().for_each(|v| v.truncate(np));
-        Ok(out)
+        Ok((out, skipped))
     };
-    let [a, b, c, d] = py.detach(run).map_err(|f| f.raise(py))?;
-    Ok((out1(py, a), out1(py, b), out1(py, c), out1(py, d)))
+    let ([a, b, c, d], skipped) = polled(py, run, || Ok(()))?;
+    Ok((out1(py, a), out1(py, b), out1(py, c), out1(py, d), skipped))
 }
 
 // ---------------------------------------------------------------------------------------
@@ -1105,6 +1196,7 @@ fn yielding_banks(
     alpha: f64,
     h: f64,
     points_per_period: u16,
+    policy: aemstep::spectrum::NonFinite,
 ) -> Res<Vec<Yielding<f64, CHUNK>>> {
     Ok(chunks(periods, damping)?
         .into_iter()
@@ -1116,6 +1208,7 @@ fn yielding_banks(
                 h,
                 Substeps::PointsPerPeriod(points_per_period),
             )
+            .map(|y| y.with_non_finite(policy))
         })
         .collect::<Result<Vec<_>, _>>()?)
 }
@@ -1127,13 +1220,16 @@ fn yielding_banks(
 /// stiffness, one per period), `alpha` — post-yield stiffness ratio in [0, 1) (0:
 /// elastic–perfectly plastic), `h` — sample interval (s), `ag` — ground acceleration
 /// (m/s²), `reduction` — `R` per period (> 0), `points_per_period` — sub-steps rule (at
-/// least this many points per initial period; 40 by default), `threads`.
+/// least this many points per initial period; 40 by default), `threads`, `nan` —
+/// `"raise"` (`NonFiniteInput` with `.step`) or `"skip"`, as `spectra`. Ctrl-C stops the
+/// call after the record passes running (two a bank).
 ///
-/// Returns `(elastic, yield_acceleration, ductility, plastic_work)` per period: elastic
-/// strength per unit mass `ω² u_o` (m/s²), yield strength per unit mass `elastic/R`
-/// (m/s²), ductility `max|u|/u_y`, plastic work per unit mass (m²/s²).
+/// Returns `(elastic, yield_acceleration, ductility, plastic_work, skipped)`: per period,
+/// elastic strength per unit mass `ω² u_o` (m/s²), yield strength per unit mass
+/// `elastic/R` (m/s²), ductility `max|u|/u_y`, plastic work per unit mass (m²/s²); and the
+/// samples skipped.
 #[pyfunction]
-#[pyo3(signature = (periods, damping, alpha, h, ag, reduction, points_per_period=40, threads=1))]
+#[pyo3(signature = (periods, damping, alpha, h, ag, reduction, points_per_period=40, threads=1, nan="raise"))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn constant_strength<'py>(
     py: Python<'py>,
@@ -1145,12 +1241,15 @@ fn constant_strength<'py>(
     reduction: PyReadonlyArray1<'py, f64>,
     points_per_period: u16,
     threads: usize,
+    nan: &str,
 ) -> PyResult<(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
+    u64,
 )> {
+    let policy = non_finite_of(nan)?;
     let (periods, damping, ag, reduction) = (
         read1(&periods),
         read1(&damping),
@@ -1158,36 +1257,43 @@ fn constant_strength<'py>(
         read1(&reduction),
     );
     let np = periods.len();
-    let run = || -> Res<[Vec<f64>; 4]> {
+    let run = |cancel: &std::sync::atomic::AtomicBool| -> Res<([Vec<f64>; 4], u64)> {
         if reduction.len() != np {
             return shape(format!(
                 "reduction must have one factor per period ({np}), got {}",
                 reduction.len()
             ));
         }
-        let banks = yielding_banks(&periods, &damping, alpha, h, points_per_period)?;
+        let banks = yielding_banks(&periods, &damping, alpha, h, points_per_period, policy)?;
         let jobs: Vec<usize> = (0..banks.len()).collect();
         let last = np - 1;
         let parts = batch::map(&jobs, threads, |&b| {
+            if cancel.load(std::sync::atomic::Ordering::Relaxed) {
+                // Interrupted: the caller raises KeyboardInterrupt, this is dropped.
+                return Err(Fail::Lib(Error::NonFiniteInput, None));
+            }
             let r: [f64; CHUNK] = core::array::from_fn(|j| reduction[(b * CHUNK + j).min(last)]);
-            banks[b].constant_strength(&ag, &r)
+            banks[b].constant_strength(&ag, &r).map_err(on_record(&ag))
         });
         let mut out: [Vec<f64>; 4] = Default::default();
+        let mut skipped = 0;
         for p in parts {
             let p = p?;
+            skipped = p.response.skipped();
             out[0].extend_from_slice(&p.elastic);
             out[1].extend_from_slice(&p.yield_acceleration);
             out[2].extend_from_slice(&p.ductility);
             out[3].extend_from_slice(&p.plastic_work);
         }
         out.iter_mut().for_each(|v| v.truncate(np));
-        Ok(out)
+        Ok((out, skipped))
     };
-    let [a, b, c, d] = py.detach(run).map_err(|f| f.raise(py))?;
-    Ok((out1(py, a), out1(py, b), out1(py, c), out1(py, d)))
+    let ([a, b, c, d], skipped) = polled(py, run, || Ok(()))?;
+    Ok((out1(py, a), out1(py, b), out1(py, c), out1(py, d), skipped))
 }
 
-/// `yield_acceleration, elastic, bracket, bracket ductility, outcome, passes` (row-major).
+/// `yield_acceleration, elastic, bracket, bracket ductility, outcome, passes, skipped`
+/// (row-major).
 type DuctilityOut = (
     Vec<f64>,
     Vec<f64>,
@@ -1195,6 +1301,7 @@ type DuctilityOut = (
     Vec<f64>,
     Vec<&'static str>,
     u32,
+    u64,
 );
 
 /// The constant-ductility inelastic spectrum: the largest strength giving a target
@@ -1203,13 +1310,15 @@ type DuctilityOut = (
 ///
 /// Arguments: as `constant_strength`, with `target` — the ductility `μ_t > 1` — instead of
 /// `reduction`; `points`, `lowest`, `tol` — the search grid (points from the elastic
-/// strength down to `lowest` times it) and the relative tolerance on the strength.
+/// strength down to `lowest` times it) and the relative tolerance on the strength; `nan`
+/// as `spectra`. Ctrl-C stops the search after the record pass running.
 ///
 /// Returns a dict: `yield_acceleration` (m/s²), `elastic` (m/s²), `bracket` (`periods×2`,
 /// m/s²), `bracket_ductility` (`periods×2`), `outcome` (list of `"converged"`,
-/// `"no_crossing"`, `"not_converged"`), `passes` (record passes of the slowest bank).
+/// `"no_crossing"`, `"not_converged"`), `passes` (record passes of the slowest bank),
+/// `skipped` (samples skipped).
 #[pyfunction]
-#[pyo3(signature = (periods, damping, alpha, h, ag, target, points=60, lowest=0.01, tol=1e-6, points_per_period=40, threads=1))]
+#[pyo3(signature = (periods, damping, alpha, h, ag, target, points=60, lowest=0.01, tol=1e-6, points_per_period=40, threads=1, nan="raise"))]
 #[allow(clippy::too_many_arguments)]
 fn constant_ductility<'py>(
     py: Python<'py>,
@@ -1224,7 +1333,9 @@ fn constant_ductility<'py>(
     tol: f64,
     points_per_period: u16,
     threads: usize,
+    nan: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let policy = non_finite_of(nan)?;
     let (periods, damping, ag) = (read1(&periods), read1(&damping), read1(&ag));
     let np = periods.len();
     let search = Search {
@@ -1232,13 +1343,15 @@ fn constant_ductility<'py>(
         lowest,
         tol,
     };
-    let run = || -> Res<DuctilityOut> {
-        let banks = yielding_banks(&periods, &damping, alpha, h, points_per_period)?;
+    let run = |cancel: &std::sync::atomic::AtomicBool| -> Res<DuctilityOut> {
+        let banks = yielding_banks(&periods, &damping, alpha, h, points_per_period, policy)?;
         let parts = batch::map(&banks, threads, |bank| {
-            bank.constant_ductility(&ag, target, &search)
+            let mut go_on = || !cancel.load(std::sync::atomic::Ordering::Relaxed);
+            bank.constant_ductility_while(&ag, target, &search, &mut go_on)
+                .map_err(on_record(&ag))
         });
-        let (mut ay, mut el, mut br, mut mu, mut oc, mut passes) =
-            (vec![], vec![], vec![], vec![], vec![], 0);
+        let (mut ay, mut el, mut br, mut mu, mut oc, mut passes, mut skipped) =
+            (vec![], vec![], vec![], vec![], vec![], 0, 0);
         for p in parts {
             let p = p?;
             ay.extend_from_slice(&p.yield_acceleration);
@@ -1251,15 +1364,16 @@ fn constant_ductility<'py>(
                 Outcome::NotConverged => "not_converged",
             }));
             passes = passes.max(p.passes);
+            skipped = p.skipped;
         }
         ay.truncate(np);
         el.truncate(np);
         br.truncate(2 * np);
         mu.truncate(2 * np);
         oc.truncate(np);
-        Ok((ay, el, br, mu, oc, passes))
+        Ok((ay, el, br, mu, oc, passes, skipped))
     };
-    let (ay, el, br, mu, oc, passes) = py.detach(run).map_err(|f| f.raise(py))?;
+    let (ay, el, br, mu, oc, passes, skipped) = polled(py, run, || Ok(()))?;
     let d = PyDict::new(py);
     d.set_item("yield_acceleration", out1(py, ay))?;
     d.set_item("elastic", out1(py, el))?;
@@ -1267,6 +1381,7 @@ fn constant_ductility<'py>(
     d.set_item("bracket_ductility", out2(py, mu, 2))?;
     d.set_item("outcome", oc)?;
     d.set_item("passes", passes)?;
+    d.set_item("skipped", skipped)?;
     Ok(d)
 }
 

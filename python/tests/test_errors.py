@@ -122,10 +122,14 @@ def test_empty_and_degenerate_inputs_raise_typed_errors_never_crash():
     # An empty record gives zero spectra, an empty list of records empty arrays.
     assert np.all(aemstep.spectrum([1.0], 0.05, 0.02, []).sd == 0)
     assert aemstep.spectra([1.0], 0.05, 0.02, []).sd.shape == (0, 1)
-    # NaN samples are skipped (held at the last finite one), not errors, in spectra.
+    # NaN samples raise NonFiniteInput with .step in spectra too (issue 34); skipped
+    # (held at the last finite one) only with nan="skip" (python/tests/test_nan.py).
     bad = ag.copy()
     bad[5] = np.nan
-    assert np.all(np.isfinite(aemstep.spectrum([0.5, 1.0], 0.05, 0.02, bad).sd))
+    with pytest.raises(aemstep.NonFiniteInput) as e:
+        aemstep.spectrum([0.5, 1.0], 0.05, 0.02, bad)
+    assert e.value.step == 5
+    assert np.all(np.isfinite(aemstep.spectrum([0.5, 1.0], 0.05, 0.02, bad, nan="skip").sd))
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,7 +1,7 @@
 //! The oscillator bank and its per-sample step.
 
 use super::operators::{self, SdofOps};
-use super::{MAX_SUBSTEPS, Scheme, Substeps};
+use super::{MAX_SUBSTEPS, NonFinite, Scheme, Substeps};
 use crate::linalg::{all_fit, fits_value};
 use crate::macros::const_try;
 use crate::{Error, Param, Real};
@@ -23,7 +23,10 @@ use core::f64::consts::TAU;
 /// the interval (see [`Bank::step`]). Periods must be given in non-decreasing order
 /// (oscillators with sub-steps are then a prefix of the bank).
 ///
-/// Size: `24P` values of `T`, `2P` bytes and `2P + 3` `f64`.
+/// Non-finite samples follow the bank's [`NonFinite`] policy ([`Bank::with_non_finite`];
+/// by default refused by the checked and record-level calls).
+///
+/// Size: `24P` values of `T`, `2P` bytes, `2P + 3` `f64` and the policy byte.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bank<T, const P: usize> {
     /// Whole-interval map, on `(u0, v0, a0, d = a1 − a0)`.
@@ -67,6 +70,8 @@ pub struct Bank<T, const P: usize> {
     /// `1/h` (1/s).
     pub(super) inv_h: T,
     pub(super) scheme: Scheme,
+    /// What the checked calls do with a non-finite sample.
+    pub(super) non_finite: NonFinite,
 }
 
 /// The validated `f64` operators of a bank, before rounding to `T`.
@@ -336,6 +341,7 @@ impl<const P: usize> Bank<f64, P> {
             time_step: self.time_step,
             inv_h: T::from_f64_rounded(self.inv_h),
             scheme: self.scheme,
+            non_finite: self.non_finite,
         }
     }
 }
@@ -406,6 +412,7 @@ macro_rules! bank_ctor {
                     time_step: h,
                     inv_h: (1.0 / h) as $t,
                     scheme,
+                    non_finite: NonFinite::Refuse,
                 };
                 let mut p = 0;
                 while p < P {
@@ -589,9 +596,11 @@ impl<T: Real, const P: usize> Bank<T, P> {
     /// rounding); with the AEM its sub-step values may exceed the bound by the scheme's
     /// `O(h²)` error, and a peak may be missed by that much.
     ///
-    /// A non-finite sample (NaN, ±∞) is skipped and counted ([`Response::skipped`]): time
-    /// still advances by `h`, with the last finite sample held in its place, so later
-    /// samples stay on their times; the peaks so far are kept.
+    /// Unchecked: a non-finite sample (NaN, ±∞) is skipped and counted
+    /// ([`Response::skipped`]) whatever the bank's [`NonFinite`] policy (this step has no
+    /// error to return; [`Bank::try_step`] applies the policy): time still advances by `h`,
+    /// with the last finite sample held in its place, so later samples stay on their times;
+    /// the peaks so far are kept.
     ///
     /// Cost: `P` whole-interval steps (10 multiply-adds, 3 absolute values and 3
     /// comparisons each), a bound check (about 20 flops) for each oscillator with
@@ -610,13 +619,31 @@ impl<T: Real, const P: usize> Bank<T, P> {
 
     /// [`Bank::step`], checked: the sample is taken on a copy of `r`, committed only if
     /// every state and peak of the copy is finite ([`Response::is_finite`]). A non-finite
-    /// sample is still skipped and counted (`Ok`), as in [`Bank::step`]; a *finite* sample
-    /// so large that the response overflows (e.g. `1.5e308` then `−1.5e308`, whose
-    /// difference is `−∞`) is the error.
+    /// sample is refused under [`NonFinite::Refuse`] (the default) and skipped and counted
+    /// (`Ok`) under [`NonFinite::Skip`], as in [`Bank::step`]; a *finite* sample so large
+    /// that the response overflows (e.g. `1.5e308` then `−1.5e308`, whose difference is
+    /// `−∞`) is an error under either policy.
     ///
-    /// Errors: [`Error::NonFiniteState`], `r` unchanged. Cost: one [`Bank::step`], a copy
-    /// of `r` and a scan of `5P` values.
+    /// Errors, each with `r` unchanged (so [`Response::samples`] is the index of the
+    /// sample refused): [`Error::NonFiniteInput`] (a non-finite sample, refused);
+    /// [`Error::NonFiniteState`]. Cost: one comparison, one [`Bank::step`], a copy of `r`
+    /// and a scan of `5P` values.
+    ///
+    /// ```
+    /// use aemstep::{Error, spectrum::{Bank, NonFinite}};
+    /// let bank = Bank::<f64, 2>::new([0.2, 1.0], [0.05; 2], 0.01)?;
+    /// let mut r = bank.at_rest();
+    /// bank.try_step(&mut r, 1.0)?;
+    /// assert_eq!(bank.try_step(&mut r, f64::NAN), Err(Error::NonFiniteInput));
+    /// assert_eq!(r.samples(), 1); // unchanged: the refused sample is sample 1
+    /// // Skipping, asked for explicitly: held and counted.
+    /// let skipping = bank.with_non_finite(NonFinite::Skip);
+    /// skipping.try_step(&mut r, f64::NAN)?;
+    /// assert_eq!((r.samples(), r.skipped()), (2, 1));
+    /// # Ok::<(), Error>(())
+    /// ```
     pub fn try_step(&self, r: &mut Response<T, P>, ag: T) -> Result<(), Error> {
+        super::check_sample(self.non_finite, ag)?;
         let mut next = *r;
         self.step(&mut next, ag);
         if next.is_finite() {
@@ -628,23 +655,31 @@ impl<T: Real, const P: usize> Bank<T, P> {
     }
 
     /// The response to a whole record: from rest, every sample of `record` (sample
-    /// interval [`Bank::time_step`]; non-finite samples skipped and counted, as in
-    /// [`Bank::step`]) then [`Bank::free_vibration_samples`] of free vibration.
+    /// interval [`Bank::time_step`]) then [`Bank::free_vibration_samples`] of free
+    /// vibration. A non-finite sample is refused ([`NonFinite::Refuse`], the default: the
+    /// record is checked before it is stepped) or skipped and counted
+    /// ([`NonFinite::Skip`], as in [`Bank::step`]).
     ///
     /// The samples are stepped unchecked and the response checked once at the end: a
     /// non-finite state or peak never turns finite again under these linear maps (`∞` and
     /// NaN propagate, peaks are running maxima), so the end check sees every overflow.
     ///
-    /// Errors: [`Error::NonFiniteState`] if the response overflowed;
-    /// [`Error::InvalidTimeStep`] if the tail exceeds
-    /// [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES). Cost:
-    /// `N + ⌈T_max/h⌉` steps, one scan.
+    /// Errors: [`Error::InvalidTimeStep`] if the tail exceeds
+    /// [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES);
+    /// [`Error::NonFiniteInput`] if a sample is not finite and the policy refuses it
+    /// ([`first_non_finite`](super::first_non_finite) gives its index);
+    /// [`Error::NonFiniteState`] if the response overflowed. Cost: `N + ⌈T_max/h⌉` steps,
+    /// two scans.
     ///
     /// ```
-    /// use aemstep::{Error, spectrum::Bank};
+    /// use aemstep::{Error, spectrum::{Bank, NonFinite}};
     /// let bank = Bank::<f64, 2>::new([0.2, 1.0], [0.05; 2], 0.01)?;
     /// let r = bank.response(&[0.0, 1.0, -1.0, 0.5])?; // m/s²
     /// assert!(r.sd()[1] > 0.0);
+    /// // a NaN sample: refused by default, skipped (held, counted) if asked
+    /// assert_eq!(bank.response(&[0.0, f64::NAN]), Err(Error::NonFiniteInput));
+    /// let held = bank.with_non_finite(NonFinite::Skip).response(&[0.0, 1.0, f64::NAN])?;
+    /// assert_eq!((held.sd(), held.skipped()), (bank.response(&[0.0, 1.0, 1.0])?.sd(), 1));
     /// // finite samples whose difference overflows: an error, not ±∞ in the spectrum
     /// assert_eq!(bank.response(&[0.0, 1.5e308, -1.5e308]), Err(Error::NonFiniteState));
     /// # Ok::<(), Error>(())
@@ -654,12 +689,14 @@ impl<T: Real, const P: usize> Bank<T, P> {
         self.record_pass(record, tail)
     }
 
-    /// From rest, every sample of `record` stepped unchecked, then `tail` samples of free
-    /// vibration, the response checked once at the end (see [`Bank::response`]): the pass
-    /// of [`Bank::response`] and of the host batch.
+    /// From rest, the record checked against the policy, every sample of `record` stepped
+    /// unchecked, then `tail` samples of free vibration, the response checked once at the
+    /// end (see [`Bank::response`]): the pass of [`Bank::response`] and of the host batch.
     ///
-    /// Errors: [`Error::NonFiniteState`]. Cost: `N + tail` steps, one scan.
+    /// Errors: [`Error::NonFiniteInput`], [`Error::NonFiniteState`]. Cost: `N + tail`
+    /// steps, two scans.
     pub(super) fn record_pass(&self, record: &[T], tail: u32) -> Result<Response<T, P>, Error> {
+        super::check_record(self.non_finite, record)?;
         let mut r = Response::rest();
         for &a in record {
             self.step(&mut r, a);
@@ -801,6 +838,21 @@ impl<T: Real, const P: usize> Bank<T, P> {
     /// The scheme the operators were built with. Cost: none.
     pub fn scheme(&self) -> Scheme {
         self.scheme
+    }
+    /// What the checked and record-level calls do with a non-finite sample
+    /// ([`NonFinite::Refuse`] unless [`Bank::with_non_finite`] chose otherwise). Cost: none.
+    pub fn non_finite(&self) -> NonFinite {
+        self.non_finite
+    }
+    /// The same bank with the non-finite-sample policy `policy` (`const fn`: usable on a
+    /// `static` bank's constructor result, e.g. `match Bank::new_f32(..) { Ok(b) =>
+    /// b.with_non_finite(NonFinite::Skip), .. }`). The operators are unchanged, so the
+    /// responses to finite records are the same bits. Cost: a copy of the bank.
+    pub const fn with_non_finite(self, policy: NonFinite) -> Self {
+        Bank {
+            non_finite: policy,
+            ..self
+        }
     }
     /// Sub-steps per sample of each oscillator (`1 ..= MAX_SUBSTEPS`). Cost: none.
     pub fn substeps(&self) -> &[u16; P] {

@@ -16,8 +16,11 @@ use crate::{Error, Real};
 /// Returns one result per record, in the order of `records`: its [`Response`], bit for
 /// bit that of stepping the record alone on any thread count, or
 /// [`Error::NonFiniteState`] if a finite sample made a state or a peak overflow (the
-/// response is checked once at the end, as in [`Bank::response`]; non-finite samples are
-/// skipped and counted, not errors). Cost: that of [`Bank::step`] per
+/// response is checked once at the end, as in [`Bank::response`]), or
+/// [`Error::NonFiniteInput`] for a record with a non-finite sample when the bank refuses
+/// them ([`NonFinite::Refuse`](super::NonFinite), the default; with
+/// [`NonFinite::Skip`](super::NonFinite) they are skipped and counted,
+/// [`Response::skipped`]). Cost: that of [`Bank::step`] per
 /// sample, divided among the threads, plus the pool's creation (one OS thread per pool
 /// thread); allocates the result and the pool. Stepping does not panic, so neither does
 /// this (a pool that cannot be built runs the records serially).

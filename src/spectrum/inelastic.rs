@@ -81,8 +81,12 @@
 //! post-yield ratio outside `[0, 1)` or a yield strength not `> 0` (NaN) is
 //! [`Error::InvalidMaterial`], as for [`hysteresis::Bilinear`](crate::hysteresis::Bilinear);
 //! a strength-reduction factor, target ductility or search setting out of range is
-//! [`Error::InvalidParameter`]. A non-finite sample is skipped and counted, as in
-//! [`Bank::step`](super::Bank::step).
+//! [`Error::InvalidParameter`]. A non-finite sample follows the bank's
+//! [`NonFinite`](super::NonFinite) policy, as in the elastic bank: by default
+//! [`Error::NonFiniteInput`] ([`Yielding::try_step`] leaves the response unchanged; the
+//! record-level calls refuse the record before stepping it); with
+//! [`Yielding::with_non_finite`]`(NonFinite::Skip)` it is held and counted
+//! ([`YieldResponse::skipped`], [`ConstantDuctility::skipped`]).
 //!
 //! **Extreme records**: every field of a record-level result is finite, or the call is a
 //! typed error: a finite sample that makes the response overflow (one sample of `5e307`
@@ -95,8 +99,8 @@
 //! [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES) is
 //! [`Error::InvalidTimeStep`].
 
-use super::Substeps;
 use super::bank::{Oscillator, check_interval, oscillator};
+use super::{NonFinite, Substeps};
 use crate::linalg::all_fit;
 use crate::macros::const_try;
 use crate::{Error, Param, Real};
@@ -107,7 +111,11 @@ use crate::{Error, Param, Real};
 /// [`YieldResponse`] carries its own ([`Yielding::at_rest`]), so one bank serves every
 /// strength of a root find.
 ///
-/// Size: `9P + 1` values of `T`, `2P` bytes and `2P + 2` `f64`.
+/// Non-finite samples follow the bank's [`NonFinite`] policy
+/// ([`Yielding::with_non_finite`]; by default refused by the checked and record-level
+/// calls).
+///
+/// Size: `9P + 1` values of `T`, `2P` bytes, `2P + 2` `f64` and the policy byte.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Yielding<T, const P: usize> {
@@ -141,6 +149,8 @@ pub struct Yielding<T, const P: usize> {
     alpha: f64,
     /// Sample interval `h` (s).
     time_step: f64,
+    /// What the checked calls do with a non-finite sample.
+    non_finite: NonFinite,
 }
 
 /// The coefficients of a bank in `f64`, before rounding to `T` (shared by the `const` and
@@ -263,6 +273,7 @@ macro_rules! yielding_ctor {
                     damping,
                     alpha,
                     time_step: h,
+                    non_finite: NonFinite::Refuse,
                 })
             }
         }
@@ -428,6 +439,7 @@ impl<T: Real, const P: usize> Yielding<T, P> {
             damping,
             alpha,
             time_step: h,
+            non_finite: NonFinite::Refuse,
         })
     }
 
@@ -487,9 +499,10 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// time by `h`, the load linear between samples, oscillator `p` in `n_p` sub-steps,
     /// its peak taken at their ends.
     ///
-    /// A non-finite sample (NaN, ±∞) is skipped and counted ([`YieldResponse::skipped`]):
-    /// time still advances by `h` with the last finite sample held in its place, as in
-    /// [`Bank::step`](super::Bank::step).
+    /// Unchecked: a non-finite sample (NaN, ±∞) is skipped and counted
+    /// ([`YieldResponse::skipped`]) whatever the bank's [`NonFinite`] policy
+    /// ([`Yielding::try_step`] applies it): time still advances by `h` with the last finite
+    /// sample held in its place, as in [`Bank::step`](super::Bank::step).
     ///
     /// Cost: `Σ_p n_p` sub-steps ([`Yielding::substeps_per_sample`]) of about 30 flops and
     /// 4 comparisons each, whatever the branch; no allocation, no panic.
@@ -502,13 +515,17 @@ impl<T: Real, const P: usize> Yielding<T, P> {
 
     /// [`Yielding::step`], checked: the sample is taken on a copy of `r`, committed only if
     /// every state, peak and energy of the copy is finite ([`YieldResponse::is_finite`]).
-    /// A non-finite sample is still skipped and counted (`Ok`); a *finite* sample so large
+    /// A non-finite sample is refused under [`NonFinite::Refuse`] (the default) and
+    /// skipped and counted (`Ok`) under [`NonFinite::Skip`]; a *finite* sample so large
     /// that the response overflows (one sample of `5e307` m/s² turns the state to NaN) is
-    /// the error.
+    /// an error under either policy.
     ///
-    /// Errors: [`Error::NonFiniteState`], `r` unchanged. Cost: one [`Yielding::step`], a
-    /// copy of `r` and a scan of `6P` values.
+    /// Errors, each with `r` unchanged (so [`YieldResponse::samples`] is the index of the
+    /// sample refused): [`Error::NonFiniteInput`] (a non-finite sample, refused);
+    /// [`Error::NonFiniteState`]. Cost: one comparison, one [`Yielding::step`], a copy of
+    /// `r` and a scan of `6P` values.
     pub fn try_step(&self, r: &mut YieldResponse<T, P>, ag: T) -> Result<(), Error> {
+        super::check_sample(self.non_finite, ag)?;
         let mut next = *r;
         self.step(&mut next, ag);
         if next.is_finite() {
@@ -533,6 +550,24 @@ impl<T: Real, const P: usize> Yielding<T, P> {
             let a0 = r.last;
             r.last = zero;
             self.advance(r, a0, zero);
+        }
+    }
+
+    /// What the checked and record-level calls do with a non-finite sample
+    /// ([`NonFinite::Refuse`] unless [`Yielding::with_non_finite`] chose otherwise). Cost:
+    /// none.
+    pub fn non_finite(&self) -> NonFinite {
+        self.non_finite
+    }
+
+    /// The same bank with the non-finite-sample policy `policy` (`const fn`, as
+    /// [`Bank::with_non_finite`](super::Bank::with_non_finite)). The coefficients are
+    /// unchanged, so the responses to finite records are the same bits. Cost: a copy of
+    /// the bank.
+    pub const fn with_non_finite(self, policy: NonFinite) -> Self {
+        Yielding {
+            non_finite: policy,
+            ..self
         }
     }
 
@@ -602,7 +637,9 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// The response to a whole record: every sample of `record` (m/s², sample interval
     /// [`Yielding::time_step`]) then [`Yielding::free_vibration_samples`] of free
     /// vibration, from rest, with strengths `yield_acceleration` (m/s², as
-    /// [`Yielding::at_rest`]). One *record pass*.
+    /// [`Yielding::at_rest`]). One *record pass*. A non-finite sample is refused
+    /// ([`NonFinite::Refuse`], the default: the record is checked before it is stepped) or
+    /// skipped and counted ([`NonFinite::Skip`], as in [`Yielding::step`]).
     ///
     /// Every field of the result is finite, its [ductility](YieldResponse::ductility)
     /// included, or the call is an error. The samples are stepped unchecked and the
@@ -612,6 +649,8 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     ///
     /// Errors: as [`Yielding::at_rest`]; [`Error::InvalidTimeStep`] if the free-vibration
     /// tail exceeds [`MAX_FREE_VIBRATION_SAMPLES`](super::MAX_FREE_VIBRATION_SAMPLES);
+    /// [`Error::NonFiniteInput`] if a sample is not finite and the policy refuses it
+    /// ([`first_non_finite`](super::first_non_finite) gives its index);
     /// [`Error::NonFiniteState`] if a finite sample made the response overflow;
     /// [`Error::OperatorOverflow`] if a ductility overflows. Cost: `N + ⌈T_max/h⌉` steps.
     pub fn response(
@@ -621,6 +660,7 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     ) -> Result<YieldResponse<T, P>, Error> {
         let mut r = self.at_rest(yield_acceleration)?;
         let tail = super::checked_tail(&self.period, self.time_step)?;
+        super::check_record(self.non_finite, record)?;
         for &a in record {
             self.step(&mut r, a);
         }
@@ -749,6 +789,40 @@ impl<T: Real, const P: usize> Yielding<T, P> {
         target: T,
         search: &Search,
     ) -> Result<ConstantDuctility<T, P>, Error> {
+        self.constant_ductility_while(record, target, search, &mut || true)
+    }
+
+    /// [`Yielding::constant_ductility`], asking `go_on()` before each record pass after
+    /// the elastic one: when it returns `false` the search stops there, and every
+    /// oscillator not finished reports [`Outcome::NotConverged`] with the bracket reached
+    /// (as when the pass budget runs out). For a caller that must stop a long search: a
+    /// time budget, or an interrupt from the user (the Python package answers Ctrl-C this
+    /// way). With `go_on` always `true`, the same result, bit for bit.
+    ///
+    /// Errors: as [`Yielding::constant_ductility`]. Cost: as it, plus one call of `go_on`
+    /// a pass.
+    ///
+    /// ```
+    /// use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
+    /// let y = Yielding::<f64, 2>::new([0.3, 1.0], [0.05; 2], 0.0, 0.01)?;
+    /// let rec: Vec<f64> = (0..500).map(|n| 3.0 * (5.0 * n as f64 * 0.01).sin()).collect();
+    /// // stop after 3 passes: the elastic one and 2 of the search
+    /// let mut left = 2;
+    /// let cd = y.constant_ductility_while(&rec, 4.0, &Search::DEFAULT, &mut || {
+    ///     left -= 1;
+    ///     left >= 0
+    /// })?;
+    /// assert_eq!(cd.passes, 3);
+    /// assert!(cd.outcome.iter().all(|&o| o == Outcome::NotConverged));
+    /// # Ok::<(), aemstep::Error>(())
+    /// ```
+    pub fn constant_ductility_while(
+        &self,
+        record: &[T],
+        target: T,
+        search: &Search,
+        go_on: &mut dyn FnMut() -> bool,
+    ) -> Result<ConstantDuctility<T, P>, Error> {
         let eps = T::default_epsilon().as_f64();
         let mu_t = target.as_f64();
         if !(mu_t.is_finite() && mu_t > 1.0) {
@@ -776,7 +850,7 @@ impl<T: Real, const P: usize> Yielding<T, P> {
         }
         let mut passes = 1u32;
         let max_passes = search.points as u32 + 2 * 64;
-        while s.iter().any(|r| r.outcome.is_none()) && passes < max_passes {
+        while s.iter().any(|r| r.outcome.is_none()) && passes < max_passes && go_on() {
             let trial: [T; P] = core::array::from_fn(|p| {
                 if s[p].outcome.is_none() {
                     T::from_f64_rounded(s[p].x)
@@ -801,6 +875,7 @@ impl<T: Real, const P: usize> Yielding<T, P> {
             ductility: core::array::from_fn(|p| [t(s[p].flo + mu_t), t(s[p].fhi + mu_t)]),
             outcome: s.map(|r| r.outcome.unwrap_or(Outcome::NotConverged)),
             passes,
+            skipped: super::non_finite_count(record),
         })
     }
 
@@ -1050,7 +1125,9 @@ pub struct ConstantStrength<T, const P: usize> {
     pub ductility: [T; P],
     /// Plastic (hysteretic) work per unit mass (m²/s²).
     pub plastic_work: [T; P],
-    /// The whole inelastic response (peaks, residual displacement, …).
+    /// The whole inelastic response (peaks, residual displacement, …; its
+    /// [`skipped`](YieldResponse::skipped) counts the non-finite samples skipped under
+    /// [`NonFinite::Skip`]).
     pub response: YieldResponse<T, P>,
 }
 
@@ -1072,4 +1149,7 @@ pub struct ConstantDuctility<T, const P: usize> {
     pub outcome: [Outcome; P],
     /// Record passes taken, the elastic one included.
     pub passes: u32,
+    /// Non-finite samples of the record skipped in every pass (under
+    /// [`NonFinite::Skip`]; `0` under [`NonFinite::Refuse`], which refuses such a record).
+    pub skipped: u64,
 }

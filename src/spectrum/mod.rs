@@ -50,8 +50,22 @@
 //!
 //! **Bad input**: a non-positive or non-finite period, periods out of order, or a damping
 //! ratio outside `[0, 1)` are typed errors at build time ([`Error::InvalidPeriod`],
-//! [`Error::InvalidDamping`]); a non-finite sample is skipped and counted, the peaks kept
-//! ([`Bank::step`]).
+//! [`Error::InvalidDamping`]).
+//!
+//! **Non-finite samples** (NaN, ±∞) follow the bank's [`NonFinite`] policy, one rule for
+//! every record-level and checked call ([`Bank`], [`RotD`], [`inelastic::Yielding`],
+//! `batch::spectra`, and [`ida::spectral_acceleration`](crate::ida::spectral_acceleration)
+//! with `std`). By default ([`NonFinite::Refuse`]) such a sample is
+//! [`Error::NonFiniteInput`]: the checked steps leave the response unchanged (its
+//! [`Response::samples`] is then the index of the refused sample), the record-level calls
+//! refuse the record before stepping it ([`first_non_finite`] gives the index of the sample
+//! they refused). With [`NonFinite::Skip`], chosen explicitly
+//! ([`Bank::with_non_finite`], [`inelastic::Yielding::with_non_finite`]), the sample is
+//! skipped: the last finite sample is held in its place (`0`, the value at rest, before
+//! any), time still advances, and it is counted ([`Response::skipped`],
+//! [`inelastic::YieldResponse::skipped`],
+//! [`inelastic::ConstantDuctility::skipped`]). The unchecked [`Bank::step`] keeps its cost
+//! and has no error to return: it always skips and counts, whatever the policy.
 //!
 //! **Extreme records**: a *finite* sample so large that a state or a peak overflows
 //! (`±1e308`, or a record times `1e290`) is an error, never a response with `±∞`/NaN in
@@ -70,6 +84,7 @@
 //!
 //! [`Error::InvalidPeriod`]: crate::Error::InvalidPeriod
 //! [`Error::InvalidDamping`]: crate::Error::InvalidDamping
+//! [`Error::NonFiniteInput`]: crate::Error::NonFiniteInput
 
 mod bank;
 mod operators;
@@ -92,9 +107,78 @@ pub(crate) fn finite<T: crate::Real>(x: T) -> bool {
     x - x == T::from_f64_rounded(0.0)
 }
 
+/// What the checked and record-level calls of a spectrum bank do with a non-finite
+/// ground-acceleration sample (NaN, ±∞): one policy for the elastic [`Bank`] (and the
+/// [`RotD`] stepped on it, and `batch::spectra`) and the yielding
+/// [`inelastic::Yielding`], chosen when the bank is built ([`Bank::with_non_finite`],
+/// [`inelastic::Yielding::with_non_finite`]; `const fn`). The default is
+/// [`NonFinite::Refuse`]. The unchecked steps ([`Bank::step`], [`RotD::step`],
+/// [`inelastic::Yielding::step`]) have no error to return and always skip. Cost of the
+/// check: one comparison per sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum NonFinite {
+    /// The sample is [`Error::NonFiniteInput`](crate::Error::NonFiniteInput): a checked
+    /// step (`try_step`) leaves the response unchanged, a record-level call (`response`,
+    /// the spectra) refuses the whole record before stepping it ([`first_non_finite`]
+    /// names the sample). The default: a record with NaN in it has no spectrum.
+    #[default]
+    Refuse,
+    /// The sample is skipped: the last finite sample is held in its place (`0`, the
+    /// value at rest, if none came before), time still advances by `h`, so later samples
+    /// stay on their times, and it is counted (`skipped`). For records with known gaps;
+    /// the result is that of the record with each gap filled by the sample before it.
+    Skip,
+}
+
+/// The index of the first non-finite sample (NaN, ±∞) of `record`, `None` if every
+/// sample is finite: the sample a record-level call refuses with
+/// [`Error::NonFiniteInput`](crate::Error::NonFiniteInput) under [`NonFinite::Refuse`]
+/// (the error itself carries no index). Cost: a scan, one comparison per sample.
+///
+/// ```
+/// use aemstep::{Error, spectrum::{Bank, first_non_finite}};
+/// let bank = Bank::<f64, 2>::new([0.2, 1.0], [0.05; 2], 0.01)?;
+/// let record = [0.0, 1.0, f64::NAN, 0.5];
+/// assert_eq!(bank.response(&record), Err(Error::NonFiniteInput));
+/// assert_eq!(first_non_finite(&record), Some(2));
+/// # Ok::<(), Error>(())
+/// ```
+pub fn first_non_finite<T: crate::Real>(record: &[T]) -> Option<usize> {
+    record.iter().position(|&a| !finite(a))
+}
+
+/// The number of non-finite samples of `record`: what [`NonFinite::Skip`] skips.
+pub(crate) fn non_finite_count<T: crate::Real>(record: &[T]) -> u64 {
+    record.iter().filter(|&&a| !finite(a)).count() as u64
+}
+
+/// `Err(NonFiniteInput)` if `policy` refuses and `record` has a non-finite sample.
+/// Cost: a scan under [`NonFinite::Refuse`], none under [`NonFinite::Skip`].
+pub(crate) fn check_record<T: crate::Real>(
+    policy: NonFinite,
+    record: &[T],
+) -> Result<(), crate::Error> {
+    match policy {
+        NonFinite::Refuse if !all_finite(record) => Err(crate::Error::NonFiniteInput),
+        _ => Ok(()),
+    }
+}
+
+/// `Err(NonFiniteInput)` if `policy` refuses and the sample `ag` is not finite. Cost: one
+/// comparison.
+#[inline(always)]
+pub(crate) fn check_sample<T: crate::Real>(policy: NonFinite, ag: T) -> Result<(), crate::Error> {
+    if policy == NonFinite::Refuse && !finite(ag) {
+        Err(crate::Error::NonFiniteInput)
+    } else {
+        Ok(())
+    }
+}
+
 /// A bank's bookkeeping of one new ground-acceleration sample `ag` (shared by [`Bank`] and
 /// [`inelastic::Yielding`]): a non-finite sample is counted in `skipped` and replaced by the
-/// last finite one; `last` becomes the sample held; the first sample (at rest, `t = 0`)
+/// last finite one ([`NonFinite::Skip`]); `last` becomes the sample held; the first sample (at rest, `t = 0`)
 /// closes no interval, every later one the interval `(a_{n−1}, a_n)` returned.
 /// Cost: a few comparisons.
 #[inline(always)]

@@ -97,8 +97,9 @@ fn abs<T: Real>(x: T) -> T {
 
 impl<T: Real, const K: usize> RotD<T, K> {
     /// Feed the next samples of the two horizontal components (`ax`, `ay`, same unit and
-    /// same sample interval `h`). Each component behaves as in [`Bank::step`] (a non-finite sample is
-    /// skipped, counted and held); each component's own peaks are kept too
+    /// same sample interval `h`). Each component behaves as in [`Bank::step`] (unchecked: a
+    /// non-finite sample is skipped, counted and held, whatever the bank's
+    /// [`NonFinite`](super::NonFinite) policy); each component's own peaks are kept too
     /// ([`RotDResponse::x`], [`RotDResponse::y`]).
     ///
     /// Cost: `Σ_p n_p` sub-steps of both components (16 multiply-adds) plus `K`
@@ -124,11 +125,14 @@ impl<T: Real, const K: usize> RotD<T, K> {
 
     /// [`RotD::step`], checked: the samples are taken on a copy of `r`, committed only if
     /// both components' states and peaks and every rotated peak are finite
-    /// ([`RotDResponse::is_finite`]). Non-finite samples are still skipped and counted
-    /// (`Ok`); finite samples that make the response overflow are the error.
+    /// ([`RotDResponse::is_finite`]). A non-finite sample of either component follows the
+    /// bank's [`NonFinite`](super::NonFinite) policy: refused (the default), or skipped and
+    /// counted in its component (`Ok`); finite samples that make the response overflow are
+    /// an error under either policy.
     ///
-    /// Errors: [`Error::NonFiniteState`], `r` unchanged. Cost: one [`RotD::step`], a copy of
-    /// `r` and a scan of it.
+    /// Errors, each with `r` unchanged: [`Error::NonFiniteInput`] (a non-finite sample,
+    /// refused); [`Error::NonFiniteState`]. Cost: two comparisons, one [`RotD::step`], a
+    /// copy of `r` and a scan of it.
     pub fn try_step<const P: usize>(
         &self,
         bank: &Bank<T, P>,
@@ -136,6 +140,8 @@ impl<T: Real, const K: usize> RotD<T, K> {
         ax: T,
         ay: T,
     ) -> Result<(), Error> {
+        super::check_sample(bank.non_finite, ax)?;
+        super::check_sample(bank.non_finite, ay)?;
         let mut next = *r;
         self.step(bank, &mut next, ax, ay);
         if next.is_finite() {
