@@ -458,9 +458,9 @@ def spectra(
     if not parts:
         empty = np.zeros((0, periods.shape[0]))
         return Spectrum(periods, empty, empty, empty, empty, empty, np.zeros(0, dtype=np.int64))
-    cols = [np.concatenate([p[q] for p in parts]) for q in range(5)]
+    sd, sv, sa, psv, psa = (np.concatenate([p[q] for p in parts]) for q in range(5))
     skipped = np.concatenate([np.asarray(p[5], dtype=np.int64) for p in parts])
-    return Spectrum(periods, *cols, skipped)
+    return Spectrum(periods, sd, sv, sa, psv, psa, skipped)
 
 
 def spectrum(
@@ -487,7 +487,8 @@ def spectrum(
         threads=threads,
         nan=nan,
     )
-    return Spectrum(s.periods, *(x[0] for x in s[1:6]), int(np.asarray(s.skipped)[0]))
+    return Spectrum(s.periods, s.sd[0], s.sv[0], s.sa[0], s.psv[0], s.psa[0],
+                    int(np.asarray(s.skipped)[0]))
 
 
 class RotDSpectrum(NamedTuple):

@@ -69,7 +69,8 @@ def _spectra(
 ) -> List[Tuple[np.ndarray, ...]]:
     s = aemstep.spectra(periods, damping, h, recs, scheme=scheme,
                         free_vibration=free_vibration, threads=threads, nan=nan)
-    return [tuple(x[i] for x in s[1:]) for i in range(len(recs))]
+    skipped = np.asarray(s.skipped)
+    return [(s.sd[i], s.sv[i], s.sa[i], s.psv[i], s.psa[i], skipped[i]) for i in range(len(recs))]
 
 
 def _constant_strength(recs: List[np.ndarray], **kw: Any) -> List["aemstep.ConstantStrength"]:
@@ -116,7 +117,8 @@ def spectra(
         empty = np.zeros((0, periods.shape[0]))
         return aemstep.Spectrum(periods, empty, empty, empty, empty, empty,
                                 np.zeros(0, dtype=np.int64))
-    return aemstep.Spectrum(periods, *(np.stack([r[q] for r in rows]) for q in range(5)),
+    sd, sv, sa, psv, psa = (np.stack([r[q] for r in rows]) for q in range(5))
+    return aemstep.Spectrum(periods, sd, sv, sa, psv, psa,
                             np.array([r[5] for r in rows], dtype=np.int64))
 
 
