@@ -282,23 +282,10 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         p: &[[T; L]; N],
         active: [bool; L],
     ) -> LaneReports<T, L> {
-        match building.band() {
-            Some(band) => {
-                crate::linalg::wide(|| self.banded(building, band, state, history, p, active))
-            }
-            None => self.lane_by_lane(building, state, history, p, active),
+        if let Some(band) = building.band() {
+            return crate::linalg::wide(|| self.banded(building, band, state, history, p, active));
         }
-    }
-
-    /// A dense-damping building: each active lane by the single step.
-    fn lane_by_lane<Lw: LaneLaw<T>>(
-        &self,
-        building: &ShearBuilding<T, Lw, N>,
-        state: &mut LaneState<T, N, L>,
-        history: &mut LaneHistory<Lw::History, N, L>,
-        p: &[[T; L]; N],
-        active: [bool; L],
-    ) -> LaneReports<T, L> {
+        // A dense-damping building: each active lane by the single step.
         core::array::from_fn(|l| {
             if !active[l] {
                 return None;

@@ -9,7 +9,7 @@
 #[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;
 #[path = "../scenes/ida/building.rs"]
-mod ida;
+mod scene;
 
 use aemstep::hysteresis::{
     Bilinear, BoucWen, Friction, HistoryModel, Law, Parallel, ShearBuilding,
@@ -34,7 +34,7 @@ fn ground(l: usize, n: u64, nan_lane: usize) -> f64 {
     if l == nan_lane && n == 333 {
         return f64::NAN;
     }
-    ida::ground(&elcentro::AG_F64, scale(l), n)
+    scene::ground(&elcentro::AG_F64, scale(l), n)
 }
 
 /// The bits of a state, to compare.
@@ -86,7 +86,7 @@ fn run_matches<Lw: LaneLaw<f64>, const N: usize, const L: usize>(
     settings: NewtonSettings<f64>,
     nan_lane: usize,
 ) -> [Result<(), Failure>; L] {
-    let lanes = LaneStepper::<f64, N, L>::new(ida::H, settings).unwrap();
+    let lanes = LaneStepper::<f64, N, L>::new(scene::H, settings).unwrap();
     let steps: [u64; L] = core::array::from_fn(length);
     let mut seen: Vec<Vec<(Vec<u64>, u64)>> = vec![vec![]; L];
     let outcome = lanes.run(
@@ -126,7 +126,7 @@ fn step_matches<Lw: LaneLaw<f64>, const N: usize, const L: usize>(
 where
     Lw::History: core::fmt::Debug,
 {
-    let lanes = LaneStepper::<f64, N, L>::new(ida::H, settings).unwrap();
+    let lanes = LaneStepper::<f64, N, L>::new(scene::H, settings).unwrap();
     let zero = SVector::<f64, N>::zeros();
     let virgin = building.initial_history();
     let start = lanes
@@ -181,8 +181,8 @@ where
 }
 
 /// The benchmark IDA building (5 bilinear storeys, Rayleigh damping: the banded path).
-fn bilinear() -> ida::Building {
-    ida::building().unwrap()
+fn bilinear() -> scene::Building {
+    scene::building().unwrap()
 }
 
 /// The IDA settings (up to 50 iterations to 1e-12): every lane but the NaN one completes,
@@ -190,7 +190,7 @@ fn bilinear() -> ida::Building {
 #[test]
 fn lanes_are_single_analyses_bit_for_bit() {
     let b = bilinear();
-    let s = ida::stepper().unwrap().settings();
+    let s = scene::stepper().unwrap().settings();
     let out1 = run_matches::<_, 5, 1>(&b, s, 9);
     assert!(out1[0].is_ok());
     assert!(run_matches::<_, 5, 2>(&b, s, 9).iter().all(|o| o.is_ok()));
@@ -231,7 +231,7 @@ fn failing_lanes_leave_the_others_bit_for_bit() {
 #[test]
 fn step_reports_match() {
     let b = bilinear();
-    let s = ida::stepper().unwrap().settings();
+    let s = scene::stepper().unwrap().settings();
     step_matches::<_, 5, 1>(&b, s, 300);
     step_matches::<_, 5, 2>(&b, s, 300);
     let errors = step_matches::<_, 5, 4>(&b, s, 1000);
@@ -247,12 +247,12 @@ fn other_laws_and_dense_damping_match() {
     let (m, c, _k) = models::five_storey_building();
     let masses = models::floor_masses(&m);
     let k = models::FIVE_STOREY_STIFFNESS;
-    let s = ida::stepper().unwrap().settings();
-    let bw = BoucWen::<f64>::new(k, ida::FY, ida::ALPHA, 0.5, 0.5, 2.0).unwrap();
+    let s = scene::stepper().unwrap().settings();
+    let bw = BoucWen::<f64>::new(k, scene::FY, scene::ALPHA, 0.5, 0.5, 2.0).unwrap();
     let bouc_wen = ShearBuilding::new(masses, [bw; 5], &c).unwrap();
     step_matches::<_, 5, 4>(&bouc_wen, s, 250);
     let pf = Parallel(
-        Bilinear::<f64>::new(k, ida::FY, ida::ALPHA).unwrap(),
+        Bilinear::<f64>::new(k, scene::FY, scene::ALPHA).unwrap(),
         Friction::<f64>::new(2e5, 1e-3).unwrap(),
     );
     let parallel = ShearBuilding::new(masses, [pf; 5], &c).unwrap();
@@ -261,7 +261,97 @@ fn other_laws_and_dense_damping_match() {
     let mut dense = c;
     dense[0][4] = 1e3;
     dense[4][0] = 1e3;
-    let law = Bilinear::<f64>::new(k, ida::FY, ida::ALPHA).unwrap();
+    let law = Bilinear::<f64>::new(k, scene::FY, scene::ALPHA).unwrap();
     let building = ShearBuilding::new(masses, [law; 5], &dense).unwrap();
     step_matches::<_, 5, 2>(&building, s, 250);
+}
+
+/// The IDA records of the tests: El Centro from samples 0, 100, 200, cut to 300, 340,
+/// 380 samples (1195 … 1515 steps), so the traces see different records of different
+/// lengths in one batch.
+#[cfg(feature = "std")]
+fn ida_records() -> Vec<Vec<f64>> {
+    [(0, 300), (100, 340), (200, 380)]
+        .iter()
+        .map(|&(a, k)| elcentro::AG_F64[a..a + k].to_vec())
+        .collect()
+}
+
+/// Stripes in lanes (4 wide: a stripe's three records and the next stripe's first) give
+/// the curves of the one-run stripes, bit for bit, on 1 and 2 threads; the collapses (by
+/// the drift limit) and the NaN-free errors included.
+#[cfg(feature = "std")]
+#[test]
+fn stripes_in_lanes_are_the_stripes() {
+    use aemstep::ida::{Collapse, OnFailure};
+    let b = bilinear();
+    let single = scene::stepper().unwrap();
+    let lanes = LaneStepper::<f64, 5, 4>::new(scene::H, single.settings()).unwrap();
+    let records = ida_records();
+    let ims = [0.5, 1.5, 2.5, 4.0, 8.0];
+    let collapse = Collapse {
+        edp: 0.2,
+        on_failure: OnFailure::Collapse,
+    };
+    let one = |r: &Vec<f64>, im: f64| scene::peak_drift(&b, &single, r, im, scene::steps(r.len()));
+    let batched = |jobs: &[(&Vec<f64>, f64)]| {
+        let jobs: Vec<(&[f64], f64, u64)> = jobs
+            .iter()
+            .map(|&(r, im)| (r.as_slice(), im, scene::steps(r.len())))
+            .collect();
+        scene::peak_drifts(&b, &lanes, &jobs)
+    };
+    let want = aemstep::ida::stripes(&records, &ims, &collapse, 1, one, None).unwrap();
+    assert!(want.iter().any(|c| c.collapse.is_some()));
+    let pts: Vec<_> = want.iter().flat_map(|c| c.points.iter()).collect();
+    assert!(pts.iter().any(|p| !p.collapsed && p.edp > 0.03), "{want:?}");
+    for threads in [1, 2] {
+        let got =
+            aemstep::ida::stripes_batched(&records, &ims, &collapse, 4, threads, batched, None)
+                .unwrap();
+        assert_eq!(format!("{got:?}"), format!("{want:?}")); // `{:?}` of f64 round-trips
+    }
+}
+
+/// Hunt-and-fill in lanes (2 records a group, each tracing its own intensities) gives the
+/// curves of the one-run hunt-and-fill, bit for bit, and the same progress total.
+#[cfg(feature = "std")]
+#[test]
+fn hunt_fill_in_lanes_is_the_hunt_fill() {
+    use aemstep::ida::{Collapse, HuntFill, OnFailure};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let b = bilinear();
+    let single = scene::stepper().unwrap();
+    let lanes = LaneStepper::<f64, 5, 2>::new(scene::H, single.settings()).unwrap();
+    let records = ida_records();
+    let settings = HuntFill {
+        first: 1.0,
+        step: 3.0,
+        step_increment: 1.0,
+        resolution: 0.5,
+        runs: 6,
+        collapse: Collapse {
+            edp: 0.2,
+            on_failure: OnFailure::Collapse,
+        },
+    };
+    let one = |r: &Vec<f64>, im: f64| scene::peak_drift(&b, &single, r, im, scene::steps(r.len()));
+    let batched = |jobs: &[(&Vec<f64>, f64)]| {
+        let jobs: Vec<(&[f64], f64, u64)> = jobs
+            .iter()
+            .map(|&(r, im)| (r.as_slice(), im, scene::steps(r.len())))
+            .collect();
+        scene::peak_drifts(&b, &lanes, &jobs)
+    };
+    let want = aemstep::ida::hunt_fill(&records, &settings, 1, one, None).unwrap();
+    assert!(want.iter().all(|c| c.collapse.is_some()), "{want:?}");
+    let last = AtomicUsize::new(0);
+    let progress = |done: usize, total: usize| {
+        assert_eq!(total, 18);
+        last.fetch_max(done, Ordering::Relaxed);
+    };
+    let got = aemstep::ida::hunt_fill_batched(&records, &settings, 2, 2, batched, Some(&progress))
+        .unwrap();
+    assert_eq!(format!("{got:?}"), format!("{want:?}"));
+    assert_eq!(last.load(Ordering::Relaxed), 18);
 }
