@@ -224,6 +224,22 @@ pub struct LaneStepper<T, const N: usize, const L: usize> {
     kin: AemKinematics<T>,
 }
 
+/// Sizes and time step only, as [`Nonlinear`] prints.
+#[cfg(feature = "defmt")]
+impl<T: Real + defmt::Format, const N: usize, const L: usize> defmt::Format
+    for LaneStepper<T, N, L>
+{
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "LaneStepper {{ N: {=usize}, L: {=usize}, h: {} }}",
+            N,
+            L,
+            self.single.time_step()
+        )
+    }
+}
+
 /// The per-lane quantities of one Newton step, `[dof][lane]` unless noted.
 struct Work<T, H, const N: usize, const L: usize> {
     vh: [[T; L]; N],
@@ -477,11 +493,9 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                 .iter()
                 .enumerate()
             {
-                if running[l] {
-                    if let Some(e) = failed {
-                        out[l] = Some(Err(*e));
-                        running[l] = false;
-                    }
+                if let (true, Some(e)) = (running[l], failed) {
+                    out[l] = Some(Err(*e));
+                    running[l] = false;
                 }
             }
             for i in 0..N {

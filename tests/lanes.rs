@@ -37,8 +37,11 @@ fn ground(l: usize, n: u64, nan_lane: usize) -> f64 {
     scene::ground(&elcentro::AG_F64, scale(l), n)
 }
 
+/// The bits of a state (`u`, `v`, `a`) and its step count.
+type Bits = (Vec<u64>, u64);
+
 /// The bits of a state, to compare.
-fn state_bits<const N: usize>(s: &State<f64, N>) -> (Vec<u64>, u64) {
+fn state_bits<const N: usize>(s: &State<f64, N>) -> Bits {
     let v = s.u().iter().chain(s.v().iter()).chain(s.a().iter());
     (v.map(|x| x.to_bits()).collect(), s.steps())
 }
@@ -56,7 +59,7 @@ fn single<Lw: Law<f64>, const N: usize>(
     stepper: &Nonlinear<f64, N>,
     steps: u64,
     ground: impl Fn(u64) -> f64,
-) -> (Vec<(Vec<u64>, u64)>, Result<(), Failure>) {
+) -> (Vec<Bits>, Result<(), Failure>) {
     let zero = SVector::<f64, N>::zeros();
     let (mut s, mut h) = match stepper.start_with_history(
         building,
@@ -88,7 +91,7 @@ fn run_matches<Lw: LaneLaw<f64>, const N: usize, const L: usize>(
 ) -> [Result<(), Failure>; L] {
     let lanes = LaneStepper::<f64, N, L>::new(scene::H, settings).unwrap();
     let steps: [u64; L] = core::array::from_fn(length);
-    let mut seen: Vec<Vec<(Vec<u64>, u64)>> = vec![vec![]; L];
+    let mut seen: Vec<Vec<Bits>> = vec![vec![]; L];
     let outcome = lanes.run(
         building,
         steps,
