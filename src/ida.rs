@@ -331,7 +331,7 @@ enum Phase {
 
 /// One record's hunt-and-fill trace as a state machine: [`Tracer::next`] chooses the next
 /// intensity from the runs so far, [`Tracer::record`] takes its result. The serial trace
-/// ([`trace`]) and the traces in lanes ([`hunt_fill_batched`], one record a lane) both
+/// ([`trace`]) and the traces in lanes ([`batched`], one record a lane) both
 /// drive it, so both choose the same intensities from the same results.
 struct Tracer<'a> {
     s: &'a HuntFill,
@@ -526,76 +526,6 @@ where
     out.into_iter().collect()
 }
 
-/// [`hunt_fill`] with a batched analysis: `width` records traced side by side, one a lane;
-/// at each round every unfinished trace of the group chooses its next intensity from its
-/// own runs so far and `analysis(jobs)` runs them at once (e.g. one a SIMD lane,
-/// [`lanes`](crate::lanes)), returning their EDPs (or errors) in the order of `jobs`, each
-/// what the one-run closure of [`hunt_fill`] returns for it. One group of `width` records
-/// a job on [`batch::map`](crate::batch::map) with `threads` threads (`0`: all available;
-/// `width` `0` is taken as `1`); `progress(done, total)` as [`hunt_fill`].
-///
-/// Returns the curves of [`hunt_fill`], bit for bit, for a batched analysis whose every
-/// result is that of the one-run analysis (each trace sees the same results, so it asks
-/// the same intensities). Errors: as [`hunt_fill`]; a result missing from a batch is a
-/// failed run ([`Error::InvalidParameter`]). Cost: as [`hunt_fill`], in at most
-/// `runs` batches a group.
-pub fn hunt_fill_batched<R, F>(
-    records: &[R],
-    settings: &HuntFill,
-    width: usize,
-    threads: usize,
-    analysis: F,
-    progress: Option<&(dyn Fn(usize, usize) + Sync)>,
-) -> Result<Vec<Curve>, Error>
-where
-    R: Sync,
-    F: Fn(&[(&R, f64)]) -> Vec<Result<f64, Error>> + Sync + Send,
-{
-    settings.check()?;
-    let p = Progress::new(records.len().saturating_mul(settings.runs), progress);
-    let groups: Vec<&[R]> = records.chunks(width.max(1)).collect();
-    let out = crate::batch::map(&groups, threads, |group| {
-        let mut tracers: Vec<Tracer<'_>> = group.iter().map(|_| Tracer::new(settings)).collect();
-        let mut failed: Vec<Option<Error>> = std::vec![None; group.len()];
-        loop {
-            let mut lanes: Vec<usize> = Vec::with_capacity(group.len());
-            let mut asked: Vec<(&R, f64)> = Vec::with_capacity(group.len());
-            for (k, t) in tracers.iter_mut().enumerate() {
-                if let (None, Some(im)) = (failed[k], t.next()) {
-                    lanes.push(k);
-                    asked.push((&group[k], im));
-                }
-            }
-            if asked.is_empty() {
-                break;
-            }
-            let out = outcomes(analysis(&asked), asked.len());
-            for ((&k, &(_, im)), o) in lanes.iter().zip(&asked).zip(out) {
-                match classify(o, im, &settings.collapse) {
-                    Ok(point) => {
-                        tracers[k].record(point);
-                        p.add(1);
-                    }
-                    Err(e) => failed[k] = Some(e),
-                }
-            }
-        }
-        let curves: Vec<Result<Curve, Error>> = tracers
-            .into_iter()
-            .zip(failed)
-            .map(|(t, f)| {
-                p.add(settings.runs - t.pts.len());
-                match f {
-                    Some(e) => Err(e),
-                    None => Ok(t.finish()),
-                }
-            })
-            .collect();
-        curves
-    });
-    out.into_iter().flatten().collect()
-}
-
 /// The IDA curves of a suite of records on fixed stripes: every record at every
 /// intensity of `intensities` (finite, `> 0`, any order), one run a job on
 /// [`batch::map`](crate::batch::map) with `threads` threads (`0`: all available); each
@@ -622,43 +552,93 @@ where
     R: Sync,
     F: Fn(&R, f64) -> Result<f64, Error> + Sync + Send,
 {
-    stripes_batched(
-        records,
+    let plan = Plan::Stripes {
         intensities,
-        collapse,
-        1,
+        collapse: *collapse,
+    };
+    let how = Batching {
+        width: 1,
         threads,
-        |jobs: &[(&R, f64)]| jobs.iter().map(|&(r, im)| analysis(r, im)).collect(),
         progress,
-    )
+    };
+    batched(records, &plan, &how, |jobs: &[(&R, f64)]| {
+        jobs.iter().map(|&(r, im)| analysis(r, im)).collect()
+    })
 }
 
-/// [`stripes`] with a batched analysis: `analysis(jobs)` runs up to `width` analyses
-/// `(record, intensity)` at once (e.g. one a SIMD lane, [`lanes`](crate::lanes)) and
-/// returns their EDPs (or errors) in the order of `jobs`, each what the one-run closure of
-/// [`stripes`] returns for it. The runs are taken intensity by intensity, all records of a
-/// stripe in consecutive lanes, `width` runs a job on [`batch::map`](crate::batch::map)
-/// with `threads` threads (`0`: all available; `width` `0` is taken as `1`).
-/// `progress(done, total)` is called after every batch.
+/// What [`batched`] runs: fixed stripes ([`stripes`]) or hunt-and-fill traces
+/// ([`hunt_fill`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Plan<'a> {
+    /// Every record at every intensity (finite, `> 0`), each run classified by `collapse`.
+    Stripes {
+        /// The intensities (the closure's units).
+        intensities: &'a [f64],
+        /// The collapse rule.
+        collapse: Collapse,
+    },
+    /// One hunt-and-fill trace a record.
+    HuntFill(HuntFill),
+}
+
+/// How [`batched`] runs its analyses.
+#[derive(Clone, Copy)]
+pub struct Batching<'a> {
+    /// Analyses a batch (e.g. the lanes `L` of a [`LaneStepper`](crate::lanes::LaneStepper);
+    /// `0` is taken as `1`).
+    pub width: usize,
+    /// Threads of the [`batch::map`](crate::batch::map) pool (`0`: all available).
+    pub threads: usize,
+    /// `progress(done, total)`, if given, called after every batch from the worker threads
+    /// (see the [module](self)).
+    pub progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
+}
+
+/// [`stripes`] or [`hunt_fill`] with a batched analysis: `analysis(jobs)` runs up to
+/// `how.width` analyses `(record, intensity)` at once (e.g. one a SIMD lane,
+/// [`lanes`](crate::lanes)) and returns their EDPs (or errors) in the order of `jobs`,
+/// each what the one-run closure returns for it. Jobs of [`batch::map`](crate::batch::map)
+/// with `how.threads` threads ([`Batching`]):
 ///
-/// Returns the curves of [`stripes`], bit for bit, for a batched analysis whose every
-/// result is that of the one-run analysis. Errors: as [`stripes`]; a result missing from
-/// a batch (the closure returned fewer than asked) is a failed run
-/// ([`Error::InvalidParameter`]). Cost: as [`stripes`], in `⌈records × intensities /
-/// width⌉` batches.
-pub fn stripes_batched<R, F>(
+/// - [`Plan::Stripes`]: the runs intensity by intensity, all records of a stripe in
+///   consecutive lanes, `width` runs a job; `progress(done, total)` after every batch.
+/// - [`Plan::HuntFill`]: `width` records a job, traced side by side, one a lane: at each
+///   round every unfinished trace of the group chooses its next intensity from its own
+///   runs so far, and the round's runs go to `analysis` at once; `progress` as
+///   [`hunt_fill`].
+///
+/// Returns the curves of [`stripes`] or [`hunt_fill`], bit for bit, for a batched analysis
+/// whose every result is that of the one-run analysis (each trace sees the same results,
+/// so it asks the same intensities). Errors: as [`stripes`] or [`hunt_fill`]; a result
+/// missing from a batch (the closure returned fewer than asked) is a failed run
+/// ([`Error::InvalidParameter`]). Cost: as [`stripes`] or [`hunt_fill`], in batches of
+/// `width` runs (hunt-and-fill: at most `runs` batches a group).
+pub fn batched<R, F>(
     records: &[R],
-    intensities: &[f64],
-    collapse: &Collapse,
-    width: usize,
-    threads: usize,
+    plan: &Plan<'_>,
+    how: &Batching<'_>,
     analysis: F,
-    progress: Option<&(dyn Fn(usize, usize) + Sync)>,
 ) -> Result<Vec<Curve>, Error>
 where
     R: Sync,
     F: Fn(&[(&R, f64)]) -> Vec<Result<f64, Error>> + Sync + Send,
 {
+    let (width, threads, progress) = (how.width.max(1), how.threads, how.progress);
+    let (intensities, collapse) = match plan {
+        Plan::Stripes {
+            intensities,
+            collapse,
+        } => (*intensities, collapse),
+        Plan::HuntFill(settings) => {
+            settings.check()?;
+            let p = Progress::new(records.len().saturating_mul(settings.runs), progress);
+            let groups: Vec<&[R]> = records.chunks(width).collect();
+            let out = crate::batch::map(&groups, threads, |group| {
+                trace_group(group, settings, &analysis, &p)
+            });
+            return out.into_iter().flatten().collect();
+        }
+    };
     collapse.check()?;
     if intensities.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
         return Err(Error::InvalidParameter(Param::Intensity));
@@ -668,7 +648,7 @@ where
         .iter()
         .flat_map(|&im| (0..records.len()).map(move |r| (r, im)))
         .collect();
-    let batches: Vec<&[(usize, f64)]> = jobs.chunks(width.max(1)).collect();
+    let batches: Vec<&[(usize, f64)]> = jobs.chunks(width).collect();
     let p = Progress::new(jobs.len(), progress);
     let runs = crate::batch::map(&batches, threads, |batch| {
         let asked: Vec<(&R, f64)> = batch.iter().map(|&(r, im)| (&records[r], im)).collect();
@@ -693,6 +673,54 @@ where
             Ok(Curve::from_points(
                 pts.into_iter().collect::<Result<Vec<_>, _>>()?,
             ))
+        })
+        .collect()
+}
+
+/// The hunt-and-fill traces of a group of records side by side (see [`batched`]).
+fn trace_group<R, F>(
+    group: &[R],
+    settings: &HuntFill,
+    analysis: &F,
+    p: &Progress<'_>,
+) -> Vec<Result<Curve, Error>>
+where
+    F: Fn(&[(&R, f64)]) -> Vec<Result<f64, Error>>,
+{
+    let mut tracers: Vec<Tracer<'_>> = group.iter().map(|_| Tracer::new(settings)).collect();
+    let mut failed: Vec<Option<Error>> = std::vec![None; group.len()];
+    loop {
+        let mut lanes: Vec<usize> = Vec::with_capacity(group.len());
+        let mut asked: Vec<(&R, f64)> = Vec::with_capacity(group.len());
+        for (k, t) in tracers.iter_mut().enumerate() {
+            if let (None, Some(im)) = (failed[k], t.next()) {
+                lanes.push(k);
+                asked.push((&group[k], im));
+            }
+        }
+        if asked.is_empty() {
+            break;
+        }
+        let out = outcomes(analysis(&asked), asked.len());
+        for ((&k, &(_, im)), o) in lanes.iter().zip(&asked).zip(out) {
+            match classify(o, im, &settings.collapse) {
+                Ok(point) => {
+                    tracers[k].record(point);
+                    p.add(1);
+                }
+                Err(e) => failed[k] = Some(e),
+            }
+        }
+    }
+    tracers
+        .into_iter()
+        .zip(failed)
+        .map(|(t, f)| {
+            p.add(settings.runs - t.pts.len());
+            match f {
+                Some(e) => Err(e),
+                None => Ok(t.finish()),
+            }
         })
         .collect()
 }

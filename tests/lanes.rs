@@ -286,7 +286,7 @@ fn ida_records() -> Vec<Vec<f64>> {
 #[cfg(feature = "std")]
 #[test]
 fn stripes_in_lanes_are_the_stripes() {
-    use aemstep::ida::{Collapse, OnFailure};
+    use aemstep::ida::{Batching, Collapse, OnFailure, Plan};
     let b = bilinear();
     let single = scene::stepper().unwrap();
     let lanes = LaneStepper::<f64, 5, 4>::new(scene::H, single.settings()).unwrap();
@@ -305,13 +305,20 @@ fn stripes_in_lanes_are_the_stripes() {
         scene::peak_drifts(&b, &lanes, &jobs)
     };
     let want = aemstep::ida::stripes(&records, &ims, &collapse, 1, one, None).unwrap();
+    let plan = Plan::Stripes {
+        intensities: &ims,
+        collapse,
+    };
     assert!(want.iter().any(|c| c.collapse.is_some()));
     let pts: Vec<_> = want.iter().flat_map(|c| c.points.iter()).collect();
     assert!(pts.iter().any(|p| !p.collapsed && p.edp > 0.03), "{want:?}");
     for threads in [1, 2] {
-        let got =
-            aemstep::ida::stripes_batched(&records, &ims, &collapse, 4, threads, batched, None)
-                .unwrap();
+        let how = Batching {
+            width: 4,
+            threads,
+            progress: None,
+        };
+        let got = aemstep::ida::batched(&records, &plan, &how, batched).unwrap();
         assert_eq!(format!("{got:?}"), format!("{want:?}")); // `{:?}` of f64 round-trips
     }
 }
@@ -321,7 +328,7 @@ fn stripes_in_lanes_are_the_stripes() {
 #[cfg(feature = "std")]
 #[test]
 fn hunt_fill_in_lanes_is_the_hunt_fill() {
-    use aemstep::ida::{Collapse, HuntFill, OnFailure};
+    use aemstep::ida::{Batching, Collapse, HuntFill, OnFailure, Plan};
     use std::sync::atomic::{AtomicUsize, Ordering};
     let b = bilinear();
     let single = scene::stepper().unwrap();
@@ -353,8 +360,12 @@ fn hunt_fill_in_lanes_is_the_hunt_fill() {
         assert_eq!(total, 18);
         last.fetch_max(done, Ordering::Relaxed);
     };
-    let got = aemstep::ida::hunt_fill_batched(&records, &settings, 2, 2, batched, Some(&progress))
-        .unwrap();
+    let how = Batching {
+        width: 2,
+        threads: 2,
+        progress: Some(&progress),
+    };
+    let got = aemstep::ida::batched(&records, &Plan::HuntFill(settings), &how, batched).unwrap();
     assert_eq!(format!("{got:?}"), format!("{want:?}"));
     assert_eq!(last.load(Ordering::Relaxed), 18);
 }

@@ -7,7 +7,7 @@
 //!   criterion's throughput is analysis-steps a second.
 //! - `IDA880`: 44 records × 20 intensities (0.1, 0.2, …, 2.0) = 880 whole analyses (15 975
 //!   steps each), peak storey drift, no collapse limit: `ida::stripes` with one analysis a
-//!   run on 1 and 2 threads, and `ida::stripes_batched` with `LaneStepper<f64, 5, 4>` (and
+//!   run on 1 and 2 threads, and `ida::batched` (`Plan::Stripes`) with `LaneStepper<f64, 5, 4>` (and
 //!   8) on 1 and 2 threads; the curves are asserted bit-identical. The records: El Centro
 //!   NS, reversed in time, negated, and 41 synthetic records of its length (white noise of
 //!   a SplitMix64 generator, seeds 1 … 41, Box–Muller, a 3-point moving average, under the
@@ -29,7 +29,7 @@ mod ida;
 use std::hint::black_box;
 use std::time::Instant;
 
-use aemstep::ida::{Collapse, OnFailure, stripes, stripes_batched};
+use aemstep::ida::{Batching, Collapse, OnFailure, Plan, batched, stripes};
 use aemstep::lanes::LaneStepper;
 use criterion::{Criterion, Throughput};
 
@@ -181,6 +181,10 @@ fn main() {
         edp: f64::INFINITY,
         on_failure: OnFailure::Collapse,
     };
+    let plan = Plan::Stripes {
+        intensities: &scales,
+        collapse,
+    };
     let run_one =
         |r: &Vec<f64>, im: f64| ida::peak_drift(&building, &single, r, im, ida::steps(r.len()));
     let serial = |threads| stripes(&recs, &scales, &collapse, threads, run_one, None).expect("ida");
@@ -199,10 +203,30 @@ fn main() {
         ida::peak_drifts(&building, &l8, &jobs)
     };
     let lanes4 = |threads| {
-        stripes_batched(&recs, &scales, &collapse, 4, threads, batched4, None).expect("ida")
+        batched(
+            &recs,
+            &plan,
+            &Batching {
+                width: 4,
+                threads,
+                progress: None,
+            },
+            batched4,
+        )
+        .expect("ida")
     };
     let lanes8 = |threads| {
-        stripes_batched(&recs, &scales, &collapse, 8, threads, batched8, None).expect("ida")
+        batched(
+            &recs,
+            &plan,
+            &Batching {
+                width: 8,
+                threads,
+                progress: None,
+            },
+            batched8,
+        )
+        .expect("ida")
     };
     let want = format!("{:?}", serial(1));
     assert_eq!(format!("{:?}", lanes4(2)), want);
