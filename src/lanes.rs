@@ -395,8 +395,9 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         // A lane still iterating.
         let mut running = active;
         let p_size = norm_inf(p);
+        let p_finite = finite(p, 0);
         for (l, run) in running.iter_mut().enumerate() {
-            if *run && !(0..N).all(|i| p[i][l].is_finite()) {
+            if *run && !p_finite[l] {
                 out[l] = Some(Err(Error::NonFiniteInput));
                 *run = false;
             }
@@ -436,8 +437,9 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
             }
             Self::trial(building, band, history, &mut w);
             band_mul_diagonal(&m_diag, &zero_off, &w.q, &mut mq);
+            let f_finite = finite(&w.force, 0);
             for l in 0..L {
-                if running[l] && !(0..N).all(|i| w.force[i][l].is_finite()) {
+                if running[l] && !f_finite[l] {
                     out[l] = Some(Err(Error::NonFiniteForce));
                     running[l] = false;
                 }
@@ -622,13 +624,14 @@ fn solve<T: Real, H, const N: usize, const L: usize>(
     r: &mut [[T; L]; N],
 ) -> [Option<Error>; L] {
     let mut failed = [None; L];
+    let [kd, cd, ko, co] = [
+        finite(&w.k_diag, 0),
+        finite(&w.c_diag, 0),
+        finite(&w.k_off, 1),
+        finite(&w.c_off, 1),
+    ];
     for (l, f) in failed.iter_mut().enumerate() {
-        let finite = (0..N).all(|i| {
-            w.k_diag[i][l].is_finite()
-                && w.c_diag[i][l].is_finite()
-                && (i == 0 || (w.k_off[i][l].is_finite() && w.c_off[i][l].is_finite()))
-        });
-        if !finite {
+        if !(kd[l] && cd[l] && ko[l] && co[l]) {
             *f = Some(Error::NonFiniteForce);
         }
     }
@@ -715,6 +718,18 @@ fn solve_positive<T: Real, const N: usize, const L: usize>(
         }
     }
     accepted
+}
+
+/// Each lane's entries from DOF `from` on are all finite.
+#[inline(always)]
+fn finite<T: Real, const N: usize, const L: usize>(x: &[[T; L]; N], from: usize) -> [bool; L] {
+    let mut ok = [true; L];
+    for row in x.iter().skip(from) {
+        for l in 0..L {
+            ok[l] &= row[l].is_finite();
+        }
+    }
+    ok
 }
 
 /// A vector's entries, each repeated in every lane.
