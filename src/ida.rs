@@ -271,6 +271,12 @@ fn run<R, F>(record: &R, im: f64, rule: &Collapse, analysis: &F) -> Result<Point
 where
     F: Fn(&R, f64) -> Result<f64, Error>,
 {
+    classify(analysis(record, im), im, rule)
+}
+
+/// Classifies the outcome of the analysis at intensity `im` (a [`Point`], or with
+/// [`OnFailure::Abort`] the error).
+fn classify(outcome: Result<f64, Error>, im: f64, rule: &Collapse) -> Result<Point, Error> {
     let failed = |e: Error| match rule.on_failure {
         OnFailure::Collapse => Ok(Point {
             intensity: im,
@@ -280,7 +286,7 @@ where
         }),
         OnFailure::Abort => Err(e),
     };
-    match analysis(record, im) {
+    match outcome {
         // NaN and −∞ are no EDP (+∞ is a collapse, as the EDP rule reads it)
         Ok(edp) if edp.is_nan() || edp == f64::NEG_INFINITY => failed(Error::NonFiniteState),
         Ok(edp) => Ok(Point {
@@ -293,6 +299,14 @@ where
     }
 }
 
+/// The outcomes of a batched analysis for `jobs` runs, one each in order; a missing one
+/// (the closure returned fewer) is a failed run, [`Error::InvalidParameter`]
+/// ([`Param::Intensity`]).
+fn outcomes(mut out: Vec<Result<f64, Error>>, jobs: usize) -> Vec<Result<f64, Error>> {
+    out.resize(jobs, Err(Error::InvalidParameter(Param::Intensity)));
+    out
+}
+
 /// The lowest collapsing intensity of `points` (`+∞` if none).
 fn lowest_collapse(points: &[Point]) -> f64 {
     points
@@ -302,70 +316,139 @@ fn lowest_collapse(points: &[Point]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Where a hunt-and-fill trace is (see the [module](self)).
+#[derive(Clone, Copy, Debug)]
+enum Phase {
+    /// Hunting up: the next run is at `im`.
+    Hunt,
+    /// Bisecting between `lo` and `hi`.
+    Bracket,
+    /// Filling the largest gaps.
+    Fill,
+    /// The budget is spent or no new intensity can be separated.
+    Done,
+}
+
+/// One record's hunt-and-fill trace as a state machine: [`Tracer::next`] chooses the next
+/// intensity from the runs so far, [`Tracer::record`] takes its result. The serial trace
+/// ([`trace`]) and the traces in lanes ([`batched`], one record a lane) both
+/// drive it, so both choose the same intensities from the same results.
+struct Tracer<'a> {
+    s: &'a HuntFill,
+    pts: Vec<Point>,
+    phase: Phase,
+    /// The hunt's next intensity and step.
+    im: f64,
+    step: f64,
+    /// The bracket: the highest non-collapsing and the lowest collapsing intensity.
+    lo: f64,
+    hi: f64,
+    /// The intensity asked by the last [`Tracer::next`].
+    asked: f64,
+    /// The fill's sorted intensities (reused).
+    xs: Vec<f64>,
+}
+
+impl<'a> Tracer<'a> {
+    fn new(s: &'a HuntFill) -> Self {
+        Tracer {
+            s,
+            pts: Vec::with_capacity(s.runs),
+            phase: Phase::Hunt,
+            im: s.first,
+            step: s.step,
+            lo: 0.0,
+            hi: 0.0,
+            asked: 0.0,
+            xs: Vec::with_capacity(s.runs + 1),
+        }
+    }
+
+    /// The next intensity to run, `None` once the trace is complete.
+    fn next(&mut self) -> Option<f64> {
+        let s = self.s;
+        if let Phase::Hunt = self.phase {
+            self.asked = self.im;
+            return Some(self.im);
+        }
+        if let Phase::Bracket = self.phase {
+            let (lo, hi) = (self.lo, self.hi);
+            let mid = lo + 0.5 * (hi - lo);
+            if self.pts.len() < s.runs && hi - lo > s.resolution && mid > lo && mid < hi {
+                self.asked = mid;
+                return Some(mid);
+            }
+            self.phase = Phase::Fill;
+        }
+        if let Phase::Fill = self.phase {
+            if self.pts.len() < s.runs {
+                let cap = lowest_collapse(&self.pts);
+                let xs = &mut self.xs;
+                xs.clear();
+                xs.push(0.0);
+                xs.extend(
+                    self.pts
+                        .iter()
+                        .filter(|p| !p.collapsed && p.intensity < cap)
+                        .map(|p| p.intensity),
+                );
+                xs.sort_by(f64::total_cmp);
+                let mut best = (0.0f64, 0.0f64);
+                for w in xs.windows(2) {
+                    if w[1] - w[0] > best.1 - best.0 {
+                        best = (w[0], w[1]);
+                    }
+                }
+                let mid = best.0 + 0.5 * (best.1 - best.0);
+                if mid > best.0 && mid < best.1 {
+                    self.asked = mid;
+                    return Some(mid);
+                }
+            }
+            self.phase = Phase::Done;
+        }
+        None
+    }
+
+    /// The run at the intensity [`Tracer::next`] asked for.
+    fn record(&mut self, p: Point) {
+        self.pts.push(p);
+        match self.phase {
+            Phase::Hunt => {
+                if p.collapsed {
+                    (self.phase, self.hi) = (Phase::Bracket, self.asked);
+                } else if self.pts.len() == self.s.runs {
+                    self.phase = Phase::Done;
+                } else {
+                    self.lo = self.asked;
+                    self.im += self.step;
+                    self.step += self.s.step_increment;
+                }
+            }
+            Phase::Bracket if p.collapsed => self.hi = self.asked,
+            Phase::Bracket => self.lo = self.asked,
+            Phase::Fill | Phase::Done => {}
+        }
+    }
+
+    /// The curve of the runs.
+    fn finish(self) -> Curve {
+        Curve::from_points(self.pts)
+    }
+}
+
 /// The hunt-and-fill trace of one record, serially (see the [module](self));
 /// `tick` is called after every run.
 fn trace_with<R, F>(record: &R, s: &HuntFill, analysis: &F, tick: &dyn Fn()) -> Result<Curve, Error>
 where
     F: Fn(&R, f64) -> Result<f64, Error>,
 {
-    let mut pts: Vec<Point> = Vec::with_capacity(s.runs);
-    let go = |im: f64, pts: &mut Vec<Point>| -> Result<bool, Error> {
-        let p = run(record, im, &s.collapse, analysis)?;
-        pts.push(p);
+    let mut tracer = Tracer::new(s);
+    while let Some(im) = tracer.next() {
+        tracer.record(run(record, im, &s.collapse, analysis)?);
         tick();
-        Ok(p.collapsed)
-    };
-    // 1. Hunt up.
-    let (mut im, mut step, mut lo) = (s.first, s.step, 0.0f64);
-    loop {
-        if go(im, &mut pts)? {
-            break;
-        }
-        if pts.len() == s.runs {
-            return Ok(Curve::from_points(pts));
-        }
-        lo = im;
-        im += step;
-        step += s.step_increment;
     }
-    // 2. Bracket by bisection.
-    let mut hi = im;
-    while pts.len() < s.runs && hi - lo > s.resolution {
-        let mid = lo + 0.5 * (hi - lo);
-        if !(mid > lo && mid < hi) {
-            break;
-        }
-        if go(mid, &mut pts)? {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    // 3. Fill the largest gaps below the lowest collapse.
-    let mut xs: Vec<f64> = Vec::with_capacity(s.runs + 1);
-    while pts.len() < s.runs {
-        let cap = lowest_collapse(&pts);
-        xs.clear();
-        xs.push(0.0);
-        xs.extend(
-            pts.iter()
-                .filter(|p| !p.collapsed && p.intensity < cap)
-                .map(|p| p.intensity),
-        );
-        xs.sort_by(f64::total_cmp);
-        let mut best = (0.0f64, 0.0f64);
-        for w in xs.windows(2) {
-            if w[1] - w[0] > best.1 - best.0 {
-                best = (w[0], w[1]);
-            }
-        }
-        let mid = best.0 + 0.5 * (best.1 - best.0);
-        if !(mid > best.0 && mid < best.1) {
-            break;
-        }
-        go(mid, &mut pts)?;
-    }
-    Ok(Curve::from_points(pts))
+    Ok(tracer.finish())
 }
 
 /// The hunt-and-fill IDA curve of one record, on the caller's thread (see the
@@ -469,27 +552,175 @@ where
     R: Sync,
     F: Fn(&R, f64) -> Result<f64, Error> + Sync + Send,
 {
+    let plan = Plan::Stripes {
+        intensities,
+        collapse: *collapse,
+    };
+    let how = Batching {
+        width: 1,
+        threads,
+        progress,
+    };
+    batched(records, &plan, &how, |jobs: &[(&R, f64)]| {
+        jobs.iter().map(|&(r, im)| analysis(r, im)).collect()
+    })
+}
+
+/// What [`batched`] runs: fixed stripes ([`stripes`]) or hunt-and-fill traces
+/// ([`hunt_fill`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Plan<'a> {
+    /// Every record at every intensity (finite, `> 0`), each run classified by `collapse`.
+    Stripes {
+        /// The intensities (the closure's units).
+        intensities: &'a [f64],
+        /// The collapse rule.
+        collapse: Collapse,
+    },
+    /// One hunt-and-fill trace a record.
+    HuntFill(HuntFill),
+}
+
+/// How [`batched`] runs its analyses.
+#[derive(Clone, Copy)]
+pub struct Batching<'a> {
+    /// Analyses a batch (e.g. the lanes `L` of a [`LaneStepper`](crate::lanes::LaneStepper);
+    /// `0` is taken as `1`).
+    pub width: usize,
+    /// Threads of the [`batch::map`](crate::batch::map) pool (`0`: all available).
+    pub threads: usize,
+    /// `progress(done, total)`, if given, called after every batch from the worker threads
+    /// (see the [module](self)).
+    pub progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
+}
+
+/// [`stripes`] or [`hunt_fill`] with a batched analysis: `analysis(jobs)` runs up to
+/// `how.width` analyses `(record, intensity)` at once (e.g. one a SIMD lane,
+/// [`lanes`](crate::lanes)) and returns their EDPs (or errors) in the order of `jobs`,
+/// each what the one-run closure returns for it. Jobs of [`batch::map`](crate::batch::map)
+/// with `how.threads` threads ([`Batching`]):
+///
+/// - [`Plan::Stripes`]: the runs intensity by intensity, all records of a stripe in
+///   consecutive lanes, `width` runs a job; `progress(done, total)` after every batch.
+/// - [`Plan::HuntFill`]: `width` records a job, traced side by side, one a lane: at each
+///   round every unfinished trace of the group chooses its next intensity from its own
+///   runs so far, and the round's runs go to `analysis` at once; `progress` as
+///   [`hunt_fill`].
+///
+/// Returns the curves of [`stripes`] or [`hunt_fill`], bit for bit, for a batched analysis
+/// whose every result is that of the one-run analysis (each trace sees the same results,
+/// so it asks the same intensities). Errors: as [`stripes`] or [`hunt_fill`]; a result
+/// missing from a batch (the closure returned fewer than asked) is a failed run
+/// ([`Error::InvalidParameter`]). Cost: as [`stripes`] or [`hunt_fill`], in batches of
+/// `width` runs (hunt-and-fill: at most `runs` batches a group).
+pub fn batched<R, F>(
+    records: &[R],
+    plan: &Plan<'_>,
+    how: &Batching<'_>,
+    analysis: F,
+) -> Result<Vec<Curve>, Error>
+where
+    R: Sync,
+    F: Fn(&[(&R, f64)]) -> Vec<Result<f64, Error>> + Sync + Send,
+{
+    let (width, threads, progress) = (how.width.max(1), how.threads, how.progress);
+    let (intensities, collapse) = match plan {
+        Plan::Stripes {
+            intensities,
+            collapse,
+        } => (*intensities, collapse),
+        Plan::HuntFill(settings) => {
+            settings.check()?;
+            let p = Progress::new(records.len().saturating_mul(settings.runs), progress);
+            let groups: Vec<&[R]> = records.chunks(width).collect();
+            let out = crate::batch::map(&groups, threads, |group| {
+                trace_group(group, settings, &analysis, &p)
+            });
+            return out.into_iter().flatten().collect();
+        }
+    };
     collapse.check()?;
     if intensities.iter().any(|&x| !(x.is_finite() && x > 0.0)) {
         return Err(Error::InvalidParameter(Param::Intensity));
     }
-    let jobs: Vec<(usize, f64)> = (0..records.len())
-        .flat_map(|r| intensities.iter().map(move |&im| (r, im)))
+    // Intensity-major: a stripe's records side by side.
+    let jobs: Vec<(usize, f64)> = intensities
+        .iter()
+        .flat_map(|&im| (0..records.len()).map(move |r| (r, im)))
         .collect();
+    let batches: Vec<&[(usize, f64)]> = jobs.chunks(width).collect();
     let p = Progress::new(jobs.len(), progress);
-    let runs = crate::batch::map(&jobs, threads, |&(r, im)| {
-        let out = run(&records[r], im, collapse, &analysis);
-        p.add(1);
-        out
+    let runs = crate::batch::map(&batches, threads, |batch| {
+        let asked: Vec<(&R, f64)> = batch.iter().map(|&(r, im)| (&records[r], im)).collect();
+        let out = outcomes(analysis(&asked), batch.len());
+        let points: Vec<Result<Point, Error>> = batch
+            .iter()
+            .zip(out)
+            .map(|(&(_, im), o)| classify(o, im, collapse))
+            .collect();
+        p.add(batch.len());
+        points
     });
-    let mut runs = runs.into_iter();
-    (0..records.len())
-        .map(|_| {
-            let pts = runs
-                .by_ref()
-                .take(intensities.len())
-                .collect::<Result<Vec<_>, _>>()?;
-            Ok(Curve::from_points(pts))
+    let mut by_record: Vec<Vec<Result<Point, Error>>> = (0..records.len())
+        .map(|_| Vec::with_capacity(intensities.len()))
+        .collect();
+    for (k, point) in runs.into_iter().flatten().enumerate() {
+        by_record[k % records.len()].push(point);
+    }
+    by_record
+        .into_iter()
+        .map(|pts| {
+            Ok(Curve::from_points(
+                pts.into_iter().collect::<Result<Vec<_>, _>>()?,
+            ))
+        })
+        .collect()
+}
+
+/// The hunt-and-fill traces of a group of records side by side (see [`batched`]).
+fn trace_group<R, F>(
+    group: &[R],
+    settings: &HuntFill,
+    analysis: &F,
+    p: &Progress<'_>,
+) -> Vec<Result<Curve, Error>>
+where
+    F: Fn(&[(&R, f64)]) -> Vec<Result<f64, Error>>,
+{
+    let mut tracers: Vec<Tracer<'_>> = group.iter().map(|_| Tracer::new(settings)).collect();
+    let mut failed: Vec<Option<Error>> = std::vec![None; group.len()];
+    loop {
+        let mut lanes: Vec<usize> = Vec::with_capacity(group.len());
+        let mut asked: Vec<(&R, f64)> = Vec::with_capacity(group.len());
+        for (k, t) in tracers.iter_mut().enumerate() {
+            if let (None, Some(im)) = (failed[k], t.next()) {
+                lanes.push(k);
+                asked.push((&group[k], im));
+            }
+        }
+        if asked.is_empty() {
+            break;
+        }
+        let out = outcomes(analysis(&asked), asked.len());
+        for ((&k, &(_, im)), o) in lanes.iter().zip(&asked).zip(out) {
+            match classify(o, im, &settings.collapse) {
+                Ok(point) => {
+                    tracers[k].record(point);
+                    p.add(1);
+                }
+                Err(e) => failed[k] = Some(e),
+            }
+        }
+    }
+    tracers
+        .into_iter()
+        .zip(failed)
+        .map(|(t, f)| {
+            p.add(settings.runs - t.pts.len());
+            match f {
+                Some(e) => Err(e),
+                None => Ok(t.finish()),
+            }
         })
         .collect()
 }

@@ -247,6 +247,9 @@ mod schemes;
 // Nonlinear (Newton) and time-varying steppers.
 mod nonlinear;
 
+// Many nonlinear analyses at once, one per SIMD lane (the yielding shear building).
+pub mod lanes;
+
 // Change detection on an observer's innovations, localization by a bank of models.
 pub mod detection;
 

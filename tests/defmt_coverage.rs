@@ -28,6 +28,8 @@ const SKIP: &[(&str, &str)] = &[
     ("Record", "std only"),
     ("OnFailure", "std only"),
     ("Collapse", "std only"),
+    ("Plan", "std only"),
+    ("Batching", "std only"),
     ("HuntFill", "std only"),
     ("Point", "std only"),
     ("Fractiles", "std only"),

@@ -110,3 +110,42 @@ pub fn peak_drift(
     }
     Ok(peak)
 }
+
+/// [`peak_drift`] of up to `L` runs at once, one a lane of `lanes` (`aemstep::lanes`), bit
+/// for bit: `jobs` are `(record, scale, steps)`, run in groups of `L`; each result is what
+/// [`peak_drift`] returns for the job.
+pub fn peak_drifts<const L: usize>(
+    building: &Building,
+    lanes: &aemstep::lanes::LaneStepper<f64, N, L>,
+    jobs: &[(&[f64], f64, u64)],
+) -> Vec<Result<f64, Error>> {
+    let mut out = Vec::with_capacity(jobs.len());
+    for group in jobs.chunks(L) {
+        let steps: [u64; L] = core::array::from_fn(|l| group.get(l).map_or(0, |j| j.2));
+        let mut peak = [0.0f64; L];
+        let outcome = lanes.run(
+            building,
+            steps,
+            |l, n| group.get(l).map_or(0.0, |j| ground(j.0, j.1, n)),
+            |state, stepped| {
+                let u = state.u();
+                for l in 0..L {
+                    if stepped[l] {
+                        for i in 0..N {
+                            let d = if i == 0 {
+                                u[0][l]
+                            } else {
+                                u[i][l] - u[i - 1][l]
+                            };
+                            peak[l] = peak[l].max(d.abs());
+                        }
+                    }
+                }
+            },
+        );
+        for l in 0..group.len() {
+            out.push(outcome[l].map(|()| peak[l]).map_err(|f| f.error));
+        }
+    }
+    out
+}

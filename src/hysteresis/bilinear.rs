@@ -167,3 +167,41 @@ impl<T: Real> Law<T> for Bilinear<T> {
         self.k * e * e / (T::one() + T::one())
     }
 }
+
+/// Both branches of [`Law::trial`] in every lane, the result selected per lane: each value
+/// computed by exactly the operations of the scalar trial, so every lane has its bits,
+/// and the loop has no branch (packed instructions).
+impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
+    #[inline(always)]
+    fn trial_lanes<const L: usize>(
+        &self,
+        committed: &[BilinearHistory<T>; L],
+        d: &[T; L],
+        _rate: &[T; L],
+    ) -> crate::lanes::LaneTrial<T, BilinearHistory<T>, L> {
+        let two = T::one() + T::one();
+        let half = T::one() / two;
+        let mut out = crate::lanes::LaneTrial {
+            force: [T::zero(); L],
+            stiffness: [T::zero(); L],
+            damping: [T::zero(); L],
+            history: *committed,
+            inelastic: [false; L],
+        };
+        for l in 0..L {
+            let dp = committed[l].plastic;
+            let f_tr = self.k * (d[l] * half - dp * half) * two;
+            let xi = f_tr - self.hard * dp;
+            let excess = xi.abs() - self.fy;
+            let plastic = excess > T::zero();
+            let s = if xi > T::zero() { T::one() } else { -T::one() };
+            let f_p = f_tr - s * self.one_minus_alpha * excess;
+            let dp_p = (dp * half + s * (self.compliance_p * half) * excess) * two;
+            out.force[l] = if plastic { f_p } else { f_tr };
+            out.stiffness[l] = if plastic { self.kt } else { self.k };
+            out.history[l].plastic = if plastic { dp_p } else { dp };
+            out.inelastic[l] = plastic;
+        }
+        out
+    }
+}

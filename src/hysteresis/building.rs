@@ -116,6 +116,12 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
         })
     }
 
+    /// `C` on its three diagonals when it is symmetric tridiagonal (the banded Newton
+    /// path, [`HistoryModel::trial_tridiagonal`]), else `None`. Cost: O(1).
+    pub(crate) fn band(&self) -> Option<&SymTridiagonal<T, N>> {
+        self.band.as_ref()
+    }
+
     /// The storey laws, ground storey first. Cost: O(1).
     pub fn laws(&self) -> &[L; N] {
         &self.laws

@@ -1,0 +1,804 @@
+//! Many analyses at once: `L` nonlinear time-history analyses of one yielding
+//! [`ShearBuilding`] advanced together, one analysis per SIMD lane, bit for bit the `L`
+//! single analyses of [`Nonlinear::try_step_with_history`].
+//!
+//! Incremental dynamic analysis, stripes and fragility studies run the same structure under
+//! many records or intensities. One analysis cannot go much faster than its Newton solve's
+//! dependency chain (`docs/performance.md`); `L` independent analyses can share every
+//! instruction. [`LaneStepper`] keeps each quantity of the `L` analyses side by side,
+//! structure-of-arrays (`[T; L]` per degree of freedom: [`LaneState`], [`LaneHistory`]),
+//! and writes every operation of the single analysis as a plain loop over the lanes, which
+//! the compiler turns into packed instructions (`f64 × 2` on SSE2, `× 4` with AVX, chosen
+//! at run time by the crate's one dispatch point, `f32` twice as wide); elsewhere the same
+//! loops run as they are.
+//!
+//! **The same bits as one analysis.** Every lane performs exactly the operations of the
+//! single step, in the same order: the predictor and corrector ([`Nonlinear`]'s
+//! kinematics), the storey laws ([`LaneLaw::trial_lanes`]: a branch of the law becomes a
+//! per-lane select between both branches, each computed as the law computes it), `C v`
+//! and `M q` on three diagonals, the residual and the convergence tests, the Newton matrix
+//! and its `L D Lᵀ` solve (a lane whose matrix is not positive definite takes the same
+//! pivoted LU as the single step). Packed `add`/`mul`/`div`/`max`/compare round each lane
+//! as the scalar instruction does and Rust never fuses a multiply and an add, so the
+//! results are identical at any `L` and on any CPU feature level (`tests/lanes.rs`).
+//!
+//! **Masks.** Newton iterates until every lane is done; a lane that has converged (or
+//! spent its budget) is committed and frozen while the others iterate. A lane that fails
+//! (not converged, non-finite force or state, singular Newton matrix, non-finite load) is
+//! left bit-identical, as the single step leaves its state, and reports its error; the
+//! other lanes go on. A lane outside the `active` mask (a finished, shorter record; an
+//! analysis that failed) is not touched. [`LaneStepper::run`] drives records of different
+//! lengths from rest and reports each lane's failure with its step.
+//!
+//! A building whose damping matrix is not symmetric tridiagonal (dense `C`) is stepped
+//! lane by lane with the single step (the same results, without the packed arithmetic).
+//!
+//! Cost per step, `k` the largest Newton iteration count of the active lanes: that of
+//! one single step of `k` iterations ([`Nonlinear`]: `(k + 1)` trials and `26N k` flops),
+//! each operation on `L` lanes at once. Stack: about twelve `N × L` arrays of `T` and the
+//! lanes' trial histories. No allocation, no panic.
+//!
+//! ```
+//! use aemstep::hysteresis::{Bilinear, ShearBuilding};
+//! use aemstep::lanes::LaneStepper;
+//! use aemstep::{models, NewtonSettings};
+//!
+//! let law = Bilinear::<f64>::new(1e8, 2e5, 0.05)?;
+//! let (m, k) = models::shear_building([1e5; 3], [1e8; 3]);
+//! let (a0, a1) = models::rayleigh_coefficients(13.0, 36.0, 0.02);
+//! let building = ShearBuilding::new([1e5; 3], [law; 3], &models::rayleigh(&m, &k, a0, a1))?;
+//!
+//! // Four intensities of one sine pulse, records of 400, 400, 300 and 200 steps.
+//! let stepper = LaneStepper::<f64, 3, 4>::new(0.005, NewtonSettings::default())?;
+//! let scale = [2.0, 4.0, 6.0, 8.0];
+//! let mut peak = [0.0f64; 4];
+//! let outcome = stepper.run(
+//!     &building,
+//!     [400, 400, 300, 200],
+//!     |lane, n| scale[lane] * (8.0 * 0.005 * n as f64).sin(),
+//!     |state, stepped| {
+//!         for (lane, p) in peak.iter_mut().enumerate() {
+//!             if stepped[lane] {
+//!                 *p = p.max(state.u()[2][lane].abs()); // roof displacement
+//!             }
+//!         }
+//!     },
+//! );
+//! assert!(outcome.iter().all(|o| o.is_ok()));
+//! assert!(peak[1] > peak[0]);
+//! # Ok::<(), aemstep::Error>(())
+//! ```
+
+use nalgebra::SVector;
+
+use crate::hysteresis::{BoucWen, Friction, HistoryModel, Law, LawTrial, Parallel, ShearBuilding};
+use crate::kinematics::{AemKinematics, Kinematics, check_time_step_as};
+use crate::linalg::lu::solve_in_place;
+use crate::{
+    Error, Iterations, NewtonReport, NewtonSettings, Nonlinear, Real, State, SymTridiagonal,
+};
+
+/// The committed histories of `L` analyses of an `N`-storey building: `[storey][lane]`.
+pub type LaneHistory<H, const N: usize, const L: usize> = [[H; L]; N];
+
+/// What one step of [`LaneStepper::step`] did in each lane: `None` for a lane outside the
+/// `active` mask (untouched), else the lane's result as
+/// [`Nonlinear::try_step_with_history`] returns it.
+pub type LaneReports<T, const L: usize> = [Option<Result<NewtonReport<T>, Error>>; L];
+
+/// One storey law's trials in `L` lanes: what [`Law::trial`] returns, each field a lane
+/// array.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LaneTrial<T, H, const L: usize> {
+    /// The forces `f` (force units).
+    pub force: [T; L],
+    /// The consistent tangent stiffnesses `∂f/∂d` (force per deformation).
+    pub stiffness: [T; L],
+    /// The tangent dampings `∂f/∂ḋ` (force per deformation rate).
+    pub damping: [T; L],
+    /// The trial histories.
+    pub history: [H; L],
+    /// Each lane on an inelastic branch.
+    pub inelastic: [bool; L],
+}
+
+/// A storey [`Law`] evaluated in `L` lanes at once, bit for bit as `L` calls of
+/// [`Law::trial`]. The default calls [`Law::trial`] lane by lane (exact by construction,
+/// not packed); [`Bilinear`](crate::hysteresis::Bilinear) computes both of its branches in
+/// every lane and selects, so its trials run as packed instructions.
+pub trait LaneLaw<T: Real>: Law<T> {
+    /// The trials at deformations `d` and rates `rate` from the `committed` histories, one
+    /// lane each. Cost: `L` law trials.
+    #[inline(always)]
+    fn trial_lanes<const L: usize>(
+        &self,
+        committed: &[Self::History; L],
+        d: &[T; L],
+        rate: &[T; L],
+    ) -> LaneTrial<T, Self::History, L> {
+        let t: [LawTrial<T, Self::History>; L] =
+            core::array::from_fn(|l| self.trial(&committed[l], d[l], rate[l]));
+        LaneTrial {
+            force: core::array::from_fn(|l| t[l].force),
+            stiffness: core::array::from_fn(|l| t[l].stiffness),
+            damping: core::array::from_fn(|l| t[l].damping),
+            history: core::array::from_fn(|l| t[l].history),
+            inelastic: core::array::from_fn(|l| t[l].inelastic),
+        }
+    }
+}
+
+impl<T: Real> LaneLaw<T> for BoucWen<T> {}
+impl<T: Real> LaneLaw<T> for Friction<T> {}
+impl<T: Real, A: Law<T>, B: Law<T>> LaneLaw<T> for Parallel<A, B> {}
+
+/// The states of `L` analyses with `N` degrees of freedom, structure-of-arrays: `u`, `v`,
+/// `a` as `[dof][lane]`, and each lane's step count.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LaneState<T, const N: usize, const L: usize> {
+    u: [[T; L]; N],
+    v: [[T; L]; N],
+    a: [[T; L]; N],
+    n: [u64; L],
+}
+
+impl<T: Real, const N: usize, const L: usize> LaneState<T, N, L> {
+    /// The `L` states side by side (lane `l` is `states[l]`). Cost: `3 N L` copies.
+    pub fn from_states(states: &[State<T, N>; L]) -> Self {
+        Self {
+            u: core::array::from_fn(|i| core::array::from_fn(|l| states[l].u[i])),
+            v: core::array::from_fn(|i| core::array::from_fn(|l| states[l].v[i])),
+            a: core::array::from_fn(|i| core::array::from_fn(|l| states[l].a[i])),
+            n: core::array::from_fn(|l| states[l].n),
+        }
+    }
+
+    /// The state of lane `lane` (`< L`), `None` past the last lane. Cost: `3N` copies.
+    pub fn lane(&self, lane: usize) -> Option<State<T, N>> {
+        if lane >= L {
+            return None;
+        }
+        let col = |x: &[[T; L]; N]| SVector::<T, N>::from_fn(|i, _| x[i][lane]);
+        Some(State::unchecked(
+            col(&self.u),
+            col(&self.v),
+            col(&self.a),
+            self.n[lane],
+        ))
+    }
+
+    /// Replace lane `lane`'s state (`lane < L`; a lane past the last is ignored). Cost:
+    /// `3N` copies.
+    pub fn set_lane(&mut self, lane: usize, state: &State<T, N>) {
+        if lane >= L {
+            return;
+        }
+        for i in 0..N {
+            self.u[i][lane] = state.u[i];
+            self.v[i][lane] = state.v[i];
+            self.a[i][lane] = state.a[i];
+        }
+        self.n[lane] = state.n;
+    }
+
+    /// Displacements `u[dof][lane]` (displacement units). Cost: none.
+    pub fn u(&self) -> &[[T; L]; N] {
+        &self.u
+    }
+
+    /// Velocities `v[dof][lane]`. Cost: none.
+    pub fn v(&self) -> &[[T; L]; N] {
+        &self.v
+    }
+
+    /// Accelerations `a[dof][lane]`. Cost: none.
+    pub fn a(&self) -> &[[T; L]; N] {
+        &self.a
+    }
+
+    /// Each lane's step count `n` (its time is `n h`). Cost: none.
+    pub fn steps(&self) -> &[u64; L] {
+        &self.n
+    }
+}
+
+/// A lane's analysis that failed in [`LaneStepper::run`]: the step and the error (its
+/// state and history are those after the last successful step).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Failure {
+    /// The step that failed (`0`: the start).
+    pub step: u64,
+    /// Its error, as the single analysis reports it.
+    pub error: Error,
+}
+
+/// The lane-batched nonlinear stepper of a [`ShearBuilding`]: `L` analyses with `N`
+/// storeys, in `f32` or `f64`, each lane bit for bit the [`Nonlinear`] stepper built from
+/// the same `h` and settings (see the [module](self)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LaneStepper<T, const N: usize, const L: usize> {
+    single: Nonlinear<T, N>,
+    kin: AemKinematics<T>,
+}
+
+/// Sizes and time step only, as [`Nonlinear`] prints.
+#[cfg(feature = "defmt")]
+impl<T: Real + defmt::Format, const N: usize, const L: usize> defmt::Format
+    for LaneStepper<T, N, L>
+{
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "LaneStepper {{ N: {=usize}, L: {=usize}, h: {} }}",
+            N,
+            L,
+            self.single.time_step()
+        )
+    }
+}
+
+/// The per-lane quantities of one Newton step, `[dof][lane]` unless noted.
+struct Work<T, H, const N: usize, const L: usize> {
+    vh: [[T; L]; N],
+    uh: [[T; L]; N],
+    q: [[T; L]; N],
+    u: [[T; L]; N],
+    v: [[T; L]; N],
+    force: [[T; L]; N],
+    history: [[H; L]; N],
+    /// The tangent's stiffness and damping bands (diagonal, off-diagonal).
+    k_diag: [[T; L]; N],
+    k_off: [[T; L]; N],
+    c_diag: [[T; L]; N],
+    c_off: [[T; L]; N],
+    branch: [u64; L],
+}
+
+impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
+    /// A stepper with time step `h` (s) and Newton settings, as [`Nonlinear::new`].
+    ///
+    /// Errors: as [`Nonlinear::new`]. Cost: O(1).
+    pub fn new(h: f64, settings: NewtonSettings<T>) -> Result<Self, Error> {
+        let single = Nonlinear::new(h, settings)?;
+        // The kinematics exactly as `Nonlinear::new` rounds them.
+        let kin = AemKinematics::new(check_time_step_as(h, T::MAX)?)?.round();
+        Ok(Self { single, kin })
+    }
+
+    /// The single-analysis stepper every lane reproduces. Cost: none.
+    pub fn single(&self) -> &Nonlinear<T, N> {
+        &self.single
+    }
+
+    /// Lane `l`'s load `p = −M ι a_g` for ground accelerations `ag[l]` (m/s²), as
+    /// [`ShearBuilding::ground_load`] forms it. Cost: `N L` multiplications.
+    pub fn ground_loads<Lw: Law<T>>(
+        building: &ShearBuilding<T, Lw, N>,
+        ag: &[T; L],
+    ) -> [[T; L]; N] {
+        let m = building.masses();
+        core::array::from_fn(|i| core::array::from_fn(|l| m[i] * (-ag[l])))
+    }
+
+    /// Advance every lane in `active` by one step under its load `p[dof][lane]`, as
+    /// [`Nonlinear::try_step_with_history`] advances one analysis: each lane's state and
+    /// history are committed only when its step converged to a finite state, and left
+    /// bit-identical otherwise. Lanes outside `active` are not touched.
+    ///
+    /// Returns each lane's report or error ([`LaneReports`]; errors as
+    /// [`Nonlinear::try_step_with_history`]). Cost: see the [module](self).
+    pub fn step<Lw: LaneLaw<T>>(
+        &self,
+        building: &ShearBuilding<T, Lw, N>,
+        state: &mut LaneState<T, N, L>,
+        history: &mut LaneHistory<Lw::History, N, L>,
+        p: &[[T; L]; N],
+        active: [bool; L],
+    ) -> LaneReports<T, L> {
+        if let Some(band) = building.band() {
+            return crate::linalg::wide(|| self.banded(building, band, state, history, p, active));
+        }
+        // A dense-damping building: each active lane by the single step.
+        core::array::from_fn(|l| {
+            if !active[l] {
+                return None;
+            }
+            let mut s = state.lane(l)?;
+            let mut h: [Lw::History; N] = core::array::from_fn(|i| history[i][l]);
+            let pl = SVector::<T, N>::from_fn(|i, _| p[i][l]);
+            let out = self
+                .single
+                .try_step_with_history(building, &mut s, &mut h, &pl);
+            if out.is_ok() {
+                state.set_lane(l, &s);
+                for (i, hi) in h.iter().enumerate() {
+                    history[i][l] = *hi;
+                }
+            }
+            Some(out)
+        })
+    }
+
+    /// The trial of every lane at `(w.u, w.v)` from the committed `history`: `C v` on
+    /// the band, the storeys' forces, histories, branches and tangent bands, in the order
+    /// of [`ShearBuilding`]'s trial.
+    #[inline(always)]
+    fn trial<Lw: LaneLaw<T>>(
+        building: &ShearBuilding<T, Lw, N>,
+        band: &SymTridiagonal<T, N>,
+        history: &LaneHistory<Lw::History, N, L>,
+        w: &mut Work<T, Lw::History, N, L>,
+    ) {
+        band_mul(band, &w.v, &mut w.force);
+        w.c_diag = lanes_of(&band.diagonal);
+        w.c_off = lanes_of(&band.off);
+        w.k_diag = [[T::zero(); L]; N];
+        w.k_off = [[T::zero(); L]; N];
+        w.branch = [0; L];
+        let laws = building.laws();
+        for i in 0..N {
+            // δ_i = u_i − u_{i−1} (δ_0 = u_0), as the building's trial.
+            let (mut d, mut r) = (w.u[i], w.v[i]);
+            if i > 0 {
+                for l in 0..L {
+                    d[l] = w.u[i][l] - w.u[i - 1][l];
+                    r[l] = w.v[i][l] - w.v[i - 1][l];
+                }
+            }
+            let s = laws[i].trial_lanes(&history[i], &d, &r);
+            for l in 0..L {
+                w.force[i][l] += s.force[l];
+                if s.inelastic[l] {
+                    w.branch[l] |= 1 << (i % 64);
+                }
+                w.k_diag[i][l] += s.stiffness[l];
+                w.c_diag[i][l] += s.damping[l];
+            }
+            if i > 0 {
+                for l in 0..L {
+                    w.force[i - 1][l] -= s.force[l];
+                    w.k_diag[i - 1][l] += s.stiffness[l];
+                    w.k_off[i][l] -= s.stiffness[l];
+                    w.c_diag[i - 1][l] += s.damping[l];
+                    w.c_off[i][l] -= s.damping[l];
+                }
+            }
+            w.history[i] = s.history;
+        }
+    }
+
+    /// The banded Newton step of every active lane (see [`LaneStepper::step`]).
+    #[inline(always)]
+    fn banded<Lw: LaneLaw<T>>(
+        &self,
+        building: &ShearBuilding<T, Lw, N>,
+        band: &SymTridiagonal<T, N>,
+        state: &mut LaneState<T, N, L>,
+        history: &mut LaneHistory<Lw::History, N, L>,
+        p: &[[T; L]; N],
+        active: [bool; L],
+    ) -> LaneReports<T, L> {
+        let mut out: LaneReports<T, L> = [None; L];
+        let settings = self.single.settings();
+        let (b, c) = (self.kin.half_h, self.kin.quarter_h2);
+        let (budget, fixed) = match settings.iterations {
+            Iterations::UpTo(k) => (k, false),
+            Iterations::Exactly(k) => (k, true),
+        };
+        let tol = settings.tolerance;
+        let masses = building.masses();
+        let zero_off = [[T::zero(); L]; N];
+        let m_diag: [[T; L]; N] = lanes_of(masses);
+        // A lane still iterating.
+        let mut running = active;
+        let p_size = norm_inf(p);
+        let p_finite = finite(p, 0);
+        for (l, run) in running.iter_mut().enumerate() {
+            if *run && !p_finite[l] {
+                out[l] = Some(Err(Error::NonFiniteInput));
+                *run = false;
+            }
+        }
+        let mut w = Work {
+            vh: [[T::zero(); L]; N],
+            uh: [[T::zero(); L]; N],
+            q: state.a,
+            u: [[T::zero(); L]; N],
+            v: [[T::zero(); L]; N],
+            force: [[T::zero(); L]; N],
+            history: *history,
+            k_diag: [[T::zero(); L]; N],
+            k_off: [[T::zero(); L]; N],
+            c_diag: [[T::zero(); L]; N],
+            c_off: [[T::zero(); L]; N],
+            branch: [0; L],
+        };
+        for i in 0..N {
+            for l in 0..L {
+                (w.vh[i][l], w.uh[i][l]) =
+                    self.kin
+                        .predict(state.u[i][l], state.v[i][l], state.a[i][l]);
+            }
+        }
+        let mut iterations = 0u32;
+        let mut last_delta = [T::zero(); L];
+        let mut branch_changes = [0u32; L];
+        let mut last_branch = [0u64; L];
+        let mut mq = [[T::zero(); L]; N];
+        let mut r = [[T::zero(); L]; N];
+        while running.iter().any(|&x| x) {
+            for i in 0..N {
+                for l in 0..L {
+                    (w.v[i][l], w.u[i][l]) = self.kin.correct(w.vh[i][l], w.uh[i][l], w.q[i][l]);
+                }
+            }
+            Self::trial(building, band, history, &mut w);
+            band_mul_diagonal(&m_diag, &zero_off, &w.q, &mut mq);
+            let f_finite = finite(&w.force, 0);
+            for l in 0..L {
+                if running[l] && !f_finite[l] {
+                    out[l] = Some(Err(Error::NonFiniteForce));
+                    running[l] = false;
+                }
+                if iterations > 0 && w.branch[l] != last_branch[l] {
+                    branch_changes[l] += 1;
+                }
+                last_branch[l] = w.branch[l];
+            }
+            for i in 0..N {
+                for l in 0..L {
+                    r[i][l] = mq[i][l] + w.force[i][l] - p[i][l];
+                }
+            }
+            let residual = relative_residual(&r, &mq, &w.force, &p_size);
+            let correction: [T; L] = if iterations == 0 {
+                [T::zero(); L]
+            } else {
+                let (nq, nu, nv) = (norm_inf(&w.q), norm_inf(&w.u), norm_inf(&w.v));
+                core::array::from_fn(|l| {
+                    let reference = nq[l].max(nu[l] / c).max(nv[l] / b);
+                    if last_delta[l] <= T::zero() {
+                        T::zero()
+                    } else if reference > T::zero() {
+                        last_delta[l] / reference
+                    } else {
+                        T::one()
+                    }
+                })
+            };
+            for l in 0..L {
+                if !running[l] {
+                    continue;
+                }
+                let converged = residual[l] <= tol || (iterations > 0 && correction[l] <= tol);
+                if iterations >= budget || (!fixed && converged) {
+                    running[l] = false;
+                    out[l] = Some(self.commit(state, history, &w, l, converged).map(|()| {
+                        NewtonReport {
+                            iterations,
+                            residual: residual[l],
+                            correction: correction[l],
+                            converged,
+                            branch_changes: branch_changes[l],
+                        }
+                    }));
+                }
+            }
+            if !running.iter().any(|&x| x) {
+                break;
+            }
+            let mut delta = r;
+            for (l, failed) in solve(&w, &m_diag, b, c, &running, &mut delta)
+                .iter()
+                .enumerate()
+            {
+                if let (true, Some(e)) = (running[l], failed) {
+                    out[l] = Some(Err(*e));
+                    running[l] = false;
+                }
+            }
+            for i in 0..N {
+                for l in 0..L {
+                    w.q[i][l] -= delta[i][l];
+                }
+            }
+            last_delta = norm_inf(&delta);
+            iterations += 1;
+        }
+        out
+    }
+
+    /// Commit lane `l`'s last iterate (state `(w.u, w.v, w.q)`, trial history) when it is
+    /// finite and `converged`; else the single step's error, nothing written.
+    fn commit<H: Copy>(
+        &self,
+        state: &mut LaneState<T, N, L>,
+        history: &mut LaneHistory<H, N, L>,
+        w: &Work<T, H, N, L>,
+        l: usize,
+        converged: bool,
+    ) -> Result<(), Error> {
+        let finite =
+            (0..N).all(|i| w.u[i][l].is_finite() && w.v[i][l].is_finite() && w.q[i][l].is_finite());
+        if !finite {
+            return Err(Error::NonFiniteState);
+        }
+        if !converged {
+            return Err(Error::NotConverged);
+        }
+        for i in 0..N {
+            state.u[i][l] = w.u[i][l];
+            state.v[i][l] = w.v[i][l];
+            state.a[i][l] = w.q[i][l];
+            history[i][l] = w.history[i][l];
+        }
+        state.n[l] = state.n[l].wrapping_add(1);
+        Ok(())
+    }
+
+    /// `L` analyses of the building from rest under ground accelerations
+    /// `ground(lane, n)` (m/s², at `t = n h`, asked for `n = 0 ..= steps[lane]`), lane
+    /// `l` for `steps[l]` steps: each started as [`Nonlinear::start_with_history`] from
+    /// the virgin history, then stepped by [`LaneStepper::step`] until its record ends or
+    /// a step fails. `observe(state, stepped)` is called after every step with the lanes
+    /// that stepped in it (their states after the step).
+    ///
+    /// Returns each lane's outcome: `Ok` with the analysis completed, or its
+    /// [`Failure`] (the others went on). Cost: `max(steps)` lane steps.
+    pub fn run<Lw, G, O>(
+        &self,
+        building: &ShearBuilding<T, Lw, N>,
+        steps: [u64; L],
+        mut ground: G,
+        mut observe: O,
+    ) -> [Result<(), Failure>; L]
+    where
+        Lw: LaneLaw<T>,
+        G: FnMut(usize, u64) -> T,
+        O: FnMut(&LaneState<T, N, L>, &[bool; L]),
+    {
+        let mut outcome: [Result<(), Failure>; L] = [Ok(()); L];
+        let zero = SVector::<T, N>::zeros();
+        let virgin = building.initial_history();
+        let mut history: LaneHistory<Lw::History, N, L> = core::array::from_fn(|i| [virgin[i]; L]);
+        let mut state = LaneState {
+            u: [[T::zero(); L]; N],
+            v: [[T::zero(); L]; N],
+            a: [[T::zero(); L]; N],
+            n: [0; L],
+        };
+        for l in 0..L {
+            let p0 = building.ground_load(ground(l, 0));
+            match self
+                .single
+                .start_with_history(building, &zero, &zero, &p0, &virgin)
+            {
+                Ok((s, h)) => {
+                    state.set_lane(l, &s);
+                    for (i, hi) in h.iter().enumerate() {
+                        history[i][l] = *hi;
+                    }
+                }
+                Err(error) => outcome[l] = Err(Failure { step: 0, error }),
+            }
+        }
+        let last = steps.iter().copied().max().unwrap_or(0);
+        for n in 1..=last {
+            let active: [bool; L] = core::array::from_fn(|l| outcome[l].is_ok() && n <= steps[l]);
+            if !active.iter().any(|&a| a) {
+                break;
+            }
+            let ag: [T; L] =
+                core::array::from_fn(|l| if active[l] { ground(l, n) } else { T::zero() });
+            let p = Self::ground_loads(building, &ag);
+            let reports = self.step(building, &mut state, &mut history, &p, active);
+            for (l, report) in reports.iter().enumerate() {
+                if let Some(Err(error)) = report {
+                    outcome[l] = Err(Failure {
+                        step: n,
+                        error: *error,
+                    });
+                }
+            }
+            let stepped: [bool; L] = core::array::from_fn(|l| matches!(reports[l], Some(Ok(_))));
+            observe(&state, &stepped);
+        }
+        outcome
+    }
+}
+
+/// The Newton correction `r ← J⁻¹ r` of every lane, `J = M + b ∂F/∂v + c ∂F/∂u` on the
+/// bands of the last trial, as the single step forms and solves it: `L D Lᵀ`, and pivoted
+/// LU of the same `J` in a lane where that declines. Returns each lane's error
+/// ([`Error::NonFiniteForce`] for a tangent entry, [`Error::SingularJacobian`]).
+#[inline(always)]
+fn solve<T: Real, H, const N: usize, const L: usize>(
+    w: &Work<T, H, N, L>,
+    m_diag: &[[T; L]; N],
+    b: T,
+    c: T,
+    running: &[bool; L],
+    r: &mut [[T; L]; N],
+) -> [Option<Error>; L] {
+    let mut failed = [None; L];
+    let [kd, cd, ko, co] = [
+        finite(&w.k_diag, 0),
+        finite(&w.c_diag, 0),
+        finite(&w.k_off, 1),
+        finite(&w.c_off, 1),
+    ];
+    for (l, f) in failed.iter_mut().enumerate() {
+        if !(kd[l] && cd[l] && ko[l] && co[l]) {
+            *f = Some(Error::NonFiniteForce);
+        }
+    }
+    // J and its scale, term by term as the single step (`M` has no off-diagonal).
+    let mut scale = [T::zero(); L];
+    let mut j_diag = [[T::zero(); L]; N];
+    let mut j_off = [[T::zero(); L]; N];
+    for i in 0..N {
+        for l in 0..L {
+            let (m, d, k) = (m_diag[i][l], w.c_diag[i][l], w.k_diag[i][l]);
+            j_diag[i][l] = m + b * d + c * k;
+            scale[l] = scale[l].max(m.abs() + b * d.abs() + c * k.abs());
+        }
+        if i > 0 {
+            for l in 0..L {
+                let (m, d, k) = (T::zero(), w.c_off[i][l], w.k_off[i][l]);
+                j_off[i][l] = m + b * d + c * k;
+                scale[l] = scale[l].max(m.abs() + b * d.abs() + c * k.abs());
+            }
+        }
+    }
+    let rhs = *r;
+    let positive = solve_positive(&j_diag, &j_off, r, &scale);
+    for l in 0..L {
+        if positive[l] || failed[l].is_some() || !running[l] {
+            continue;
+        }
+        // Not positive definite in this lane: pivot, on the same J.
+        let j = SymTridiagonal::<T, N> {
+            diagonal: SVector::from_fn(|i, _| j_diag[i][l]),
+            off: SVector::from_fn(|i, _| j_off[i][l]),
+        };
+        let mut x = SVector::<T, N>::from_fn(|i, _| rhs[i][l]);
+        if solve_in_place(&mut j.to_matrix(), &mut x, scale[l]) {
+            for i in 0..N {
+                r[i][l] = x[i];
+            }
+        } else {
+            failed[l] = Some(Error::SingularJacobian);
+        }
+    }
+    failed
+}
+
+/// `A x = b` in place for the symmetric tridiagonal `A` of every lane (diagonal `d`,
+/// off-diagonal `e`), by `L D Lᵀ` exactly as the single step's solve; a lane whose pivot
+/// is not finite or not above `N·ε·scale` is reported `false` (its `b` unspecified).
+#[inline(always)]
+fn solve_positive<T: Real, const N: usize, const L: usize>(
+    d: &[[T; L]; N],
+    e: &[[T; L]; N],
+    x: &mut [[T; L]; N],
+    scale: &[T; L],
+) -> [bool; L] {
+    let n_eps = T::from_f64_rounded(N as f64) * T::default_epsilon();
+    let tiny: [T; L] = core::array::from_fn(|l| n_eps * scale[l]);
+    let mut accepted = [true; L];
+    let mut inv = [[T::zero(); L]; N];
+    let mut prev = [T::zero(); L];
+    for i in 0..N {
+        for l in 0..L {
+            let li = e[i][l] * prev[l];
+            let di = if i == 0 {
+                d[0][l]
+            } else {
+                d[i][l] - li * e[i][l]
+            };
+            accepted[l] &= di > tiny[l] && di.is_finite();
+            if i > 0 {
+                x[i][l] -= li * x[i - 1][l];
+            }
+            prev[l] = T::one() / di;
+            inv[i][l] = prev[l];
+        }
+    }
+    for i in (0..N).rev() {
+        for l in 0..L {
+            let upper = if i + 1 < N {
+                e[i + 1][l] * x[i + 1][l]
+            } else {
+                T::zero()
+            };
+            x[i][l] = (x[i][l] - upper) * inv[i][l];
+        }
+    }
+    accepted
+}
+
+/// Each lane's entries from DOF `from` on are all finite.
+#[inline(always)]
+fn finite<T: Real, const N: usize, const L: usize>(x: &[[T; L]; N], from: usize) -> [bool; L] {
+    let mut ok = [true; L];
+    for row in x.iter().skip(from) {
+        for l in 0..L {
+            ok[l] &= row[l].is_finite();
+        }
+    }
+    ok
+}
+
+/// A vector's entries, each repeated in every lane.
+#[inline(always)]
+fn lanes_of<T: Real, const N: usize, const L: usize>(x: &SVector<T, N>) -> [[T; L]; N] {
+    core::array::from_fn(|i| [x[i]; L])
+}
+
+/// `y = A x` in every lane for the band `A`, as [`SymTridiagonal::mul`].
+#[inline(always)]
+fn band_mul<T: Real, const N: usize, const L: usize>(
+    a: &SymTridiagonal<T, N>,
+    x: &[[T; L]; N],
+    y: &mut [[T; L]; N],
+) {
+    band_mul_diagonal(&lanes_of(&a.diagonal), &lanes_of(&a.off), x, y);
+}
+
+/// `y = A x` in every lane, `A` symmetric tridiagonal with diagonal `d[i][lane]` and
+/// off-diagonal `e[i][lane]`, each row summed in column order as [`SymTridiagonal::mul`].
+#[inline(always)]
+fn band_mul_diagonal<T: Real, const N: usize, const L: usize>(
+    d: &[[T; L]; N],
+    e: &[[T; L]; N],
+    x: &[[T; L]; N],
+    y: &mut [[T; L]; N],
+) {
+    for i in 0..N {
+        for l in 0..L {
+            let mut s = T::zero();
+            if i > 0 {
+                s = e[i][l] * x[i - 1][l];
+            }
+            s += d[i][l] * x[i][l];
+            if i + 1 < N {
+                s += e[i + 1][l] * x[i + 1][l];
+            }
+            y[i][l] = s;
+        }
+    }
+}
+
+/// `‖x‖∞` of every lane, folded from zero in DOF order with `max` as the single step.
+#[inline(always)]
+fn norm_inf<T: Real, const N: usize, const L: usize>(x: &[[T; L]; N]) -> [T; L] {
+    let mut s = [T::zero(); L];
+    for row in x {
+        for l in 0..L {
+            s[l] = s[l].max(row[l].abs());
+        }
+    }
+    s
+}
+
+/// `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` of every lane, `0` where the denominator is zero.
+#[inline(always)]
+fn relative_residual<T: Real, const N: usize, const L: usize>(
+    r: &[[T; L]; N],
+    mq: &[[T; L]; N],
+    f: &[[T; L]; N],
+    p_size: &[T; L],
+) -> [T; L] {
+    let (nr, nm, nf) = (norm_inf(r), norm_inf(mq), norm_inf(f));
+    core::array::from_fn(|l| {
+        let scale = nm[l].max(nf[l]).max(p_size[l]);
+        if scale > T::zero() {
+            nr[l] / scale
+        } else {
+            T::zero()
+        }
+    })
+}
