@@ -178,12 +178,16 @@ fn wide_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
     out: &mut [T],
 ) {
     let (flat, xf) = (ops.as_flattened().as_flattened(), x.as_flattened());
-    wide_blocks_flat::<T, W>(flat, N, K, from, xf, out);
+    // `N`, `K` written in the closure: constants inside the AVX-compiled function too.
+    avx_if_large(K * N * N * core::mem::size_of::<T>(), || {
+        column_blocks_flat::<T, W>(flat, N, K, from, xf, out)
+    });
 }
 
 /// [`wide_blocks`] on the flat storage of `n` rows of `k` blocks (`flat`: `k·n²` values,
-/// `xf`: `k·n`): the one body of the const-generic product (inlined with `n`, `k`
-/// constants, so its code is that of constant sizes) and of the run-time-sized one.
+/// `xf`: `k·n`), sizes known at run time: the run-time-sized operators' product, the same
+/// body ([`column_blocks_flat`]) as the const-generic one.
+#[cfg(feature = "std")]
 #[inline(always)]
 pub(crate) fn wide_blocks_flat<T: Real, const W: usize>(
     flat: &[T],
@@ -193,11 +197,21 @@ pub(crate) fn wide_blocks_flat<T: Real, const W: usize>(
     xf: &[T],
     out: &mut [T],
 ) {
+    avx_if_large(k * n * n * core::mem::size_of::<T>(), || {
+        column_blocks_flat::<T, W>(flat, n, k, from, xf, out)
+    });
+}
+
+/// Run `f` through the run-time AVX choice ([`super::wide`]) if the operator holds at
+/// least [`MIN_BYTES`](super::avx::MIN_BYTES) `bytes` (x86-64), else inline.
+#[inline(always)]
+fn avx_if_large(bytes: usize, f: impl FnOnce()) {
     #[cfg(target_arch = "x86_64")]
-    if k * n * n * core::mem::size_of::<T>() >= super::avx::MIN_BYTES {
-        return super::wide(|| column_blocks_flat::<T, W>(flat, n, k, from, xf, out));
+    if bytes >= super::avx::MIN_BYTES {
+        return super::wide(f);
     }
-    column_blocks_flat::<T, W>(flat, n, k, from, xf, out);
+    let _ = bytes;
+    f();
 }
 
 /// Rows in the row layout times `x` (blocks `from..K`): a single row first if their number
