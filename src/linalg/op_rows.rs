@@ -178,10 +178,13 @@ fn wide_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
     out: &mut [T],
 ) {
     let (flat, xf) = (ops.as_flattened().as_flattened(), x.as_flattened());
-    // `N`, `K` written in the closure: constants inside the AVX-compiled function too.
-    avx_if_large(K * N * N * core::mem::size_of::<T>(), || {
-        column_blocks_flat::<T, W>(flat, N, K, from, xf, out)
-    });
+    // `N`, `K` written in the closure (constants inside the AVX-compiled function too),
+    // and the small sizes' product called directly (inlined, unrolled for the size).
+    #[cfg(target_arch = "x86_64")]
+    if K * N * N * core::mem::size_of::<T>() >= super::avx::MIN_BYTES {
+        return super::wide(|| column_blocks_flat::<T, W>(flat, N, K, from, xf, out));
+    }
+    column_blocks_flat::<T, W>(flat, N, K, from, xf, out);
 }
 
 /// [`wide_blocks`] on the flat storage of `n` rows of `k` blocks (`flat`: `k·n²` values,
@@ -197,21 +200,17 @@ pub(crate) fn wide_blocks_flat<T: Real, const W: usize>(
     xf: &[T],
     out: &mut [T],
 ) {
-    avx_if_large(k * n * n * core::mem::size_of::<T>(), || {
-        column_blocks_flat::<T, W>(flat, n, k, from, xf, out)
-    });
-}
-
-/// Run `f` through the run-time AVX choice ([`super::wide`]) if the operator holds at
-/// least [`MIN_BYTES`](super::avx::MIN_BYTES) `bytes` (x86-64), else inline.
-#[inline(always)]
-fn avx_if_large(bytes: usize, f: impl FnOnce()) {
+    // Through the run-time AVX choice from the same size on as the const-generic product.
     #[cfg(target_arch = "x86_64")]
-    if bytes >= super::avx::MIN_BYTES {
-        return super::wide(f);
+    let large = k * n * n * core::mem::size_of::<T>() >= super::avx::MIN_BYTES;
+    #[cfg(not(target_arch = "x86_64"))]
+    let large = false;
+    let mut product = || column_blocks_flat::<T, W>(flat, n, k, from, xf, out);
+    if large {
+        super::wide(product)
+    } else {
+        product()
     }
-    let _ = bytes;
-    f();
 }
 
 /// Rows in the row layout times `x` (blocks `from..K`): a single row first if their number
