@@ -8,9 +8,12 @@
 use nalgebra::SVector;
 
 use crate::kinematics::{AemKinematics, Kinematics, NewmarkKinematics, check_time_step_as};
-use crate::linalg::lu::{Lu, condition, row_scales};
+use crate::linalg::lu::{Lu, condition_flat, factor, row_scales_flat, solve_flat};
 use crate::linalg::op_rows::OpRows;
-use crate::linalg::{Mat, add_scaled, all_finite, first_error, fits, round_rows, rows_f64};
+use crate::linalg::{
+    Mat, add_scaled_flat, all_finite, all_finite_flat, copy_flat, first_error, fits_flat, identity,
+    round_rows, rows_f64,
+};
 use crate::scalar::initial_inputs_finite;
 use crate::{Error, Param, Real, State};
 
@@ -27,7 +30,7 @@ pub(crate) struct Kernel<T, const N: usize, K> {
     /// [`AemKinematics`] or [`NewmarkKinematics`].
     pub kin: K,
     pub start: Option<StartOps<T, N>>,
-    /// `κ₁` of the row-equilibrated effective matrix ([`condition`]).
+    /// `κ₁` of the row-equilibrated effective matrix ([`condition_flat`]).
     pub condition: f64,
 }
 
@@ -351,13 +354,18 @@ pub(crate) fn mat_vec<T: Real, const R: usize, const C: usize>(
     a: &[[T; C]; R],
     x: &SVector<T, C>,
 ) -> SVector<T, R> {
-    SVector::from_fn(|i, _| {
-        let mut s = T::zero();
-        for j in 0..C {
-            s += a[i][j] * x[j];
-        }
-        s
-    })
+    SVector::from_fn(|i, _| dot(&a[i], x.as_slice()))
+}
+
+/// `Σ a_j x_j`, from zero, in index order (over the common length): one row of
+/// [`mat_vec`], and of the run-time-sized start (`std`). `len` multiply-adds.
+#[inline(always)]
+pub(crate) fn dot<T: Real>(a: &[T], x: &[T]) -> T {
+    let mut s = T::zero();
+    for (&a, &x) in a.iter().zip(x) {
+        s += a * x;
+    }
+    s
 }
 
 /// Row `i`: `[s_0 A_0[i], …, s_{K−1} A_{K−1}[i]]` (e.g. `[G[i], −GC[i], −GK[i]]`), in the
@@ -400,24 +408,124 @@ pub(crate) const fn start_operators<const N: usize>(
     k: &Mat<N, N>,
     max: f64,
 ) -> Result<Option<(Lu<N>, StartOps<f64, N>)>, Error> {
-    let lu = match Lu::new(m, &row_scales(m)) {
-        Some(lu) => lu,
-        None => return Ok(None),
-    };
-    let s = StartOps {
-        minv: lu.inverse(),
-        minv_c: lu.solve(c),
-        minv_k: lu.solve(k),
-    };
+    let mut arrays = StartArrays::<N>::new();
+    let ident = identity::<N>();
+    match start_operators_flat(
+        &Terms::of(m, c, k),
+        ident.as_flattened(),
+        max,
+        &mut arrays.buffers(),
+    ) {
+        Ok(regular) => Ok(arrays.finish(regular)),
+        Err(e) => Err(e),
+    }
+}
+
+/// The arrays of one factorization of a const-generic build, lent as [`Factored`].
+pub(crate) struct FactorArrays<const N: usize> {
+    a: Mat<N, N>,
+    lu: Mat<N, N>,
+    scales: [f64; N],
+    pivot_scales: [f64; N],
+    perm: [usize; N],
+}
+
+impl<const N: usize> FactorArrays<N> {
+    const fn new() -> Self {
+        Self {
+            a: [[0.0; N]; N],
+            lu: [[0.0; N]; N],
+            scales: [0.0; N],
+            pivot_scales: [0.0; N],
+            perm: [0; N],
+        }
+    }
+
+    const fn factored(&mut self) -> Factored<'_> {
+        Factored {
+            a: self.a.as_flattened_mut(),
+            scales: &mut self.scales,
+            lu: self.lu.as_flattened_mut(),
+            pivot_scales: &mut self.pivot_scales,
+            perm: &mut self.perm,
+        }
+    }
+}
+
+/// The arrays of [`start_operators`], lent as [`StartBuffers`].
+pub(crate) struct StartArrays<const N: usize> {
+    f: FactorArrays<N>,
+    ops: StartOps<f64, N>,
+}
+
+impl<const N: usize> StartArrays<N> {
+    const fn new() -> Self {
+        let z = [[0.0; N]; N];
+        Self {
+            f: FactorArrays::new(),
+            ops: StartOps {
+                minv: z,
+                minv_c: z,
+                minv_k: z,
+            },
+        }
+    }
+
+    const fn buffers(&mut self) -> StartBuffers<'_> {
+        StartBuffers {
+            f: self.f.factored(),
+            minv: self.ops.minv.as_flattened_mut(),
+            minv_c: self.ops.minv_c.as_flattened_mut(),
+            minv_k: self.ops.minv_k.as_flattened_mut(),
+        }
+    }
+
+    /// The factorization of `M` and the operators, if `M` is `regular`.
+    const fn finish(self, regular: bool) -> Option<(Lu<N>, StartOps<f64, N>)> {
+        if regular {
+            Some((Lu::from_parts(self.f.lu, self.f.perm), self.ops))
+        } else {
+            None
+        }
+    }
+}
+
+/// The output buffers of [`start_operators_flat`]: the factorization of `M` and the
+/// row-major `n×n` `M⁻¹`, `M⁻¹C`, `M⁻¹K`.
+pub(crate) struct StartBuffers<'a> {
+    pub f: Factored<'a>,
+    pub minv: &'a mut [f64],
+    pub minv_c: &'a mut [f64],
+    pub minv_k: &'a mut [f64],
+}
+
+/// [`start_operators`] into the buffers `b` (`ident`: the `n×n` identity): the one
+/// start-up build of both sizes. `Ok(false)` when `M` is singular to working precision.
+/// Errors: as [`start_operators`].
+pub(crate) const fn start_operators_flat(
+    t: &Terms<'_>,
+    ident: &[f64],
+    max: f64,
+    b: &mut StartBuffers<'_>,
+) -> Result<bool, Error> {
+    let n = b.f.perm.len();
+    copy_flat(b.f.a, t.m);
+    row_scales_flat(t.m, b.f.scales);
+    if !b.f.factor() {
+        return Ok(false);
+    }
+    b.f.solve(ident, n, b.minv);
+    b.f.solve(t.c, n, b.minv_c);
+    b.f.solve(t.k, n, b.minv_k);
     // Overflow anywhere before underflow anywhere (the same verdict whatever the order).
     let fit = [
-        fits(&s.minv, m, max),
-        fits(&s.minv_c, c, max),
-        fits(&s.minv_k, k, max),
+        fits_flat(b.minv, t.m, max),
+        fits_flat(b.minv_c, t.c, max),
+        fits_flat(b.minv_k, t.k, max),
     ];
     match first_error(fit) {
         Some(e) => Err(e),
-        None => Ok(Some((lu, s))),
+        None => Ok(true),
     }
 }
 
@@ -432,7 +540,7 @@ pub(crate) struct KernelOps<const N: usize> {
     pub aem: AemKinematics<f64>,
     /// The factorization of `M_eff`, for further solves (e.g. `G B`).
     pub lu: Lu<N>,
-    /// `κ₁` of the row-equilibrated `M_eff` ([`condition`]).
+    /// `κ₁` of the row-equilibrated `M_eff` ([`condition_flat`]).
     pub condition: f64,
     /// The factorization of `M` (if regular) and the start-up operators.
     pub start: Option<(Lu<N>, StartOps<f64, N>)>,
@@ -449,11 +557,42 @@ pub(crate) const fn terms_scales<const N: usize>(
     wk: f64,
 ) -> [f64; N] {
     let mut s = [0.0f64; N];
+    terms_scales_flat(&Terms::of(m, c, k), wc, wk, &mut s);
+    s
+}
+
+/// Row-major `n×n` `M, C, K` as flat slices: the data of an operator build of any size.
+pub(crate) struct Terms<'a> {
+    pub m: &'a [f64],
+    pub c: &'a [f64],
+    pub k: &'a [f64],
+}
+
+impl<'a> Terms<'a> {
+    /// The const-generic arrays, flattened.
+    pub(crate) const fn of<const N: usize>(
+        m: &'a Mat<N, N>,
+        c: &'a Mat<N, N>,
+        k: &'a Mat<N, N>,
+    ) -> Self {
+        Self {
+            m: m.as_flattened(),
+            c: c.as_flattened(),
+            k: k.as_flattened(),
+        }
+    }
+}
+
+/// [`terms_scales`] into `s` (`n = s.len()`): the one loop both sizes use.
+pub(crate) const fn terms_scales_flat(t: &Terms<'_>, wc: f64, wk: f64, s: &mut [f64]) {
+    let n = s.len();
     let mut i = 0;
-    while i < N {
+    while i < n {
+        s[i] = 0.0;
         let mut j = 0;
-        while j < N {
-            let t = m[i][j].abs() + wc.abs() * c[i][j].abs() + wk.abs() * k[i][j].abs();
+        while j < n {
+            let x = i * n + j;
+            let t = t.m[x].abs() + wc.abs() * t.c[x].abs() + wk.abs() * t.k[x].abs();
             if t > s[i] {
                 s[i] = t;
             }
@@ -461,7 +600,6 @@ pub(crate) const fn terms_scales<const N: usize>(
         }
         i += 1;
     }
-    s
 }
 
 /// The range verdict of an operator build: the [`fits`] checks of its operators `fit` and
@@ -496,14 +634,59 @@ pub(crate) const fn effective_lu<const N: usize>(
     wc: f64,
     wk: f64,
 ) -> Result<(Mat<N, N>, [f64; N], Lu<N>), Error> {
-    let meff = add_scaled(&add_scaled(m, wc, c), wk, k);
-    if !all_finite(&meff) {
+    let mut f = FactorArrays::<N>::new();
+    match effective_lu_flat(&Terms::of(m, c, k), wc, wk, &mut f.factored()) {
+        Ok(()) => Ok((f.a, f.scales, Lu::from_parts(f.lu, f.perm))),
+        Err(e) => Err(e),
+    }
+}
+
+/// A row-major `n×n` matrix (`a`), the row scales of its terms, and its factorization
+/// ([`factor`]: `lu`, the permuted scales, `perm`): the output buffers of one
+/// factorization of an operator build of any size (`n = perm.len()`).
+pub(crate) struct Factored<'a> {
+    pub a: &'a mut [f64],
+    pub scales: &'a mut [f64],
+    pub lu: &'a mut [f64],
+    pub pivot_scales: &'a mut [f64],
+    pub perm: &'a mut [usize],
+}
+
+impl Factored<'_> {
+    /// Factorize `a` with `scales` into `lu` ([`factor`]); `false` if singular to working
+    /// precision.
+    const fn factor(&mut self) -> bool {
+        copy_flat(self.lu, self.a);
+        copy_flat(self.pivot_scales, self.scales);
+        factor(self.lu, self.perm.len(), self.pivot_scales, self.perm)
+    }
+
+    /// `x = A⁻¹ B` (`B` row-major `n×c`) by the factors ([`solve_flat`]).
+    const fn solve(&self, b: &[f64], c: usize, x: &mut [f64]) {
+        solve_flat(self.lu, self.perm, b, c, x);
+    }
+}
+
+/// [`effective_lu`] into the buffers `f` (`n = f.perm.len()`): the one effective-matrix
+/// build of both sizes. Errors: as [`effective_lu`].
+pub(crate) const fn effective_lu_flat(
+    t: &Terms<'_>,
+    wc: f64,
+    wk: f64,
+    f: &mut Factored<'_>,
+) -> Result<(), Error> {
+    // (M + wc C) + wk K, entry by entry.
+    copy_flat(f.a, t.m);
+    add_scaled_flat(f.a, wc, t.c);
+    add_scaled_flat(f.a, wk, t.k);
+    if !all_finite_flat(f.a) {
         return Err(Error::OperatorOverflow);
     }
-    let scales = terms_scales(m, c, k, wc, wk);
-    match Lu::new(&meff, &scales) {
-        Some(lu) => Ok((meff, scales, lu)),
-        None => Err(Error::SingularEffectiveMatrix),
+    terms_scales_flat(t, wc, wk, f.scales);
+    if f.factor() {
+        Ok(())
+    } else {
+        Err(Error::SingularEffectiveMatrix)
     }
 }
 
@@ -524,7 +707,75 @@ pub(crate) const fn newmark_operators<const N: usize>(
     gamma: f64,
     max: f64,
 ) -> Result<KernelOps<N>, Error> {
-    if !(all_finite(m) && all_finite(c) && all_finite(k)) {
+    let z = [[0.0; N]; N];
+    let (mut eff, mut g, mut gc, mut gk) = (FactorArrays::<N>::new(), z, z, z);
+    let mut start = StartArrays::<N>::new();
+    let ident = identity::<N>();
+    let mut b = Buffers {
+        eff: eff.factored(),
+        g: g.as_flattened_mut(),
+        gc: gc.as_flattened_mut(),
+        gk: gk.as_flattened_mut(),
+        start: start.buffers(),
+    };
+    let built = match newmark_operators_flat(
+        &Terms::of(m, c, k),
+        ident.as_flattened(),
+        h,
+        beta,
+        gamma,
+        max,
+        &mut b,
+    ) {
+        Ok(built) => built,
+        Err(e) => return Err(e),
+    };
+    Ok(KernelOps {
+        g,
+        gc,
+        gk,
+        kin: built.kin,
+        aem: built.aem,
+        lu: Lu::from_parts(eff.lu, eff.perm),
+        condition: built.condition,
+        start: start.finish(built.start),
+    })
+}
+
+/// The output buffers of [`newmark_operators_flat`] (row-major, `n×n` unless said): the
+/// effective matrix and its factorization, `G`, `GC`, `GK`, and the start-up operators.
+pub(crate) struct Buffers<'a> {
+    pub eff: Factored<'a>,
+    pub g: &'a mut [f64],
+    pub gc: &'a mut [f64],
+    pub gk: &'a mut [f64],
+    pub start: StartBuffers<'a>,
+}
+
+/// What [`newmark_operators_flat`] returns besides its buffers.
+pub(crate) struct Built {
+    pub kin: NewmarkKinematics<f64>,
+    pub aem: AemKinematics<f64>,
+    /// `κ₁` of the row-equilibrated `M_eff` ([`condition_flat`]).
+    pub condition: f64,
+    /// `M` is regular: the start-up operators are in the buffers.
+    pub start: bool,
+}
+
+/// [`newmark_operators`] into the buffers `b` (`n = b.eff.perm.len()`, `ident` the `n×n`
+/// identity): the one build of the Newmark-family operators, for the const-generic
+/// kernels and, behind `std`, the run-time-sized one. Same checks, in the same order, and
+/// the same arithmetic whatever the size. Errors: as [`newmark_operators`].
+pub(crate) const fn newmark_operators_flat(
+    t: &Terms<'_>,
+    ident: &[f64],
+    h: f64,
+    beta: f64,
+    gamma: f64,
+    max: f64,
+    b: &mut Buffers<'_>,
+) -> Result<Built, Error> {
+    if !(all_finite_flat(t.m) && all_finite_flat(t.c) && all_finite_flat(t.k)) {
         return Err(Error::NonFiniteInput);
     }
     if !(beta.is_finite() && gamma.is_finite() && beta >= 0.0 && gamma >= 0.0) {
@@ -542,28 +793,30 @@ pub(crate) const fn newmark_operators<const N: usize>(
     if let Err(e) = check_time_step_as(h, max) {
         return Err(e);
     }
-    let (meff, scales, lu) = match effective_lu(m, c, k, kin.gamma_h, kin.beta_h2) {
-        Ok(e) => e,
-        Err(e) => return Err(e),
-    };
-    let (g, gc, gk) = (lu.inverse(), lu.solve(c), lu.solve(k));
-    let fit = [fits(&g, &meff, max), fits(&gc, c, max), fits(&gk, k, max)];
+    if let Err(e) = effective_lu_flat(t, kin.gamma_h, kin.beta_h2, &mut b.eff) {
+        return Err(e);
+    }
+    let n = b.eff.perm.len();
+    b.eff.solve(ident, n, b.g);
+    b.eff.solve(t.c, n, b.gc);
+    b.eff.solve(t.k, n, b.gk);
+    let fit = [
+        fits_flat(b.g, b.eff.a, max),
+        fits_flat(b.gc, t.c, max),
+        fits_flat(b.gk, t.k, max),
+    ];
     // Overflow (of an operator or of a kinematic coefficient) before underflow.
     if let Err(e) = range_verdict(fit, kin.fits(max)) {
         return Err(e);
     }
-    let start = match start_operators(m, c, k, max) {
+    let start = match start_operators_flat(t, ident, max, &mut b.start) {
         Ok(s) => s,
         Err(e) => return Err(e),
     };
-    Ok(KernelOps {
-        g,
-        gc,
-        gk,
+    Ok(Built {
         kin,
         aem,
-        lu,
-        condition: condition(&meff, &g, &scales),
+        condition: condition_flat(b.eff.a, b.g, b.eff.scales),
         start,
     })
 }

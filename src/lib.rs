@@ -222,6 +222,14 @@ pub use macros::rows_to_columns as __rows_to_columns;
 #[cfg_attr(docsrs, doc(cfg(feature = "std")))]
 pub mod batch;
 
+// Models of any size, with the number of degrees of freedom chosen at run time (host only).
+#[cfg(feature = "std")]
+#[cfg_attr(docsrs, doc(cfg(feature = "std")))]
+pub mod dynamic;
+#[cfg(feature = "std")]
+#[cfg_attr(docsrs, doc(cfg(feature = "std")))]
+pub use dynamic::{DynLinear, DynState};
+
 // Incremental dynamic analysis over a suite of records on the batch pool (host only).
 #[cfg(feature = "std")]
 #[cfg_attr(docsrs, doc(cfg(feature = "std")))]

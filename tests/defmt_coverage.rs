@@ -34,6 +34,8 @@ const SKIP: &[(&str, &str)] = &[
     ("Point", "std only"),
     ("Fractiles", "std only"),
     ("Curve", "std only"),
+    ("DynLinear", "std only"),
+    ("DynState", "std only"),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

@@ -188,7 +188,8 @@ def linear_response(
 ) -> LinearResponse:
     """Step ``M u'' + C u' + K u = p(t)`` over a record; one interface for every scheme.
 
-    ``m``, ``c``, ``k``: ``n×n`` mass (kg), damping (N·s/m), stiffness (N/m). ``h``: time
+    ``m``, ``c``, ``k``: ``n×n`` mass (kg), damping (N·s/m), stiffness (N/m) (``n`` in
+    ``SIZES``, or any ``n ≥ 1`` with ``scheme="aem"``). ``h``: time
     step (s). Loads either ``p`` (N, ``steps×n``, row ``i`` at ``t = i·h``) or
     ``ground_acceleration`` (m/s², length ``steps``) with ``influence`` ``ι`` (default all
     ones): ``p = −M ι a_g``, ``u`` then relative to the ground. ``u0``, ``v0``: initial

@@ -8,8 +8,9 @@
 //! kg, N, ground accelerations in m/s².
 //!
 //! **Sizes.** The library's sizes are const generics. Structures (`n` degrees of freedom,
-//! storeys) are dispatched over [`SIZES`] (1 to 10, 12, 15, 20); any other `n` raises
-//! `UnsupportedSize`. Spectra take any number of periods: they are stepped in banks of
+//! storeys) are dispatched over [`SIZES`] (1 to 10, 12, 15, 20); `linear_response` with
+//! the AEM takes any other `n` on the run-time-sized `DynLinear` (bit-identical where both
+//! serve), other `n` elsewhere raise `UnsupportedSize`. Spectra take any number of periods: they are stepped in banks of
 //! [`CHUNK`] oscillators, the last bank padded with copies of the longest period. Observers
 //! take 1 to [`MAX_SENSORS`] sensors.
 //!
@@ -24,13 +25,13 @@
 //! built by `laws.rs`) over many records and intensities; `records.rs` reads records.
 
 use aemstep::hysteresis::{EnergyAccount, HistoryModel, Law, ShearBuilding};
-use aemstep::nalgebra::{SMatrix, SVector};
+use aemstep::nalgebra::{DMatrix, SMatrix, SVector};
 use aemstep::observer::{Kalman, Observer, Outputs, StateSpace, SteadyState};
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
 use aemstep::spectrum::{Bank, RotD, Scheme, Substeps};
 use aemstep::{
-    Damping, Error, Exact, GeneralizedAlpha, Linear, Modal, Newmark, NewtonSettings, Nonlinear,
-    Stepper, batch,
+    Damping, DynLinear, DynState, Error, Exact, GeneralizedAlpha, Linear, Modal, Newmark,
+    NewtonSettings, Nonlinear, Stepper, batch,
 };
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -211,8 +212,17 @@ fn shape<T>(msg: String) -> Res<T> {
     Err(Fail::Shape(msg))
 }
 
-/// Call `$f::<N, 2N>(args…)` for the run-time size `$n`, or fail with `UnsupportedSize`.
+/// Call `$f::<N, 2N>(args…)` for the run-time size `$n`, or fail with `UnsupportedSize`;
+/// with `else $g(args…)`, sizes outside [`SIZES`] go to `$g` (the run-time-sized path)
+/// instead. The compiled sizes stay: their steps are unrolled for the size.
 macro_rules! by_size {
+    ($n:expr, $f:ident ( $($arg:expr),* $(,)? ) else $g:ident ( $($garg:expr),* $(,)? )) => {
+        if SIZES.contains(&$n) {
+            by_size!($n, $f($($arg),*))
+        } else {
+            $g($($garg),*)
+        }
+    };
     ($n:expr, $f:ident ( $($arg:expr),* $(,)? )) => {
         match $n {
             1 => $f::<1, 2>($($arg),*),
@@ -528,6 +538,35 @@ fn linear_n<const N: usize, const S: usize>(job: &LinearJob, stop: &AtomicBool) 
     }
 }
 
+/// [`linear_n`] at a size outside [`SIZES`]: the AEM on [`DynLinear`], the const-generic
+/// `Linear` sized at run time (bit-identical to it where both serve); the other schemes
+/// are compiled for [`SIZES`] only.
+fn linear_any(job: &LinearJob, n: usize, stop: &AtomicBool) -> Res<Histories> {
+    if n == 0 || !matches!(job.scheme, LinearScheme::Aem) {
+        return Err(Fail::Size(format!(
+            "{n} degrees of freedom: scheme \"aem\" takes any n, the other schemes n in {SIZES:?}"
+        )));
+    }
+    let dm = |a: &[f64]| DMatrix::from_row_slice(n, n, a);
+    let sys = DynLinear::<f64>::new(&dm(&job.m), &dm(&job.c), &dm(&job.k), job.h)?;
+    let steps = job.p.len() / n;
+    let load = |s: usize| &job.p[s * n..(s + 1) * n];
+    let (mut u, mut v, mut a) = (buffer(steps, n)?, buffer(steps, n)?, buffer(steps, n)?);
+    let mut keep = |s: &DynState<f64>| {
+        u.extend_from_slice(s.u());
+        v.extend_from_slice(s.v());
+        a.extend_from_slice(s.a());
+    };
+    let mut s = sys.start(&job.u0, &job.v0, load(0)).map_err(at(0))?;
+    keep(&s);
+    for i in 1..steps {
+        stopped(stop, i)?;
+        sys.try_step(&mut s, load(i)).map_err(at(i))?;
+        keep(&s);
+    }
+    Ok((u, v, a))
+}
+
 /// The `R` lowest modes of the job's model, the loads as `N` inputs (`B = I`), the DOFs as
 /// outputs; the full state rebuilt from the modes at every step.
 fn modal_run<const N: usize, const R: usize>(job: &LinearJob, stop: &AtomicBool) -> Res<Histories> {
@@ -623,9 +662,11 @@ fn linear_response<'py>(
         Ok((job, n))
     };
     let (job, n) = run().map_err(|f| f.raise(py))?;
-    let (u, v, a) = interruptible(py, work_units(job.p.len() / n.max(1), n, 2), |stop| {
-        by_size!(n, linear_n(&job, stop))
-    })?;
+    let (u, v, a) = interruptible(
+        py,
+        work_units(job.p.len() / n.max(1), n, 2),
+        |stop| by_size!(n, linear_n(&job, stop) else linear_any(&job, n, stop)),
+    )?;
     Ok((out2(py, u, n), out2(py, v, n), out2(py, a, n)))
 }
 

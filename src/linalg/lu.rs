@@ -16,7 +16,7 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::{Mat, identity};
+use super::{Mat, identity, max_abs_flat};
 use crate::Real;
 
 /// `P A = L U` of an `N×N` `f64` matrix, `L` unit lower triangular, both stored in `lu`.
@@ -33,98 +33,33 @@ impl<const N: usize> Lu<N> {
     /// working precision (see the module docs), or a scale is zero or not finite. Inputs
     /// must be finite. Cost: `N³/3` multiply-adds.
     pub(crate) const fn new(a: &Mat<N, N>, scales: &[f64; N]) -> Option<Self> {
-        let tiny = (N as f64) * f64::EPSILON;
         let mut lu = *a;
         let mut s = *scales;
         let mut perm = [0usize; N];
-        let mut i = 0;
-        while i < N {
-            if !(s[i].is_finite() && s[i] > 0.0) {
-                return None;
-            }
-            perm[i] = i;
-            i += 1;
+        if factor(lu.as_flattened_mut(), N, &mut s, &mut perm) {
+            Some(Self { lu, perm })
+        } else {
+            None
         }
-        let mut col = 0;
-        while col < N {
-            // Scaled partial pivoting: the largest |a_rc| / s_r at or below the diagonal.
-            let mut piv = col;
-            let mut best = lu[col][col].abs() / s[col];
-            let mut r = col + 1;
-            while r < N {
-                let x = lu[r][col].abs() / s[r];
-                if x > best {
-                    best = x;
-                    piv = r;
-                }
-                r += 1;
-            }
-            if best.is_nan() || best <= tiny {
-                return None;
-            }
-            if piv != col {
-                let t = lu[piv];
-                lu[piv] = lu[col];
-                lu[col] = t;
-                let t = perm[piv];
-                perm[piv] = perm[col];
-                perm[col] = t;
-                let t = s[piv];
-                s[piv] = s[col];
-                s[col] = t;
-            }
-            let d = lu[col][col];
-            r = col + 1;
-            while r < N {
-                let f = lu[r][col] / d;
-                lu[r][col] = f;
-                if f != 0.0 {
-                    let mut j = col + 1;
-                    while j < N {
-                        lu[r][j] -= f * lu[col][j];
-                        j += 1;
-                    }
-                }
-                r += 1;
-            }
-            col += 1;
-        }
-        Some(Self { lu, perm })
     }
 
     /// `A⁻¹ B` for an `N×C` right-hand side (forward and back substitution, column by
-    /// column). Cost: `N²·C` multiply-adds.
+    /// column; [`solve_flat`]). Cost: `N²·C` multiply-adds.
     pub(crate) const fn solve<const C: usize>(&self, b: &Mat<N, C>) -> Mat<N, C> {
         let mut x = [[0.0; C]; N];
-        let mut c = 0;
-        while c < C {
-            // L y = P b
-            let mut i = 0;
-            while i < N {
-                let mut s = b[self.perm[i]][c];
-                let mut k = 0;
-                while k < i {
-                    s -= self.lu[i][k] * x[k][c];
-                    k += 1;
-                }
-                x[i][c] = s;
-                i += 1;
-            }
-            // U x = y
-            let mut i = N;
-            while i > 0 {
-                i -= 1;
-                let mut s = x[i][c];
-                let mut k = i + 1;
-                while k < N {
-                    s -= self.lu[i][k] * x[k][c];
-                    k += 1;
-                }
-                x[i][c] = s / self.lu[i][i];
-            }
-            c += 1;
-        }
+        solve_flat(
+            self.lu.as_flattened(),
+            &self.perm,
+            b.as_flattened(),
+            C,
+            x.as_flattened_mut(),
+        );
         x
+    }
+
+    /// The factorization from the output of [`factor`] (`lu` and `perm` as it left them).
+    pub(crate) const fn from_parts(lu: Mat<N, N>, perm: [usize; N]) -> Self {
+        Self { lu, perm }
     }
 
     /// `A⁻¹` (the solve with the identity). Cost: `N³` multiply-adds.
@@ -133,22 +68,145 @@ impl<const N: usize> Lu<N> {
     }
 }
 
+/// Factorize the row-major `n×n` matrix `lu` in place (`P A = L U`, `L` unit lower
+/// triangular, both stored in `lu`; `perm[i]`: the row of `A` that is row `i` of `P A`),
+/// with the row scales `s` (permuted alongside): the one factorization behind [`Lu::new`]
+/// and the run-time-sized operator build (`std`). `false` when the matrix is singular to
+/// working precision (see the module docs) or a scale is zero or not finite; inputs must
+/// be finite and the slices hold `n²`, `n`, `n` values (`false` if they do not).
+/// Cost: `n³/3` multiply-adds.
+pub(crate) const fn factor(lu: &mut [f64], n: usize, s: &mut [f64], perm: &mut [usize]) -> bool {
+    if lu.len() != n * n || s.len() != n || perm.len() != n {
+        return false;
+    }
+    let tiny = (n as f64) * f64::EPSILON;
+    let mut i = 0;
+    while i < n {
+        if !(s[i].is_finite() && s[i] > 0.0) {
+            return false;
+        }
+        perm[i] = i;
+        i += 1;
+    }
+    let mut col = 0;
+    while col < n {
+        // Scaled partial pivoting: the largest |a_rc| / s_r at or below the diagonal.
+        let mut piv = col;
+        let mut best = lu[col * n + col].abs() / s[col];
+        let mut r = col + 1;
+        while r < n {
+            let x = lu[r * n + col].abs() / s[r];
+            if x > best {
+                best = x;
+                piv = r;
+            }
+            r += 1;
+        }
+        if best.is_nan() || best <= tiny {
+            return false;
+        }
+        if piv != col {
+            let (pn, cn) = (piv * n, col * n);
+            let mut j = 0;
+            while j < n {
+                let t = lu[pn + j];
+                lu[pn + j] = lu[cn + j];
+                lu[cn + j] = t;
+                j += 1;
+            }
+            let t = perm[piv];
+            perm[piv] = perm[col];
+            perm[col] = t;
+            let t = s[piv];
+            s[piv] = s[col];
+            s[col] = t;
+        }
+        let d = lu[col * n + col];
+        r = col + 1;
+        while r < n {
+            // Row offsets hoisted: the inner loop costs the compiler's evaluator no more
+            // than indexing `[[f64; N]; N]` did (`Linear<f32, 63>` in a `static`).
+            let (rn, cn) = (r * n, col * n);
+            let f = lu[rn + col] / d;
+            lu[rn + col] = f;
+            if f != 0.0 {
+                // lu[r][j] -= f·lu[col][j] for j > col, by running flat indices.
+                let (mut a, mut b, end) = (rn + col + 1, cn + col + 1, rn + n);
+                while a < end {
+                    lu[a] -= f * lu[b];
+                    a += 1;
+                    b += 1;
+                }
+            }
+            r += 1;
+        }
+        col += 1;
+    }
+    true
+}
+
+/// `x = A⁻¹ B` from the factors of [`factor`] (`lu`: `n×n` with `n = perm.len()`), `B`
+/// and `x` row-major `n×c`: forward and back substitution, column by column. The one
+/// solve behind [`Lu::solve`] and the run-time-sized build. Cost: `n²·c` multiply-adds.
+pub(crate) const fn solve_flat(lu: &[f64], perm: &[usize], b: &[f64], c: usize, x: &mut [f64]) {
+    let n = perm.len();
+    let mut col = 0;
+    while col < c {
+        // L y = P b (row offsets and column strides hoisted, see `factor`)
+        let mut i = 0;
+        while i < n {
+            let mut s = b[perm[i] * c + col];
+            // s −= lu[i][k]·x[k][col] for k < i, by running flat indices.
+            let (mut l, end, mut xk) = (i * n, i * n + i, col);
+            while l < end {
+                s -= lu[l] * x[xk];
+                xk += c;
+                l += 1;
+            }
+            x[i * c + col] = s;
+            i += 1;
+        }
+        // U x = y
+        let mut i = n;
+        while i > 0 {
+            i -= 1;
+            let li = i * n;
+            let mut s = x[i * c + col];
+            // s −= lu[i][k]·x[k][col] for k > i, by running flat indices.
+            let (mut l, end, mut xk) = (li + i + 1, li + n, (i + 1) * c + col);
+            while l < end {
+                s -= lu[l] * x[xk];
+                xk += c;
+                l += 1;
+            }
+            x[i * c + col] = s / lu[li + i];
+        }
+        col += 1;
+    }
+}
+
 /// The largest `|a_ij|` of each row: the row scales of a matrix that is data (not
 /// assembled from terms).
 pub(crate) const fn row_scales<const N: usize>(a: &Mat<N, N>) -> [f64; N] {
     let mut s = [0.0; N];
-    let mut i = 0;
-    while i < N {
-        let mut j = 0;
-        while j < N {
-            if a[i][j].abs() > s[i] {
-                s[i] = a[i][j].abs();
+    row_scales_flat(a.as_flattened(), &mut s);
+    s
+}
+
+/// [`row_scales`] of a row-major `n×n` matrix `a` into `s` (`n = s.len()`).
+pub(crate) const fn row_scales_flat(a: &[f64], s: &mut [f64]) {
+    let n = s.len();
+    let (mut i, mut rest) = (0, a);
+    while i < n {
+        s[i] = match rest.split_at_checked(n) {
+            Some((row, r)) => {
+                rest = r;
+                max_abs_flat(row)
             }
-            j += 1;
-        }
+            None => 0.0,
+        };
         i += 1;
     }
-    s
 }
 
 /// `κ₁` of the row-equilibrated matrix, `‖D⁻¹A‖₁ ‖A⁻¹D‖₁` with `D = diag(scales)`, from
@@ -159,14 +217,21 @@ pub(crate) const fn condition<const N: usize>(
     inv: &Mat<N, N>,
     scales: &[f64; N],
 ) -> f64 {
+    condition_flat(a.as_flattened(), inv.as_flattened(), scales)
+}
+
+/// [`condition`] of row-major `n×n` `a` and `inv` (`n = scales.len()`): the one loop both
+/// sizes use.
+pub(crate) const fn condition_flat(a: &[f64], inv: &[f64], scales: &[f64]) -> f64 {
+    let n = scales.len();
     let (mut na, mut ni) = (0.0f64, 0.0f64);
     let mut j = 0;
-    while j < N {
+    while j < n {
         let (mut ca, mut ci) = (0.0, 0.0);
         let mut i = 0;
-        while i < N {
-            ca += a[i][j].abs() / scales[i];
-            ci += inv[i][j].abs() * scales[j];
+        while i < n {
+            ca += a[i * n + j].abs() / scales[i];
+            ci += inv[i * n + j].abs() * scales[j];
             i += 1;
         }
         if ca > na {

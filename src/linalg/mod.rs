@@ -67,14 +67,15 @@ pub(crate) fn sym<T: Real, const S: usize>(a: &SMatrix<T, S, S>) -> SMatrix<T, S
 
 /// All entries finite.
 pub(crate) const fn all_finite<const R: usize, const C: usize>(a: &Mat<R, C>) -> bool {
-    let mut i = 0;
-    while i < R {
-        let mut j = 0;
-        while j < C {
-            if !a[i][j].is_finite() {
-                return false;
-            }
-            j += 1;
+    all_finite_flat(a.as_flattened())
+}
+
+/// All entries finite ([`all_finite`] on a flat slice: the one loop both use).
+pub(crate) const fn all_finite_flat(a: &[f64]) -> bool {
+    let (mut i, len) = (0, a.len());
+    while i < len {
+        if !a[i].is_finite() {
+            return false;
         }
         i += 1;
     }
@@ -83,15 +84,16 @@ pub(crate) const fn all_finite<const R: usize, const C: usize>(a: &Mat<R, C>) ->
 
 /// Largest `|a_ij|` (`0` for an empty matrix; NaN entries are skipped).
 pub(crate) const fn max_abs<const R: usize, const C: usize>(a: &Mat<R, C>) -> f64 {
+    max_abs_flat(a.as_flattened())
+}
+
+/// [`max_abs`] of a flat slice (the one loop both use).
+pub(crate) const fn max_abs_flat(a: &[f64]) -> f64 {
     let mut s = 0.0f64;
-    let mut i = 0;
-    while i < R {
-        let mut j = 0;
-        while j < C {
-            if a[i][j].abs() > s {
-                s = a[i][j].abs();
-            }
-            j += 1;
+    let (mut i, len) = (0, a.len());
+    while i < len {
+        if a[i].abs() > s {
+            s = a[i].abs();
         }
         i += 1;
     }
@@ -105,16 +107,27 @@ pub(crate) const fn add_scaled<const R: usize, const C: usize>(
     b: &Mat<R, C>,
 ) -> Mat<R, C> {
     let mut r = *a;
-    let mut i = 0;
-    while i < R {
-        let mut j = 0;
-        while j < C {
-            r[i][j] += s * b[i][j];
-            j += 1;
-        }
+    add_scaled_flat(r.as_flattened_mut(), s, b.as_flattened());
+    r
+}
+
+/// `dst = src` if the lengths agree (else nothing: a `copy_from_slice` with no panic).
+pub(crate) const fn copy_flat(dst: &mut [f64], src: &[f64]) {
+    // One `copy_from_slice` (a memcpy, also for the compiler's evaluator: a copy of the
+    // operators of `Linear<f32, 63>` in a `static` stays within its step budget).
+    if dst.len() == src.len() {
+        dst.copy_from_slice(src);
+    }
+}
+
+/// `r += s·b` entry by entry on flat slices of one length (the one loop [`add_scaled`]
+/// and the run-time-sized build use).
+pub(crate) const fn add_scaled_flat(r: &mut [f64], s: f64, b: &[f64]) {
+    let (mut i, len) = (0, if r.len() < b.len() { r.len() } else { b.len() });
+    while i < len {
+        r[i] += s * b[i];
         i += 1;
     }
-    r
 }
 
 /// `s·a`.
@@ -180,6 +193,15 @@ pub(crate) const fn identity<const N: usize>() -> Mat<N, N> {
         i += 1;
     }
     r
+}
+
+/// Write the row-major `n×n` identity into `r` (`n²` values, all overwritten): the
+/// run-time-sized twin of [`identity`].
+#[cfg(feature = "std")]
+pub(crate) fn identity_flat(r: &mut [f64], n: usize) {
+    for (i, x) in r.iter_mut().enumerate() {
+        *x = if i % (n + 1) == 0 { 1.0 } else { 0.0 };
+    }
 }
 
 /// `√x` for finite `x ≥ 0`, in `const`: Newton's iteration from a bit-level first guess
@@ -336,19 +358,20 @@ pub(crate) const fn fits<const R: usize, const C: usize, const R2: usize, const 
     source: &Mat<R2, C2>,
     max: f64,
 ) -> Result<(), crate::Error> {
+    fits_flat(a.as_flattened(), source.as_flattened(), max)
+}
+
+/// [`fits`] on flat slices (any shapes): the one check both use.
+pub(crate) const fn fits_flat(a: &[f64], source: &[f64], max: f64) -> Result<(), crate::Error> {
     let mut m = 0.0f64;
-    let mut i = 0;
-    while i < R {
-        let mut j = 0;
-        while j < C {
-            if !fits_value(a[i][j], max) {
-                return Err(crate::Error::OperatorOverflow);
-            }
-            let x = a[i][j].abs();
-            if x > m {
-                m = x;
-            }
-            j += 1;
+    let (mut i, len) = (0, a.len());
+    while i < len {
+        if !fits_value(a[i], max) {
+            return Err(crate::Error::OperatorOverflow);
+        }
+        let x = a[i].abs();
+        if x > m {
+            m = x;
         }
         i += 1;
     }
@@ -357,7 +380,7 @@ pub(crate) const fn fits<const R: usize, const C: usize, const R2: usize, const 
     } else {
         f32::MIN_POSITIVE as f64
     };
-    if (m == 0.0 && max_abs(source) != 0.0) || (m != 0.0 && m < min_normal) {
+    if (m == 0.0 && max_abs_flat(source) != 0.0) || (m != 0.0 && m < min_normal) {
         return Err(crate::Error::OperatorUnderflow);
     }
     Ok(())

@@ -54,9 +54,16 @@ const fn first_block(n: usize, w: usize) -> usize {
     }
 }
 
+/// Rows of a column block of the run-time-sized operators ([`wide_rows`] of x86-64, on
+/// every target: their layout and product are the same code everywhere).
+#[cfg(feature = "std")]
+pub(crate) const fn dyn_wide_rows(bytes: usize) -> usize {
+    8 * 16 / bytes
+}
+
 /// Position in the flat storage (`K·N²` values) of row `i`, flat column `c` (`b·N + j`),
 /// in the row layout (`w = 0`) or the column-blocked one with blocks of `w` rows.
-const fn flat_index(n: usize, k: usize, i: usize, c: usize, w: usize) -> usize {
+pub(crate) const fn flat_index(n: usize, k: usize, i: usize, c: usize, w: usize) -> usize {
     let kn = k * n;
     if w == 0 {
         return i * kn + c;
@@ -170,11 +177,40 @@ fn wide_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
     x: &[[T; N]; K],
     out: &mut [T],
 ) {
+    let (flat, xf) = (ops.as_flattened().as_flattened(), x.as_flattened());
+    // `N`, `K` written in the closure (constants inside the AVX-compiled function too),
+    // and the small sizes' product called directly (inlined, unrolled for the size).
     #[cfg(target_arch = "x86_64")]
     if K * N * N * core::mem::size_of::<T>() >= super::avx::MIN_BYTES {
-        return super::wide(|| column_blocks::<T, N, K, W>(ops, from, x, out));
+        return super::wide(|| column_blocks_flat::<T, W>(flat, N, K, from, xf, out));
     }
-    column_blocks::<T, N, K, W>(ops, from, x, out);
+    column_blocks_flat::<T, W>(flat, N, K, from, xf, out);
+}
+
+/// [`wide_blocks`] on the flat storage of `n` rows of `k` blocks (`flat`: `k·n²` values,
+/// `xf`: `k·n`), sizes known at run time: the run-time-sized operators' product, the same
+/// body ([`column_blocks_flat`]) as the const-generic one.
+#[cfg(feature = "std")]
+#[inline(always)]
+pub(crate) fn wide_blocks_flat<T: Real, const W: usize>(
+    flat: &[T],
+    n: usize,
+    k: usize,
+    from: usize,
+    xf: &[T],
+    out: &mut [T],
+) {
+    // Through the run-time AVX choice from the same size on as the const-generic product.
+    #[cfg(target_arch = "x86_64")]
+    let large = k * n * n * core::mem::size_of::<T>() >= super::avx::MIN_BYTES;
+    #[cfg(not(target_arch = "x86_64"))]
+    let large = false;
+    let mut product = || column_blocks_flat::<T, W>(flat, n, k, from, xf, out);
+    if large {
+        super::wide(product)
+    } else {
+        product()
+    }
 }
 
 /// Rows in the row layout times `x` (blocks `from..K`): a single row first if their number
@@ -199,17 +235,20 @@ fn row_pairs<T: Real, const N: usize, const K: usize>(
 /// Storage in the column-blocked layout with blocks of `W` rows, times `x` (blocks
 /// `from..K`: the flat columns from `from·N` on): the first block ([`first_block`] rows,
 /// dispatched to its size), then the blocks of `W`.
+/// The column-blocked product on flat storage of `n` rows of `k` blocks: the one body both the
+/// const-generic and the run-time-sized products run.
 #[inline(always)]
-pub(super) fn column_blocks<T: Real, const N: usize, const K: usize, const W: usize>(
-    ops: &[[[T; N]; K]; N],
+pub(super) fn column_blocks_flat<T: Real, const W: usize>(
+    flat: &[T],
+    n: usize,
+    k: usize,
     from: usize,
-    x: &[[T; N]; K],
+    xf: &[T],
     out: &mut [T],
 ) {
-    let kn = K * N;
-    let b0 = first_block(N, W);
-    let skip = from.saturating_mul(N);
-    let (flat, xf) = (ops.as_flattened().as_flattened(), x.as_flattened());
+    let kn = k * n;
+    let b0 = first_block(n, W);
+    let skip = from.saturating_mul(n);
     // Each block's columns, and `x`, from `skip` on (none if `skip ≥ K·N`).
     let xf = xf.get(skip..).unwrap_or(&[]);
     let (Some((first, rest)), Some((out_first, out_rest))) = (
@@ -296,8 +335,16 @@ fn dots<T: Real, const N: usize, const K: usize, const R: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::{column_blocks, flat_index, layout, row_pairs, wide_blocks};
+    use super::{column_blocks_flat, flat_index, layout, row_pairs, wide_blocks};
     use crate::Real;
+
+    fn flat<T, const N: usize, const K: usize>(a: &[[[T; N]; K]; N]) -> &[T] {
+        a.as_flattened().as_flattened()
+    }
+
+    fn flat_x<T, const N: usize, const K: usize>(x: &[[T; N]; K]) -> &[T] {
+        x.as_flattened()
+    }
 
     /// Row `i` of `rows[.., from..] · x[from..]` as one serial chain, first product first:
     /// the order every layout and block shape must keep (zeros if `from ≥ K`).
@@ -340,8 +387,12 @@ mod tests {
                 let mut out = [T::one(); N];
                 match w {
                     0 => row_pairs(&stored, from, &x, &mut out),
-                    16 => column_blocks::<T, N, K, 16>(&stored, from, &x, &mut out),
-                    _ => column_blocks::<T, N, K, 32>(&stored, from, &x, &mut out),
+                    16 => {
+                        column_blocks_flat::<T, 16>(flat(&stored), N, K, from, flat_x(&x), &mut out)
+                    }
+                    _ => {
+                        column_blocks_flat::<T, 32>(flat(&stored), N, K, from, flat_x(&x), &mut out)
+                    }
                 }
                 for i in 0..N {
                     assert_eq!(
@@ -409,7 +460,7 @@ mod tests {
         }
         for from in [0, 1] {
             let (mut plain, mut wide) = ([T::zero(); N], [T::zero(); N]);
-            column_blocks::<T, N, K, W>(&ops, from, &x, &mut plain);
+            column_blocks_flat::<T, W>(flat(&ops), N, K, from, flat_x(&x), &mut plain);
             wide_blocks::<T, N, K, W>(&ops, from, &x, &mut wide);
             for (p, w) in plain.iter().zip(&wide) {
                 assert_eq!(

@@ -23,7 +23,9 @@
 use std::hint::black_box;
 use std::time::Duration;
 
-use aemstep::{CompensatedLinear, Exact, GeneralizedAlpha, Linear, Newmark, Real, Stepper};
+use aemstep::{
+    CompensatedLinear, DynLinear, Exact, GeneralizedAlpha, Linear, Newmark, Real, Stepper,
+};
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, BenchmarkId, Criterion, Throughput};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
@@ -76,6 +78,25 @@ fn bench_stepper<T: Real, S: Stepper<T, N, Input = SVector<T, N>>, const N: usiz
     });
 }
 
+/// The same AEM stepper sized at run time (`DynLinear`, heap operators, the same product):
+/// whether the compiled sizes of the Python package still pay for themselves.
+fn bench_dyn<T: Real, const N: usize>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    m: &SMatrix<f64, N, N>,
+    c: &SMatrix<f64, N, N>,
+    k: &SMatrix<f64, N, N>,
+    h: f64,
+) {
+    let dm = |a: &SMatrix<f64, N, N>| DMatrix::from_fn(N, N, |i, j| a[(i, j)]);
+    let sys = DynLinear::<T>::new(&dm(m), &dm(c), &dm(k), h).expect("dyn linear");
+    let (p, z) = (vec![T::from_f64_rounded(1.0); N], vec![T::zero(); N]);
+    let mut s = sys.start(&z, &z, &p).expect("start");
+    g.throughput(Throughput::Elements((3 * N * N + 7 * N) as u64));
+    g.bench_with_input(BenchmarkId::new("aem-dyn", N), &N, |b, _| {
+        b.iter(|| sys.step(black_box(&mut s), black_box(&p)))
+    });
+}
+
 fn per_step<T: Real, const N: usize>(c: &mut Criterion, ty: &str) {
     let sys = system::<N>();
     let (m, cc, k) = (&sys.0, &sys.1, &sys.2);
@@ -86,6 +107,7 @@ fn per_step<T: Real, const N: usize>(c: &mut Criterion, ty: &str) {
         .sample_size(20);
     let lin = Box::new(Linear::<T, N>::new(m, cc, k, h).expect("linear"));
     bench_stepper(&mut g, "aem", &*lin, 3 * N * N + 7 * N);
+    bench_dyn::<T, N>(&mut g, m, cc, k, h);
     let af = Box::new(lin.a_form());
     bench_stepper(&mut g, "aem-aform", &*af, 12 * N * N);
     drop(af);
