@@ -9,8 +9,15 @@
 //! released, waking every [`POLL`](crate::POLL) to read an atomic counter, call the user's
 //! `progress(done, total)` and check for signals (Ctrl-C). A raised exception (from the
 //! callback or a `KeyboardInterrupt`) sets a cancel flag that makes every later run of the
-//! batch return at once; the exception is raised when the batch has wound down. The runs
-//! and their order are the library's: the curves are those of the serial run, bit for bit.
+//! batch return at once (the loads of the runs going turn NaN, which ends them at their
+//! next step); the exception is raised when the batch has wound down.
+//!
+//! **Many runs at once.** The runs go [`LANES`] at a time through `aemstep::ida::batched`,
+//! one a SIMD lane of `aemstep::lanes::LaneStepper` (stripes: a stripe's records side by
+//! side; hunt-and-fill: four records' traces side by side), every law of the package. Each
+//! lane is bit for bit the single run of `shear_building`, so the curves are those of the
+//! serial one-run-at-a-time IDA, bit for bit, on any thread count; a run that fails does
+//! not stop the others of its batch, and the collapse and abort rules are the library's.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -28,8 +35,8 @@ use crate::{Fail, Res, SIZES, out1, out2, read1, read2, rows, shape, square};
 
 /// Analyses stepped together by [`LaneStepper`], one a lane: `f64 × 4` fills one AVX
 /// register (two SSE2 ones). Measured on the 880-analysis IDA of `scripts/bench_python.py`
-/// (docs in the CHANGELOG): faster than 2 lanes a batch, and a batch of 4 runs still
-/// leaves 220 batches to share between threads.
+/// (1 thread, load 3.3 to 4.1 on 2 cores): 1.60 s with 4 lanes, 1.74 s with 2, 1.68 s
+/// with 8; 4 lanes a batch still leaves 220 batches to share between threads.
 const LANES: usize = 4;
 
 /// The intensities to run: fixed stripes, or a hunt-and-fill trace.
