@@ -3,7 +3,8 @@
 //! `storeys × width` parameter table to `[L; N]`.
 
 use aemstep::Error;
-use aemstep::hysteresis::{Bilinear, BoucWen, Friction, Law, Parallel};
+use aemstep::hysteresis::{Bilinear, BoucWen, Friction, Parallel};
+use aemstep::lanes::LaneLaw;
 
 use crate::{Fail, Res};
 
@@ -29,7 +30,7 @@ pub(crate) fn law_width(law: &str) -> Option<usize> {
 /// What to do with the `N` storey laws once built (a generic callback over the law type).
 pub(crate) trait WithLaws<const N: usize> {
     type Out;
-    fn run<L: Law<f64> + Send + Sync>(self, laws: [L; N]) -> Res<Self::Out>;
+    fn run<L: LaneLaw<f64> + Send + Sync>(self, laws: [L; N]) -> Res<Self::Out>;
 }
 
 /// `N` laws, the `i`-th from `f(i)`.

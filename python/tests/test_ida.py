@@ -108,6 +108,85 @@ def test_results_do_not_depend_on_the_thread_count(elcentro):
             assert a.collapse == c.collapse
 
 
+# Each law the package exposes: its ida_* parameter row (one a storey) and the same
+# storeys as shear_building's keywords.
+LAWS = {
+    "bilinear": ([], {}),
+    "bouc_wen": ([0.5, 0.5, 1.0], dict(beta=0.5, gamma=0.5, n=1.0)),
+    "bilinear_friction": ([5e4, 1e-3], dict(fs=5e4, vr=1e-3)),
+}
+
+
+def law_building(law, dense=False):
+    """building() with `law`'s storeys; `dense`: a damping C coupling storeys 1 and 3 (not
+    tridiagonal: the lanes fall back to single steps)."""
+    b = dict(building(), law=law)
+    extra, _ = LAWS[law]
+    b["params"] = np.column_stack([b["params"]] + [np.full(3, x) for x in extra])
+    if dense:
+        c = b["c"].copy()
+        c[0, 2] = c[2, 0] = 0.1 * c[0, 1]
+        b["c"] = c
+    return b
+
+
+def direct_run(b, rec, dt, scale, **newton):
+    """(peak drift, error name): one shear_building run of `scale × rec` with building `b`
+    (`inf` and the error's class name for a run that fails)."""
+    _, kw = LAWS[b["law"]]
+    try:
+        r = aemstep.shear_building(
+            b["masses"], b["c"], dt, scale * rec, k=K, fy=FY, alpha=ALPHA, law=b["law"],
+            energy=False, histories=False, **kw, **newton
+        )
+    except aemstep.AemstepError as e:
+        return np.inf, type(e).__name__
+    return r.peak_drift, None
+
+
+def lane_suite(elcentro):
+    """Five records of different lengths (120 to 1000 samples): more than one batch of
+    lanes, the last one partly filled, lanes ending at different steps."""
+    ag, dt = elcentro
+    return [ag[:600].copy(), -ag[150:800].copy(), 1.3 * ag[300:900], ag[50:170].copy(),
+            -0.7 * ag[400:1400]], dt
+
+
+@pytest.mark.parametrize("law", sorted(LAWS))
+def test_lanes_equal_single_runs_bitwise_for_every_law(elcentro, law):
+    """The runs go four at a time in SIMD lanes (aemstep::lanes): every curve point is the
+    direct shear_building run's peak drift to the last bit, for every law, records of
+    different lengths, runs that fail beside runs that do not (the failed ones collapse with
+    their error), a dense damping matrix, on 1 and 2 threads, stripes and hunt-and-fill."""
+    recs, dt = lane_suite(elcentro)
+    cases = [
+        (law_building(law), {}, [2.0, 0.5, 4.0]),
+        # Newton with one iteration: small runs converge, yielding ones fail (NotConverged),
+        # side by side in the same batches.
+        (law_building(law), dict(max_iterations=1, tolerance=1e-14), [0.01, 3.0]),
+    ]
+    if law == "bilinear":
+        cases.append((law_building(law, dense=True), {}, [0.5, 3.0]))
+    errors = set()
+    for b, newton, ims in cases:
+        direct = [[direct_run(b, rec, dt, s, **newton) for s in sorted(ims)] for rec in recs]
+        errors |= {e for row in direct for _, e in row}
+        for threads in (1, 2):
+            curves = aemstep.ida_stripes(recs, dt, ims, threads=threads, **b, **newton)
+            for cur, want in zip(curves, direct):
+                np.testing.assert_array_equal(cur.drift, [d for d, _ in want])
+                assert cur.error == [e for _, e in want]
+                np.testing.assert_array_equal(cur.collapsed, [e is not None for _, e in want])
+    assert errors == {None, "NotConverged"}, "runs should fail beside runs that converge"
+    b = law_building(law)
+    curves = aemstep.ida_hunt_fill(recs, dt, collapse_drift=0.015, runs=8, threads=2, **b)
+    for rec, cur in zip(recs, curves):
+        want = [direct_run(b, rec, dt, s)[0] for s in cur.intensity]
+        np.testing.assert_array_equal(cur.drift, want)
+        np.testing.assert_array_equal(cur.collapsed, np.array(want) >= 0.015)
+    assert sum(cur.collapse is not None for cur in curves) >= 3, "traces should collapse"
+
+
 def hand_intensity_at(cur, level):
     """The intensity where a curve first reaches `level` (numpy, for the fractile test):
     its non-collapsing points below its lowest collapse, from the origin, linear."""
