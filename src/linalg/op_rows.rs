@@ -232,11 +232,10 @@ fn row_pairs<T: Real, const N: usize, const K: usize>(
     }
 }
 
-/// Storage in the column-blocked layout with blocks of `W` rows, times `x` (blocks
-/// `from..K`: the flat columns from `from·N` on): the first block ([`first_block`] rows,
-/// dispatched to its size), then the blocks of `W`.
-/// The column-blocked product on flat storage of `n` rows of `k` blocks: the one body both the
-/// const-generic and the run-time-sized products run.
+/// Storage in the column-blocked layout with blocks of `W` rows (flat: `n` rows of `k`
+/// blocks), times `x` (blocks `from..k`: the flat columns from `from·n` on): the first
+/// block ([`first_block`] rows, dispatched to its size), then the blocks of `W`. The one
+/// body both the const-generic and the run-time-sized products run.
 #[inline(always)]
 pub(super) fn column_blocks_flat<T: Real, const W: usize>(
     flat: &[T],
