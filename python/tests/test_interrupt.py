@@ -51,6 +51,27 @@ CALLS = {
         "ag = record(1_000_000)",
         "aemstep.mr_building(m, c, k, ag, 0.01, law='on')",
     ),
+    # The spectra calls (nan34): a 1e6-sample white-noise record, 5000 s at 0.005 s.
+    "spectrum": (
+        "ag = np.random.default_rng(34).standard_normal(1_000_000)",
+        "aemstep.spectrum(np.geomspace(0.01, 10, 4000), 0.05, 0.005, ag)",
+    ),
+    "spectra": (
+        "ag = np.random.default_rng(34).standard_normal(1_000_000)",
+        "aemstep.spectra(np.geomspace(0.01, 10, 2000), 0.05, 0.005, [ag, ag])",
+    ),
+    "rotd": (
+        "ag = np.random.default_rng(34).standard_normal(1_000_000)",
+        "aemstep.rotd(np.geomspace(0.01, 10, 320), 0.05, 0.005, ag, ag[::-1])",
+    ),
+    "constant_strength": (
+        "ag = np.random.default_rng(34).standard_normal(1_000_000)",
+        "aemstep.constant_strength(np.geomspace(0.05, 3, 800), 0.05, 0.005, ag, 4.0, threads=1)",
+    ),
+    "constant_ductility": (
+        "ag = np.random.default_rng(34).standard_normal(1_000_000)",
+        "aemstep.constant_ductility(np.geomspace(0.05, 3, 32), 0.05, 0.005, ag, 4.0, threads=1)",
+    ),
     "ida_stripes": (
         "ag = record(5_000_000); params = np.tile([2e3, 1e9, 0.0], (n, 1))",
         "aemstep.ida_stripes([ag], 0.01, [1.0], masses=np.ones(n), law='bilinear', params=params, c=c, threads=1)",
