@@ -10,7 +10,7 @@
 use std::fmt::Debug;
 
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
-use aemstep::spectrum::{Bank, Response, RotD, RotDResponse, Scheme, Substeps};
+use aemstep::spectrum::{Bank, NonFinite, Response, RotD, RotDResponse, Scheme, Substeps};
 use aemstep::{Error, Param, Real};
 
 use super::common::*;
@@ -158,6 +158,14 @@ where
         "{SP}: the bank does not keep its data"
     );
     let _ = bank.free_vibration_samples();
+    // The policy for non-finite samples: refused by default (checked below against the
+    // skipping bank, whose documented hold-and-count the rest of this check follows).
+    check!(
+        bank.non_finite() == NonFinite::Refuse,
+        "{SP}: a bank does not refuse non-finite samples by default"
+    );
+    let refusing = bank;
+    let bank = bank.with_non_finite(NonFinite::Skip);
     let (rot, mut r, mut rr) = at_rest(&bank);
     let mut held = T::zero();
     let mut record = Vec::new();
@@ -168,6 +176,16 @@ where
         // The checked step: the unchecked one's result when finite, else `r` unchanged.
         let mut tried = r;
         let t = bank.try_step(&mut tried, x);
+        let mut refused = before;
+        let tr = refusing.try_step(&mut refused, x);
+        check!(
+            if x.is_finite() {
+                tr == t && bits(&refused) == bits(&tried)
+            } else {
+                tr == Err(Error::NonFiniteInput) && bits(&refused) == bits(&before)
+            },
+            "{SP}: the refusing Bank::try_step gave {tr:?} for the sample {x:?}"
+        );
         bank.step(&mut r, x);
         count(SP, "samples");
         match t {
@@ -282,6 +300,15 @@ where
             "{SP}: batch differs from stepping"
         );
         count(SP, "batch compared");
+        let refused = aemstep::spectrum::batch::spectra(&refusing, &[&record[..]], 0, 1);
+        let fin = record.iter().all(|x| x.is_finite());
+        check!(
+            match (&refused[0], &out[0]) {
+                (Err(Error::NonFiniteInput), _) => !fin,
+                (a, b) => fin && a.as_ref().map(bits) == b.as_ref().map(bits),
+            },
+            "{SP}: the refusing batch differs from the policy"
+        );
     }
     let _ = batch;
     None
@@ -371,6 +398,8 @@ fn inelastic_typed<T: Real>(
         ),
     }
     let Ok(bank) = bank else { return got };
+    let refusing = bank;
+    let bank = bank.with_non_finite(NonFinite::Skip);
     let ay = y.ay.map(T::from_f64_rounded);
     let rest = bank.at_rest(&ay);
     outcome(SP, &rest);
@@ -391,6 +420,16 @@ fn inelastic_typed<T: Real>(
             let before = r;
             let mut tried = r;
             let t = bank.try_step(&mut tried, x);
+            let mut refused = before;
+            let tr = refusing.try_step(&mut refused, x);
+            check!(
+                if x.is_finite() {
+                    tr == t && bits(&refused) == bits(&tried)
+                } else {
+                    tr == Err(Error::NonFiniteInput) && bits(&refused) == bits(&before)
+                },
+                "{SP}: the refusing Yielding::try_step gave {tr:?} for the sample {x:?}"
+            );
             bank.step(&mut r, x);
             count(SP, "yielding samples");
             check!(
