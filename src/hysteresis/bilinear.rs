@@ -133,6 +133,13 @@ impl<T: Real> Law<T> for Bilinear<T> {
         let two = T::one() + T::one();
         let half = T::one() / two;
         let f_tr = self.k * (d * half - dp * half) * two;
+        if !f_tr.is_finite() {
+            // `k (d − d_p)` beyond `T::MAX` (or a non-finite input): the force may still fit
+            // (a plastic trial gives back `±f_y` and the hardening), so the trial is taken
+            // at half scale throughout (found by fuzzing: `f_y = 3e307`, a reversal from a
+            // plastic offset of `−1.7e299` gave NaN for a force of `f_y`).
+            return self.trial_at_half_scale(committed, d);
+        }
         let xi = f_tr - self.hard * dp;
         let excess = xi.abs() - self.fy;
         if excess > T::zero() {
@@ -171,6 +178,51 @@ impl<T: Real> Law<T> for Bilinear<T> {
 /// Both branches of [`Law::trial`] in every lane, the result selected per lane: each value
 /// computed by exactly the operations of the scalar trial, so every lane has its bits,
 /// and the loop has no branch (packed instructions).
+impl<T: Real> Bilinear<T> {
+    /// [`Law::trial`] with every force halved (`k (d − d_p) / 2`, `ξ / 2`, the excess over
+    /// `f_y / 2`), doubled at the end: the same values as the full-scale trial wherever both
+    /// are finite (halving and doubling are exact in the normal range), and a finite force
+    /// where `k (d − d_p)` alone overflows but the returned force fits. Cold: taken only when
+    /// the full-scale elastic trial force is not finite. Cost: about 12 flops.
+    #[cold]
+    #[inline(never)]
+    fn trial_at_half_scale(
+        &self,
+        committed: &BilinearHistory<T>,
+        d: T,
+    ) -> LawTrial<T, BilinearHistory<T>> {
+        let dp = committed.plastic;
+        let two = T::one() + T::one();
+        let half = T::one() / two;
+        let f_h = self.k * (d * half - dp * half);
+        let xi_h = f_h - self.hard * (dp * half);
+        let excess_h = xi_h.abs() - self.fy * half;
+        if excess_h > T::zero() {
+            let s = if xi_h > T::zero() {
+                T::one()
+            } else {
+                -T::one()
+            };
+            return LawTrial {
+                force: (f_h - s * self.one_minus_alpha * excess_h) * two,
+                stiffness: self.kt,
+                damping: T::zero(),
+                history: BilinearHistory {
+                    plastic: (dp * half + s * self.compliance_p * excess_h) * two,
+                },
+                inelastic: true,
+            };
+        }
+        LawTrial {
+            force: f_h * two,
+            stiffness: self.k,
+            damping: T::zero(),
+            history: *committed,
+            inelastic: false,
+        }
+    }
+}
+
 impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
     #[inline(always)]
     fn trial_lanes<const L: usize>(
@@ -188,9 +240,11 @@ impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
             history: *committed,
             inelastic: [false; L],
         };
+        let mut overflow = false;
         for l in 0..L {
             let dp = committed[l].plastic;
             let f_tr = self.k * (d[l] * half - dp * half) * two;
+            overflow |= !f_tr.is_finite();
             let xi = f_tr - self.hard * dp;
             let excess = xi.abs() - self.fy;
             let plastic = excess > T::zero();
@@ -201,6 +255,18 @@ impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
             out.stiffness[l] = if plastic { self.kt } else { self.k };
             out.history[l].plastic = if plastic { dp_p } else { dp };
             out.inelastic[l] = plastic;
+        }
+        if overflow {
+            // A lane whose `k (d − d_p)` overflowed takes the scalar trial's half-scale
+            // path: every lane through the scalar trial, so each keeps its bits.
+            for l in 0..L {
+                let t = Law::trial(self, &committed[l], d[l], _rate[l]);
+                out.force[l] = t.force;
+                out.stiffness[l] = t.stiffness;
+                out.damping[l] = t.damping;
+                out.history[l] = t.history;
+                out.inelastic[l] = t.inelastic;
+            }
         }
         out
     }
