@@ -126,41 +126,41 @@ impl<T: Real> Law<T> for Bilinear<T> {
     #[inline]
     fn trial(&self, committed: &BilinearHistory<T>, d: T, _rate: T) -> LawTrial<T, Self::History> {
         let dp = committed.plastic;
-        // `k (d − d_p)` at half scale: with a tiny `k` and deformations near `T::MAX`,
-        // `d − d_p` (up to `2·T::MAX`) can overflow though the force fits. Halving and
-        // doubling are exact in the normal range, so this rounds as `k (d − d_p)` does
-        // (no cancellation of `k d − k d_p`); only subnormal deformations lose a bit.
+        // The whole trial at half scale: `f_h = k (d − d_p) / 2`, `ξ / 2`, the excess over
+        // `f_y / 2`, doubled at the end. Halving and doubling are exact in the normal range,
+        // so this rounds as the full-scale trial does (no cancellation of `k d − k d_p`),
+        // while `d − d_p` (up to `2·T::MAX` with a tiny `k`) and `k (d − d_p)` (beyond
+        // `T::MAX` on a reversal from a large plastic offset whose returned force is `±f_y`:
+        // `f_y = 3e307`, an offset of `−1.7e299`, found by fuzzing) stay finite; only
+        // subnormal forces lose a bit. Branch-free of any overflow test, so the Newton
+        // loop's code is as before.
         let two = T::one() + T::one();
         let half = T::one() / two;
-        let f_tr = self.k * (d * half - dp * half) * two;
-        if !f_tr.is_finite() {
-            // `k (d − d_p)` beyond `T::MAX` (or a non-finite input): the force may still fit
-            // (a plastic trial gives back `±f_y` and the hardening), so the trial is taken
-            // at half scale throughout (found by fuzzing: `f_y = 3e307`, a reversal from a
-            // plastic offset of `−1.7e299` gave NaN for a force of `f_y`).
-            return self.trial_at_half_scale(committed, d);
-        }
-        let xi = f_tr - self.hard * dp;
-        let excess = xi.abs() - self.fy;
-        if excess > T::zero() {
-            let s = if xi > T::zero() { T::one() } else { -T::one() };
+        let dp_h = dp * half;
+        let f_h = self.k * (d * half - dp_h);
+        let xi_h = f_h - self.hard * dp_h;
+        let excess_h = xi_h.abs() - self.fy * half;
+        if excess_h > T::zero() {
+            let s = if xi_h > T::zero() {
+                T::one()
+            } else {
+                -T::one()
+            };
             return LawTrial {
-                force: f_tr - s * self.one_minus_alpha * excess,
+                force: (f_h - s * self.one_minus_alpha * excess_h) * two,
                 stiffness: self.kt,
                 damping: T::zero(),
                 history: BilinearHistory {
-                    // `d_p + c·excess` at half scale: the new `d_p` lies between the
-                    // committed one and `d` (plastic flow moves it toward `d`, never past),
-                    // so it fits `T`, but the increment alone (up to `2·T::MAX`, tiny `k`)
-                    // may not. Halving and doubling are exact (but below the normal range).
-                    plastic: (dp * half + s * (self.compliance_p * half) * excess) * two,
+                    // `d_p + c·excess`: the new `d_p` lies between the committed one and `d`
+                    // (plastic flow moves it toward `d`, never past), so it fits `T`.
+                    plastic: (dp_h + s * self.compliance_p * excess_h) * two,
                 },
                 inelastic: true,
             };
         }
         // Elastic (a NaN trial lands here too and stays NaN in the force).
         LawTrial {
-            force: f_tr,
+            force: f_h * two,
             stiffness: self.k,
             damping: T::zero(),
             history: *committed,
@@ -178,51 +178,6 @@ impl<T: Real> Law<T> for Bilinear<T> {
 /// Both branches of [`Law::trial`] in every lane, the result selected per lane: each value
 /// computed by exactly the operations of the scalar trial, so every lane has its bits,
 /// and the loop has no branch (packed instructions).
-impl<T: Real> Bilinear<T> {
-    /// [`Law::trial`] with every force halved (`k (d − d_p) / 2`, `ξ / 2`, the excess over
-    /// `f_y / 2`), doubled at the end: the same values as the full-scale trial wherever both
-    /// are finite (halving and doubling are exact in the normal range), and a finite force
-    /// where `k (d − d_p)` alone overflows but the returned force fits. Cold: taken only when
-    /// the full-scale elastic trial force is not finite. Cost: about 12 flops.
-    #[cold]
-    #[inline(never)]
-    fn trial_at_half_scale(
-        &self,
-        committed: &BilinearHistory<T>,
-        d: T,
-    ) -> LawTrial<T, BilinearHistory<T>> {
-        let dp = committed.plastic;
-        let two = T::one() + T::one();
-        let half = T::one() / two;
-        let f_h = self.k * (d * half - dp * half);
-        let xi_h = f_h - self.hard * (dp * half);
-        let excess_h = xi_h.abs() - self.fy * half;
-        if excess_h > T::zero() {
-            let s = if xi_h > T::zero() {
-                T::one()
-            } else {
-                -T::one()
-            };
-            return LawTrial {
-                force: (f_h - s * self.one_minus_alpha * excess_h) * two,
-                stiffness: self.kt,
-                damping: T::zero(),
-                history: BilinearHistory {
-                    plastic: (dp * half + s * self.compliance_p * excess_h) * two,
-                },
-                inelastic: true,
-            };
-        }
-        LawTrial {
-            force: f_h * two,
-            stiffness: self.k,
-            damping: T::zero(),
-            history: *committed,
-            inelastic: false,
-        }
-    }
-}
-
 impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
     #[inline(always)]
     fn trial_lanes<const L: usize>(
@@ -240,33 +195,23 @@ impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
             history: *committed,
             inelastic: [false; L],
         };
-        let mut overflow = false;
         for l in 0..L {
-            let dp = committed[l].plastic;
-            let f_tr = self.k * (d[l] * half - dp * half) * two;
-            overflow |= !f_tr.is_finite();
-            let xi = f_tr - self.hard * dp;
-            let excess = xi.abs() - self.fy;
-            let plastic = excess > T::zero();
-            let s = if xi > T::zero() { T::one() } else { -T::one() };
-            let f_p = f_tr - s * self.one_minus_alpha * excess;
-            let dp_p = (dp * half + s * (self.compliance_p * half) * excess) * two;
-            out.force[l] = if plastic { f_p } else { f_tr };
+            let dp_h = committed[l].plastic * half;
+            let f_h = self.k * (d[l] * half - dp_h);
+            let xi_h = f_h - self.hard * dp_h;
+            let excess_h = xi_h.abs() - self.fy * half;
+            let plastic = excess_h > T::zero();
+            let s = if xi_h > T::zero() {
+                T::one()
+            } else {
+                -T::one()
+            };
+            let f_p = (f_h - s * self.one_minus_alpha * excess_h) * two;
+            let dp_p = (dp_h + s * self.compliance_p * excess_h) * two;
+            out.force[l] = if plastic { f_p } else { f_h * two };
             out.stiffness[l] = if plastic { self.kt } else { self.k };
-            out.history[l].plastic = if plastic { dp_p } else { dp };
+            out.history[l].plastic = if plastic { dp_p } else { committed[l].plastic };
             out.inelastic[l] = plastic;
-        }
-        if overflow {
-            // A lane whose `k (d − d_p)` overflowed takes the scalar trial's half-scale
-            // path: every lane through the scalar trial, so each keeps its bits.
-            for l in 0..L {
-                let t = Law::trial(self, &committed[l], d[l], _rate[l]);
-                out.force[l] = t.force;
-                out.stiffness[l] = t.stiffness;
-                out.damping[l] = t.damping;
-                out.history[l] = t.history;
-                out.inelastic[l] = t.inelastic;
-            }
         }
         out
     }
