@@ -91,7 +91,7 @@ pub enum Error {
     RiccatiNotConverged,
     /// A state-space size parameter does not match the model: `S = 2N` for the full state
     /// `x = [u; v]`, `S = 3N` for generalized-α's `x = [u; v; a]`, `S = 2R` for `R` modes;
-    /// or, for a model sized at run time ([`DynLinear`](crate::DynLinear), feature `std`),
+    /// or, for a model sized at run time (`DynLinear`, feature `std`),
     /// a matrix, vector or state not of the model's size.
     StateSizeMismatch,
     /// The unknown input cannot be estimated from the chosen sensors

@@ -82,7 +82,7 @@
 //! [`Error::InvalidMaterial`], as for [`hysteresis::Bilinear`](crate::hysteresis::Bilinear);
 //! a strength-reduction factor, target ductility or search setting out of range is
 //! [`Error::InvalidParameter`]. A non-finite sample follows the bank's
-//! [`NonFinite`](super::NonFinite) policy, as in the elastic bank: by default
+//! [`NonFinite`] policy, as in the elastic bank: by default
 //! [`Error::NonFiniteInput`] ([`Yielding::try_step`] leaves the response unchanged; the
 //! record-level calls refuse the record before stepping it); with
 //! [`Yielding::with_non_finite`]`(NonFinite::Skip)` it is held and counted

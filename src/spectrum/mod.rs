@@ -54,7 +54,7 @@
 //!
 //! **Non-finite samples** (NaN, ±∞) follow the bank's [`NonFinite`] policy, one rule for
 //! every record-level and checked call ([`Bank`], [`RotD`], [`inelastic::Yielding`],
-//! `batch::spectra`, and [`ida::spectral_acceleration`](crate::ida::spectral_acceleration)
+//! `batch::spectra`, and `ida::spectral_acceleration`
 //! with `std`). By default ([`NonFinite::Refuse`]) such a sample is
 //! [`Error::NonFiniteInput`]: the checked steps leave the response unchanged (its
 //! [`Response::samples`] is then the index of the refused sample), the record-level calls
