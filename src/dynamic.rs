@@ -7,7 +7,7 @@
 //! checks in the same order, the same arithmetic), rounded once to `T` the same way,
 //! stored in the column-blocked layout and multiplied by the same per-row product
 //! (`op_rows`' `wide_blocks_flat`), with the same predictor and corrector
-//! ([`Kinematics`]). So at every size both serve, `DynLinear<T>` and `Linear<T, N>` give
+//! (`Kinematics`). So at every size both serve, `DynLinear<T>` and `Linear<T, N>` give
 //! bit-identical histories (`tests/runtime_size.rs` checks `u`, `v`, `a` at every sample).
 //!
 //! Memory is allocated once, by [`DynLinear::new`] (`6N²` values of `T` and a few `N×N`
