@@ -179,11 +179,7 @@ where
         let mut refused = before;
         let tr = refusing.try_step(&mut refused, x);
         check!(
-            if x.is_finite() {
-                tr == t && bits(&refused) == bits(&tried)
-            } else {
-                tr == Err(Error::NonFiniteInput) && bits(&refused) == bits(&before)
-            },
+            refusal_holds(x, (&t, &tried), (&tr, &refused), &before),
             "{SP}: the refusing Bank::try_step gave {tr:?} for the sample {x:?}"
         );
         bank.step(&mut r, x);
@@ -314,6 +310,22 @@ where
     None
 }
 
+/// The checked step of a bank that refuses non-finite samples against the skipping bank's
+/// (each `(result, response after it)`, both from `before`): the same result and bits for a
+/// finite sample `x`; for a non-finite one `NonFiniteInput` with the response unchanged.
+fn refusal_holds<T: Real, S: Debug>(
+    x: T,
+    skipping: (&Result<(), Error>, &S),
+    refusing: (&Result<(), Error>, &S),
+    before: &S,
+) -> bool {
+    if x.is_finite() {
+        refusing.0 == skipping.0 && bits(refusing.1) == bits(skipping.1)
+    } else {
+        *refusing.0 == Err(Error::NonFiniteInput) && bits(refusing.1) == bits(before)
+    }
+}
+
 /// A bank of either scalar, for the generic checks (short-lived: its size is no matter).
 #[allow(clippy::large_enum_variant)]
 enum BankAny {
@@ -423,11 +435,7 @@ fn inelastic_typed<T: Real>(
             let mut refused = before;
             let tr = refusing.try_step(&mut refused, x);
             check!(
-                if x.is_finite() {
-                    tr == t && bits(&refused) == bits(&tried)
-                } else {
-                    tr == Err(Error::NonFiniteInput) && bits(&refused) == bits(&before)
-                },
+                refusal_holds(x, (&t, &tried), (&tr, &refused), &before),
                 "{SP}: the refusing Yielding::try_step gave {tr:?} for the sample {x:?}"
             );
             bank.step(&mut r, x);
