@@ -11,6 +11,7 @@ records (one column a record, a time index in seconds or timedeltas).
 
 from __future__ import annotations
 
+import importlib
 import math
 from typing import Any, List, Optional, Sequence, Tuple, TypeVar
 
@@ -20,24 +21,23 @@ import numpy.typing as npt
 F64 = npt.NDArray[np.float64]
 
 
-def _pandas() -> Any:
+def optional(module: str, user: str, package: str) -> Any:
+    """``module`` imported on first use, or an ``ImportError`` saying that ``user`` needs the
+    optional dependency ``package`` and how to install it."""
     try:
-        import pandas
-    except ImportError as e:  # pragma: no cover - exercised without pandas only
+        return importlib.import_module(module)
+    except ImportError as e:  # pragma: no cover - exercised without the package only
         raise ImportError(
-            "to_pandas() needs pandas, an optional dependency of aemstep: pip install pandas"
+            f"{user} needs {package}, an optional dependency of aemstep: pip install {package}"
         ) from e
-    return pandas
+
+
+def _pandas() -> Any:
+    return optional("pandas", "to_pandas()", "pandas")
 
 
 def _xarray() -> Any:
-    try:
-        import xarray
-    except ImportError as e:  # pragma: no cover - exercised without xarray only
-        raise ImportError(
-            "to_xarray() needs xarray, an optional dependency of aemstep: pip install xarray"
-        ) from e
-    return xarray
+    return optional("xarray", "to_xarray()", "xarray")
 
 
 class History:

@@ -10,17 +10,13 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from . import frames
+
 
 def _axes(ax: Any) -> Any:
     if ax is not None:
         return ax
-    try:
-        import matplotlib.pyplot as plt
-    except ImportError as e:
-        raise ImportError(
-            "aemstep.plot needs matplotlib, an optional dependency of aemstep: "
-            "pip install matplotlib"
-        ) from e
+    plt = frames.optional("matplotlib.pyplot", "aemstep.plot", "matplotlib")
     _, new = plt.subplots()
     return new
 
