@@ -23,7 +23,7 @@ mod elcentro;
 
 use aemstep::Real;
 use aemstep::spectrum::NonFinite;
-use aemstep::spectrum::inelastic::{ConstantDuctility, Outcome, Search, Yielding, YieldResponse};
+use aemstep::spectrum::inelastic::{ConstantDuctility, Outcome, Search, YieldResponse, Yielding};
 
 const DT: f64 = elcentro::DT;
 
@@ -103,7 +103,11 @@ fn same<T: Real, const P: usize>(a: &YieldResponse<T, P>, b: &YieldResponse<T, P
 }
 
 /// The scalar path: `step` every sample, then the free vibration `response` appends.
-fn scalar<T: Real, const P: usize>(y: &Yielding<T, P>, rec: &[T], ay: &[T; P]) -> YieldResponse<T, P> {
+fn scalar<T: Real, const P: usize>(
+    y: &Yielding<T, P>,
+    rec: &[T],
+    ay: &[T; P],
+) -> YieldResponse<T, P> {
     let mut r = y.at_rest(ay).unwrap();
     for &a in rec {
         y.step(&mut r, a);
@@ -130,10 +134,22 @@ fn check_response<const P: usize>(lo: f64, hi: f64, n: usize) {
         ];
         for ay in &strengths {
             let what = format!("P = {P}, α = {alpha}, N = {n}, a_y = {ay:?}");
-            same(&y.response(clean, ay).unwrap(), &scalar(&y, clean, ay), &what);
-            same(&y.response(&holes, ay).unwrap(), &scalar(&y, &holes, ay), &what);
+            same(
+                &y.response(clean, ay).unwrap(),
+                &scalar(&y, clean, ay),
+                &what,
+            );
+            same(
+                &y.response(&holes, ay).unwrap(),
+                &scalar(&y, &holes, ay),
+                &what,
+            );
             let ay32 = ay.map(|a| a as f32);
-            same(&y32.response(clean32, &ay32).unwrap(), &scalar(&y32, clean32, &ay32), &what);
+            same(
+                &y32.response(clean32, &ay32).unwrap(),
+                &scalar(&y32, clean32, &ay32),
+                &what,
+            );
         }
     }
 }
@@ -155,7 +171,10 @@ fn spectra_digest<const P: usize>(lo: f64, hi: f64, rec: &[f64], policy: NonFini
             .unwrap()
             .with_non_finite(policy);
         for mu in [2.0, 4.0, 6.0] {
-            digest_cd(&mut h, &y.constant_ductility(rec, mu, &Search::DEFAULT).unwrap());
+            digest_cd(
+                &mut h,
+                &y.constant_ductility(rec, mu, &Search::DEFAULT).unwrap(),
+            );
         }
         let cs = y.constant_strength(rec, &[4.0; P]).unwrap();
         h.reals(&cs.elastic);
@@ -209,5 +228,13 @@ fn spectra_match_the_pinned_scalar_results_long() {
     assert_eq!(got, PINNED_LONG);
 }
 
-const PINNED_SHORT: [u64; 3] = [0x368f_6757_41c9_5a81, 0xd6b8_6942_65b5_1504, 0x720e_4af5_7b45_f344];
-const PINNED_LONG: [u64; 3] = [0x9c16_5d57_30bd_f58f, 0x975e_84cc_316b_eba9, 0x14f9_f104_59d2_03ed];
+const PINNED_SHORT: [u64; 3] = [
+    0x368f_6757_41c9_5a81,
+    0xd6b8_6942_65b5_1504,
+    0x720e_4af5_7b45_f344,
+];
+const PINNED_LONG: [u64; 3] = [
+    0x9c16_5d57_30bd_f58f,
+    0x975e_84cc_316b_eba9,
+    0x14f9_f104_59d2_03ed,
+];

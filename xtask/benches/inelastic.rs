@@ -37,7 +37,8 @@ fn fastest(id: &str, reps: usize, f: &mut dyn FnMut() -> u64) {
 
 fn main() {
     let rec: &[f64] = &elcentro::AG_F64;
-    let banks = [0.0, 0.05].map(|a| Yielding::<f64, P>::new(periods(), [0.05; P], a, DT).expect("bank"));
+    let banks =
+        [0.0, 0.05].map(|a| Yielding::<f64, P>::new(periods(), [0.05; P], a, DT).expect("bank"));
     println!(
         "# {P} periods 0.05-3 s, El Centro {} samples; sub-steps a sample {}",
         rec.len(),
@@ -47,7 +48,9 @@ fn main() {
         let mut passes = 0;
         for b in &banks {
             for mu in [2.0, 4.0, 6.0] {
-                let cd = b.constant_ductility(black_box(rec), mu, &Search::DEFAULT).expect("cd");
+                let cd = b
+                    .constant_ductility(black_box(rec), mu, &Search::DEFAULT)
+                    .expect("cd");
                 passes += cd.passes as u64;
             }
         }
