@@ -1,5 +1,5 @@
 """The inelastic spectra step their oscillators in SIMD lanes, packed by the search (only
-the unfinished trials of a constant-ductility pass are stepped, 8 a group): a period's
+the unfinished trials of a constant-ductility pass are stepped, 4 a group): a period's
 result must not depend on which other periods share its bank, its lanes or its passes.
 Each period computed alone (one oscillator, the rest of its bank padding) must give the
 bits of the same period within 20 others, for both laws, under ``nan="skip"``, on 1 and

@@ -71,13 +71,14 @@
 //! ([`Yielding::substeps_per_sample`]; on the host, x86-64, about 8 ns per oscillator
 //! sub-step in `f64` and 9 in `f32`: a serial chain per oscillator, not vectorized across
 //! the bank; it is the step the Cortex-M firmware and streaming use). The record-level
-//! calls ([`Yielding::response`] and the spectra) instead step the oscillators 8 at a time
+//! calls ([`Yielding::response`] and the spectra) instead step the oscillators 4 at a time
 //! side by side in SIMD lanes (`f64 × 4` with AVX, chosen at run time, `× 2` on SSE2), each
 //! group over the whole record, a lane with fewer sub-steps a sample than its group's
 //! most frozen for the rest (its state kept by a select), with exactly the scalar step's
-//! operations: the same bits (`tests/inelastic_lanes.rs`), measured 1.6× faster a pass at
-//! 40 periods 0.05–3 s (`cargo bench -p xtask --bench inelastic`); the
-//! constant-ductility search steps only the trials not yet finished. A *record pass* is `N` samples plus
+//! operations: the same bits (`tests/inelastic_lanes.rs`); the constant-ductility search
+//! steps only the trials not yet finished. Measured (host timing, `cargo bench -p xtask
+//! --bench inelastic`, 40 periods 0.05–3 s, El Centro, 240 searches): 2.0 s before, 0.55 s
+//! after. A *record pass* is `N` samples plus
 //! [`Yielding::free_vibration_samples`] of free vibration: the constant-strength spectrum
 //! takes 2 passes, the constant-ductility spectrum `1 + (points − 1) + refinement` at most
 //! (see [`Yielding::constant_ductility`]; the passes are reported). No allocation, no
@@ -721,7 +722,7 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// ([`first_non_finite`](super::first_non_finite) gives its index);
     /// [`Error::NonFiniteState`] if a finite sample made the response overflow;
     /// [`Error::OperatorOverflow`] if a ductility overflows. Cost: `N + ⌈T_max/h⌉` steps,
-    /// the oscillators stepped 8 at a time in SIMD lanes, each group `max n_p` sub-steps a
+    /// the oscillators stepped 4 at a time in SIMD lanes, each group `max n_p` sub-steps a
     /// sample (the module's **Cost**); the result is the bits of [`Yielding::step`] and
     /// [`Yielding::free_vibration`] sample by sample.
     pub fn response(
@@ -853,7 +854,7 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     ///    grid points.
     ///
     /// The oscillators search in lockstep: each pass steps every oscillator whose search is
-    /// not finished, with its own trial strength, packed into SIMD lanes (8 trials a
+    /// not finished, with its own trial strength, packed into SIMD lanes (4 trials a
     /// group; [`Yielding::response`]), so the number of passes is the slowest one's and
     /// their cost falls as the searches finish. The result is the bits of stepping every
     /// trial alone with [`Yielding::step`].
@@ -993,9 +994,12 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     }
 }
 
-/// Oscillators a group of the record pass steps side by side ([`Yielding::pass`]): 8, two
-/// AVX registers of `f64` (4 of SSE2), so that two independent sub-step chains overlap.
-const LANES: usize = 8;
+/// Oscillators a group of the record pass steps side by side ([`Yielding::pass`]): 4, one
+/// AVX register of `f64` (two of SSE2). Measured against 8 (two chains overlapping, but
+/// more lanes frozen while the group's shortest periods finish their sub-steps): the
+/// 240-search constant-ductility benchmark took 0.55 s with 4 and 0.81 s with 8 (host
+/// timing, load 6–7 on 2 cores: `cargo bench -p xtask --bench inelastic`).
+const LANES: usize = 4;
 
 /// `L` oscillators of a [`Yielding`] bank and their responses, structure-of-arrays: each
 /// quantity `[T; L]`, the sub-step counts as `T` (exact: at most
