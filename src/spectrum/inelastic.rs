@@ -70,7 +70,15 @@
 //! **Cost**: [`Yielding::step`] is `Σ_p n_p` sub-steps per sample
 //! ([`Yielding::substeps_per_sample`]; on the host, x86-64, about 8 ns per oscillator
 //! sub-step in `f64` and 9 in `f32`: a serial chain per oscillator, not vectorized across
-//! the bank). A *record pass* is `N` samples plus
+//! the bank; it is the step the Cortex-M firmware and streaming use). The record-level
+//! calls ([`Yielding::response`] and the spectra) instead step the oscillators 4 at a time
+//! side by side in SIMD lanes (`f64 × 4` with AVX, chosen at run time, `× 2` on SSE2), each
+//! group over the whole record, a lane with fewer sub-steps a sample than its group's
+//! most frozen for the rest (its state kept by a select), with exactly the scalar step's
+//! operations: the same bits (`tests/inelastic_lanes.rs`); the constant-ductility search
+//! steps only the trials not yet finished. Measured (host timing, `cargo bench -p xtask
+//! --bench inelastic`, 40 periods 0.05–3 s, El Centro, 240 searches): 2.0 s before, 0.55 s
+//! after. A *record pass* is `N` samples plus
 //! [`Yielding::free_vibration_samples`] of free vibration: the constant-strength spectrum
 //! takes 2 passes, the constant-ductility spectrum `1 + (points − 1) + refinement` at most
 //! (see [`Yielding::constant_ductility`]; the passes are reported). No allocation, no
@@ -634,6 +642,67 @@ impl<T: Real, const P: usize> Yielding<T, P> {
         }
     }
 
+    /// One record pass of the oscillators `live[p]` from `r` (at rest): every sample of
+    /// `record` as [`Yielding::step`] then `tail` samples of free vibration as
+    /// [`Yielding::free_vibration`], the live oscillators packed [`LANES`] to a group and
+    /// each group stepped over the whole record side by side, through the crate's run-time
+    /// AVX choice (`linalg::wide`: `f64 × 4` with AVX, `× 2` on SSE2). Bit-identical to
+    /// the scalar step (see [`Group::advance`]); the oscillators not live stay at rest
+    /// and `r`'s sample counters advance as [`Yielding::step`]'s.
+    fn pass(&self, r: &mut YieldResponse<T, P>, record: &[T], tail: u32, live: &[bool; P]) {
+        crate::linalg::wide(|| self.pass_lanes::<LANES>(r, record, tail, live));
+    }
+
+    #[inline(always)]
+    fn pass_lanes<const L: usize>(
+        &self,
+        r: &mut YieldResponse<T, P>,
+        record: &[T],
+        tail: u32,
+        live: &[bool; P],
+    ) {
+        let mut idx = [0usize; P];
+        let mut m = 0;
+        for p in 0..P {
+            if live[p] {
+                idx[m] = p;
+                m += 1;
+            }
+        }
+        let mut start = 0;
+        while start < m {
+            let end = if start + L < m { start + L } else { m };
+            // A group short of `L` fills its lanes with copies of its last oscillator,
+            // stepped and not written back.
+            let lane: [usize; L] = core::array::from_fn(|l| idx[(start + l).min(end - 1)]);
+            let mut g = Group::gather(self, r, &lane);
+            let (mut last, mut samples, mut skipped) = (r.last, r.samples, r.skipped);
+            for &a in record {
+                if let Some((a0, a1)) = super::take_sample(&mut last, &mut samples, &mut skipped, a)
+                {
+                    g.advance(a0, a1);
+                }
+            }
+            if samples != 0 {
+                let zero = T::from_f64_rounded(0.0);
+                for _ in 0..tail {
+                    let a0 = last;
+                    last = zero;
+                    g.advance(a0, zero);
+                }
+            }
+            g.scatter(r, &lane[..end - start]);
+            start = end;
+        }
+        // The sample counters, as the scalar steps leave them.
+        for &a in record {
+            let _ = super::take_sample(&mut r.last, &mut r.samples, &mut r.skipped, a);
+        }
+        if r.samples != 0 && tail > 0 {
+            r.last = T::from_f64_rounded(0.0);
+        }
+    }
+
     /// The response to a whole record: every sample of `record` (m/s², sample interval
     /// [`Yielding::time_step`]) then [`Yielding::free_vibration_samples`] of free
     /// vibration, from rest, with strengths `yield_acceleration` (m/s², as
@@ -652,19 +721,32 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// [`Error::NonFiniteInput`] if a sample is not finite and the policy refuses it
     /// ([`first_non_finite`](super::first_non_finite) gives its index);
     /// [`Error::NonFiniteState`] if a finite sample made the response overflow;
-    /// [`Error::OperatorOverflow`] if a ductility overflows. Cost: `N + ⌈T_max/h⌉` steps.
+    /// [`Error::OperatorOverflow`] if a ductility overflows. Cost: `N + ⌈T_max/h⌉` steps,
+    /// the oscillators stepped 4 at a time in SIMD lanes, each group `max n_p` sub-steps a
+    /// sample (the module's **Cost**); the result is the bits of [`Yielding::step`] and
+    /// [`Yielding::free_vibration`] sample by sample.
     pub fn response(
         &self,
         record: &[T],
         yield_acceleration: &[T; P],
     ) -> Result<YieldResponse<T, P>, Error> {
+        self.response_of(record, yield_acceleration, &[true; P])
+    }
+
+    /// [`Yielding::response`] of the oscillators `live[p]` only, the others left at rest
+    /// (their trial finished: the constant-ductility search steps only the unfinished ones).
+    /// The live oscillators are stepped in lanes ([`Yielding::pass`]): the bits of
+    /// [`Yielding::step`].
+    fn response_of(
+        &self,
+        record: &[T],
+        yield_acceleration: &[T; P],
+        live: &[bool; P],
+    ) -> Result<YieldResponse<T, P>, Error> {
         let mut r = self.at_rest(yield_acceleration)?;
         let tail = super::checked_tail(&self.period, self.time_step)?;
         super::check_record(self.non_finite, record)?;
-        for &a in record {
-            self.step(&mut r, a);
-        }
-        self.free_vibration(&mut r, tail);
+        self.pass(&mut r, record, tail, live);
         if !r.is_finite() {
             return Err(Error::NonFiniteState);
         }
@@ -771,8 +853,11 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     ///    is not its largest can be found only if `μ` crosses `μ_t` three times between two
     ///    grid points.
     ///
-    /// The oscillators search in lockstep: each pass steps every oscillator with its own
-    /// trial strength, so the cost is the passes of the slowest one.
+    /// The oscillators search in lockstep: each pass steps every oscillator whose search is
+    /// not finished, with its own trial strength, packed into SIMD lanes (4 trials a
+    /// group; [`Yielding::response`]), so the number of passes is the slowest one's and
+    /// their cost falls as the searches finish. The result is the bits of stepping every
+    /// trial alone with [`Yielding::step`].
     ///
     /// Errors: [`Error::InvalidParameter`] if `target` is not finite and `> 1`, a setting of
     /// `search` is out of range ([`Search`]; its `tol` below `4 ε` of `T`), or the record
@@ -858,7 +943,10 @@ impl<T: Real, const P: usize> Yielding<T, P> {
                     T::from_f64_rounded(f64::INFINITY)
                 }
             });
-            let mu = self.response(record, &trial)?.ductility();
+            // Only the unfinished trials are stepped: a finished one would step with
+            // `a_y = +∞`, the elastic pass again, whose response is finite (it was checked).
+            let live: [bool; P] = core::array::from_fn(|p| s[p].outcome.is_none());
+            let mu = self.response_of(record, &trial, &live)?.ductility();
             passes += 1;
             for p in 0..P {
                 if s[p].outcome.is_none() {
@@ -903,6 +991,149 @@ impl<T: Real, const P: usize> Yielding<T, P> {
     /// Cost: a sum over the bank.
     pub fn substeps_per_sample(&self) -> u32 {
         self.n.iter().map(|&n| n as u32).sum()
+    }
+}
+
+/// Oscillators a group of the record pass steps side by side ([`Yielding::pass`]): 4, one
+/// AVX register of `f64` (two of SSE2). Measured against 8 (two chains overlapping, but
+/// more lanes frozen while the group's shortest periods finish their sub-steps): the
+/// 240-search constant-ductility benchmark took 0.55 s with 4 and 0.81 s with 8 (host
+/// timing, load 6–7 on 2 cores: `cargo bench -p xtask --bench inelastic`).
+const LANES: usize = 4;
+
+/// `L` oscillators of a [`Yielding`] bank and their responses, structure-of-arrays: each
+/// quantity `[T; L]`, the sub-step counts as `T` (exact: at most
+/// [`MAX_SUBSTEPS`](super::MAX_SUBSTEPS)) so that every per-lane choice is a select
+/// between two values of `T`.
+struct Group<T, const L: usize> {
+    w2: [T; L],
+    inv_w2: [T; L],
+    aw2: [T; L],
+    hard: [T; L],
+    four_h: [T; L],
+    two_h: [T; L],
+    inv_de: [T; L],
+    inv_dp: [T; L],
+    inv_n: [T; L],
+    lim: [T; L],
+    n: [T; L],
+    /// The most sub-steps of a lane.
+    most: u16,
+    u: [T; L],
+    v: [T; L],
+    f: [T; L],
+    sd: [T; L],
+    work: [T; L],
+    plastic: [T; L],
+    yielding: [u32; L],
+}
+
+impl<T: Real, const L: usize> Group<T, L> {
+    /// The coefficients and states of the oscillators `lane` (indices into the bank).
+    #[inline(always)]
+    fn gather<const P: usize>(
+        y: &Yielding<T, P>,
+        r: &YieldResponse<T, P>,
+        lane: &[usize; L],
+    ) -> Self {
+        let of = |a: &[T; P]| -> [T; L] { core::array::from_fn(|l| a[lane[l]]) };
+        let mut most = 0;
+        for &p in lane {
+            most = most.max(y.n[p]);
+        }
+        Group {
+            w2: of(&y.w2),
+            inv_w2: of(&y.inv_w2),
+            aw2: of(&y.aw2),
+            hard: of(&y.hard),
+            four_h: of(&y.four_h),
+            two_h: of(&y.two_h),
+            inv_de: of(&y.inv_de),
+            inv_dp: of(&y.inv_dp),
+            inv_n: of(&y.inv_n),
+            lim: of(&r.lim),
+            n: core::array::from_fn(|l| T::from_f64_rounded(y.n[lane[l]] as f64)),
+            most,
+            u: of(&r.u),
+            v: of(&r.v),
+            f: of(&r.f),
+            sd: of(&r.sd),
+            work: of(&r.work),
+            plastic: of(&r.plastic),
+            yielding: core::array::from_fn(|l| r.yielding[lane[l]]),
+        }
+    }
+
+    /// Write lanes `0..lane.len()` back to the oscillators `lane`.
+    #[inline(always)]
+    fn scatter<const P: usize>(&self, r: &mut YieldResponse<T, P>, lane: &[usize]) {
+        for (l, &p) in lane.iter().enumerate() {
+            r.u[p] = self.u[l];
+            r.v[p] = self.v[l];
+            r.f[p] = self.f[l];
+            r.sd[p] = self.sd[l];
+            r.work[p] = self.work[l];
+            r.plastic[p] = self.plastic[l];
+            r.yielding[p] = self.yielding[l];
+        }
+    }
+
+    /// One sample interval `a0 → a1` of every lane: [`Yielding`]'s private `advance`,
+    /// the same operations in the same order on each lane, its branches as selects, for
+    /// `most` sub-steps; a lane past its own `n_p` computes and keeps its state (a select
+    /// of the old values), so each lane's result is the scalar one bit for bit (packed
+    /// `add`/`mul`/compare round each lane as the scalar instruction does; Rust fuses
+    /// nothing). The sub-steps on which a lane yielded are summed in `T` over the
+    /// sample (exact: at most `MAX_SUBSTEPS`) and added to its `u32` count saturating,
+    /// as the scalar step's one at a time.
+    #[inline(always)]
+    fn advance(&mut self, a0: T, a1: T) {
+        let d = a1 - a0;
+        let zero = T::from_f64_rounded(0.0);
+        let one = T::from_f64_rounded(1.0);
+        let half = T::from_f64_rounded(0.5);
+        let dl: [T; L] = core::array::from_fn(|l| d * self.inv_n[l]);
+        let mut g = [a0; L];
+        let mut count = [zero; L];
+        for k in 1..=self.most {
+            let kt = T::from_f64_rounded(k as f64);
+            for l in 0..L {
+                let (u, v, f) = (self.u[l], self.v[l], self.f[l]);
+                let (lim, aw2) = (self.lim[l], self.aw2[l]);
+                let live = kt <= self.n[l];
+                let g1 = if kt == self.n[l] { a1 } else { g[l] + dl[l] };
+                let b = self.four_h[l] * v - f - (g[l] + g1);
+                let du_e = (b - f) * self.inv_de[l];
+                let u_e = u + du_e;
+                let f_e = f + self.w2[l] * du_e;
+                let q = f_e - aw2 * u_e;
+                let slim = if q > zero { lim } else { -lim };
+                let u_p = u + (b - aw2 * u - slim) * self.inv_dp[l];
+                let f_p = aw2 * u_p + slim;
+                let yields = q > lim || -q > lim;
+                let u1 = if yields { u_p } else { u_e };
+                let f1 = if yields { f_p } else { f_e };
+                let v1 = self.two_h[l] * (u1 - u) - v;
+                let ddp = (u1 - u) - (f1 - f) * self.inv_w2[l];
+                let ddp = if yields { ddp } else { zero };
+                let work = self.work[l] + ddp * (f1 - half * self.hard[l] * ddp);
+                let plastic = self.plastic[l] + if ddp > zero { ddp } else { -ddp };
+                let au = if u1 > zero { u1 } else { -u1 };
+                let sd = self.sd[l];
+                let sd = if au > sd { au } else { sd };
+                self.u[l] = if live { u1 } else { u };
+                self.v[l] = if live { v1 } else { v };
+                self.f[l] = if live { f1 } else { f };
+                g[l] = if live { g1 } else { g[l] };
+                self.work[l] = if live { work } else { self.work[l] };
+                self.plastic[l] = if live { plastic } else { self.plastic[l] };
+                self.sd[l] = if live { sd } else { self.sd[l] };
+                count[l] += if live && yields { one } else { zero };
+            }
+        }
+        for l in 0..L {
+            self.yielding[l] = self.yielding[l].saturating_add(count[l].as_f64() as u32);
+        }
     }
 }
 
