@@ -14,6 +14,10 @@
 //! `f64` temporaries) and [`DynLinear::start`] (`7N` values of `T` in the state); stepping
 //! allocates nothing.
 
+mod building;
+
+pub use building::{DynBuildingState, DynNonlinear, DynShearBuilding};
+
 use std::vec;
 use std::vec::Vec;
 

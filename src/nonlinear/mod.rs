@@ -304,6 +304,13 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         self.settings
     }
 
+    /// The step's kinematics `h`, `h/2`, `h²/4` in `T` (the run-time-sized stepper, `std`,
+    /// takes them from here: one check and one rounding). Cost: O(1).
+    #[cfg(feature = "std")]
+    pub(crate) fn kinematics(&self) -> AemKinematics<T> {
+        self.kin
+    }
+
     /// The state at `t = 0`, with `q0 = M⁻¹ (p0 − F(u0, v0))` (paper eq. 45).
     ///
     /// Errors: [`Error::NonFiniteInput`] (`u0`, `v0`, `p0` or `M`),
@@ -501,20 +508,21 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
             }
             last_branch = branch;
             let r = mq + f - p;
-            let residual = relative_residual(&r, &mq, &f, p_size);
-            let correction = if iterations == 0 {
-                T::zero()
-            } else {
-                let reference = norm_inf(&q).max(norm_inf(&u) / c).max(norm_inf(&v) / b);
-                if last_delta <= T::zero() {
-                    T::zero()
-                } else if reference > T::zero() {
-                    last_delta / reference
-                } else {
-                    T::one()
-                }
-            };
-            let converged = residual <= tol || (iterations > 0 && correction <= tol);
+            let (residual, correction, converged) = judge(
+                Iterate {
+                    r: r.as_slice(),
+                    mq: mq.as_slice(),
+                    f: f.as_slice(),
+                    q: q.as_slice(),
+                    u: u.as_slice(),
+                    v: v.as_slice(),
+                },
+                p_size,
+                (b, c),
+                iterations,
+                last_delta,
+                tol,
+            );
             let done = iterations >= budget || (!fixed && converged);
             if done {
                 let next = State::unchecked(u, v, q, state.n.wrapping_add(1));
@@ -620,18 +628,16 @@ impl<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>
         if !t.stiffness.is_finite() || !t.damping.is_finite() {
             return Err(Error::NonFiniteForce);
         }
-        let (m, d, k) = (&t.mass, &t.damping, &t.stiffness);
-        let mut scale = T::zero();
         let mut j = SymTridiagonal::zero();
-        for i in 0..N {
-            j.diagonal[i] = m.diagonal[i] + b * d.diagonal[i] + c * k.diagonal[i];
-            scale =
-                scale.max(m.diagonal[i].abs() + b * d.diagonal[i].abs() + c * k.diagonal[i].abs());
-            if i > 0 {
-                j.off[i] = m.off[i] + b * d.off[i] + c * k.off[i];
-                scale = scale.max(m.off[i].abs() + b * d.off[i].abs() + c * k.off[i].abs());
-            }
-        }
+        let scale = jacobian_flat(
+            [t.mass.diagonal.as_slice(), t.mass.off.as_slice()],
+            [t.damping.diagonal.as_slice(), t.damping.off.as_slice()],
+            [t.stiffness.diagonal.as_slice(), t.stiffness.off.as_slice()],
+            b,
+            c,
+            &mut j.diagonal.data.0[0],
+            &mut j.off.data.0[0],
+        );
         let rhs = *r;
         if tridiagonal::solve_positive(&j, r, scale) {
             return Ok(());
@@ -764,23 +770,91 @@ fn all_finite<T: Real, const N: usize>(x: &SVector<T, N>) -> bool {
 }
 
 fn norm_inf<T: Real, const N: usize>(x: &SVector<T, N>) -> T {
+    norm_inf_flat(x.as_slice())
+}
+
+/// `‖x‖∞`, folded in index order. Cost: `n`.
+#[inline(always)]
+pub(crate) fn norm_inf_flat<T: Real>(x: &[T]) -> T {
     x.iter().fold(T::zero(), |s, e| s.max(e.abs()))
 }
 
-/// `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` (`p_size = ‖p‖∞`), `0` when the denominator is zero
-/// (then `r = 0` too).
-fn relative_residual<T: Real, const N: usize>(
-    r: &SVector<T, N>,
-    mq: &SVector<T, N>,
-    f: &SVector<T, N>,
+/// One Newton iterate as the convergence test reads it (each slice of `N` values): the
+/// residual `r = M q + F − p`, `M q`, `F`, and the iterate's `q`, `u`, `v`.
+#[derive(Clone, Copy)]
+pub(crate) struct Iterate<'a, T> {
+    pub(crate) r: &'a [T],
+    pub(crate) mq: &'a [T],
+    pub(crate) f: &'a [T],
+    pub(crate) q: &'a [T],
+    pub(crate) u: &'a [T],
+    pub(crate) v: &'a [T],
+}
+
+/// The convergence test of every Newton iterate ([`NewtonSettings::tolerance`]), shared by
+/// the const-generic and the run-time-sized (`std`) iterations: `(residual, correction,
+/// converged)` of iterate `x` after `iterations` Newton corrections, the last of size
+/// `last_delta` (`‖δq‖∞`), with `p_size = ‖p‖∞` and `(b, c) = (h/2, h²/4)`. The relative
+/// residual `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` is `0` when the denominator is (then
+/// `r = 0` too). Cost: `7N` comparisons, 3 divisions.
+#[inline(always)]
+pub(crate) fn judge<T: Real>(
+    x: Iterate<'_, T>,
     p_size: T,
-) -> T {
-    let scale = norm_inf(mq).max(norm_inf(f)).max(p_size);
-    if scale > T::zero() {
-        norm_inf(r) / scale
+    (b, c): (T, T),
+    iterations: u32,
+    last_delta: T,
+    tol: T,
+) -> (T, T, bool) {
+    let scale = norm_inf_flat(x.mq).max(norm_inf_flat(x.f)).max(p_size);
+    let residual = if scale > T::zero() {
+        norm_inf_flat(x.r) / scale
     } else {
         T::zero()
+    };
+    let correction = if iterations == 0 {
+        T::zero()
+    } else {
+        let reference = norm_inf_flat(x.q)
+            .max(norm_inf_flat(x.u) / c)
+            .max(norm_inf_flat(x.v) / b);
+        if last_delta <= T::zero() {
+            T::zero()
+        } else if reference > T::zero() {
+            last_delta / reference
+        } else {
+            T::one()
+        }
+    };
+    let converged = residual <= tol || (iterations > 0 && correction <= tol);
+    (residual, correction, converged)
+}
+
+/// The Newton matrix `J = M + b ∂F/∂v + c ∂F/∂u` on three diagonals (`jd`, `jo`; `jo[0]`
+/// left as it is) from the bands `[diagonal, off]` of `M`, `∂F/∂v` (`d`) and `∂F/∂u`
+/// (`k`), and its entry scale `max |M| + b |∂F/∂v| + c |∂F/∂u|` for the pivot tests: the
+/// one assembly of the const-generic and the run-time-sized (`std`) tridiagonal Newton
+/// paths. Every slice holds `n = jd.len()` values. Cost: `16n` flops.
+#[inline(always)]
+pub(crate) fn jacobian_flat<T: Real>(
+    [md, mo]: [&[T]; 2],
+    [dd, doff]: [&[T]; 2],
+    [kd, ko]: [&[T]; 2],
+    b: T,
+    c: T,
+    jd: &mut [T],
+    jo: &mut [T],
+) -> T {
+    let mut scale = T::zero();
+    for i in 0..jd.len() {
+        jd[i] = md[i] + b * dd[i] + c * kd[i];
+        scale = scale.max(md[i].abs() + b * dd[i].abs() + c * kd[i].abs());
+        if i > 0 {
+            jo[i] = mo[i] + b * doff[i] + c * ko[i];
+            scale = scale.max(mo[i].abs() + b * doff[i].abs() + c * ko[i].abs());
+        }
     }
+    scale
 }
 
 /// The state at step 0 with the acceleration from the equation of motion,
