@@ -16,7 +16,7 @@
 
 mod building;
 
-pub use building::{DynBuildingState, DynNonlinear, DynShearBuilding};
+pub use building::{DynBuildingState, DynEnergyAccount, DynNonlinear, DynShearBuilding};
 
 use std::vec;
 use std::vec::Vec;

@@ -7,7 +7,7 @@
 use std::vec;
 use std::vec::Vec;
 
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVectorView};
 
 use crate::hysteresis::{Bands, Law, check_building, storeys_flat};
 use crate::kinematics::{AemKinematics, Kinematics};
@@ -623,4 +623,253 @@ fn dense_jacobian<T: Real, L: Law<T>>(
         }
     }
     Ok(scale)
+}
+
+/// The energy balance of a [`DynShearBuilding`] run (feature `std`):
+/// [`EnergyAccount`](crate::hysteresis::EnergyAccount) at a run-time size, the same
+/// balance, quadrature and order of operations,
+///
+/// ```text
+/// E₀ + E_in = E_k + E_s + E_v + E_h + error
+/// E_in = ∫ p·du      E_k = ½ vᵀ M v      E_s = Σ recoverable strain energy of the storeys
+/// E_v = ∫ (C v)·du   E_h = Σᵢ ∫ fᵢ dδᵢ − (E_s − E_s,₀)
+/// ```
+///
+/// each integral by the trapezoidal rule per step. Units: J with SI inputs. It keeps the
+/// history committed before the step itself, so [`DynEnergyAccount::step`] takes only the
+/// state after it.
+///
+/// Size: `12N` values of `T` and `N` histories, allocated by
+/// [`DynEnergyAccount::start`]. Cost per step: `N` law trials (the storey forces) and `N`
+/// recoverable energies, `C v` (`5N` flops with a tridiagonal `C`, `N²` otherwise) and
+/// `15N` flops; no allocation.
+///
+/// ```
+/// use aemstep::hysteresis::Bilinear;
+/// use aemstep::nalgebra::DMatrix;
+/// use aemstep::{DynEnergyAccount, DynNonlinear, DynShearBuilding, NewtonSettings};
+///
+/// let n = 11;
+/// let c = DMatrix::from_fn(n, n, |i, j| if i == j { 2e4 } else { 0.0 }); // N·s/m
+/// let building = DynShearBuilding::new(&vec![1e5; n], vec![Bilinear::<f64>::new(1e8, 2e5, 0.05)?; n], &c)?;
+/// let stepper = DynNonlinear::<f64>::new(0.005, NewtonSettings::default())?;
+/// let (zero, mut p) = (vec![0.0; n], vec![0.0; n]);
+/// let mut s = stepper.start(&building, &zero, &zero, &zero)?;
+/// let mut account = DynEnergyAccount::start(&building, &s, &zero);
+/// for step in 1..=400 {
+///     building.ground_load(6.0 * (8.0 * 0.005 * step as f64).sin(), &mut p); // N
+///     stepper.try_step(&building, &mut s, &p)?;
+///     account.step(&building, &s, &p);
+/// }
+/// assert!(account.hysteretic > 0.0); // it yielded
+/// assert!(account.max_balance_error()? <= 1e-6 * account.max_input());
+/// # Ok::<(), aemstep::Error>(())
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct DynEnergyAccount<T, H> {
+    /// `E₀`: kinetic plus recoverable energy at the start (J).
+    pub initial: T,
+    /// `E_in = ∫ p·du`: work of the loads since the start (J).
+    pub input: T,
+    /// `E_k = ½ vᵀ M v` now (J).
+    pub kinetic: T,
+    /// `E_s`: the storeys' recoverable strain energy now (J).
+    pub recoverable: T,
+    /// `E_v = ∫ (C v)·du`: dissipated by the linear damping since the start (J).
+    pub viscous: T,
+    /// `E_h`: dissipated by the storey laws since the start (J).
+    pub hysteretic: T,
+    storey_work: T,
+    recoverable0: T,
+    max_input: T,
+    max_error: T,
+    /// At the last accounted step: `u`, the load, `C v`, the storey forces `f_i`, the
+    /// committed history.
+    u: Vec<T>,
+    load: Vec<T>,
+    damping_force: Vec<T>,
+    storey_force: Vec<T>,
+    history: Vec<H>,
+    /// Scratch: the new `C v` and `f_i`, `du`, its drifts, a sum of two vectors.
+    new_damping: Vec<T>,
+    new_storey: Vec<T>,
+    du: Vec<T>,
+    d_drift: Vec<T>,
+    sum: Vec<T>,
+}
+
+impl<T: Real, H: Copy> DynEnergyAccount<T, H> {
+    /// The account at the start of a run: the state [`DynNonlinear::start`] returned and
+    /// the load `load` (N, `N` values) it started with. Cost: as a step; allocates.
+    pub fn start<L: Law<T, History = H>>(
+        building: &DynShearBuilding<T, L>,
+        state: &DynBuildingState<T, H>,
+        load: &[T],
+    ) -> Self {
+        let n = building.size();
+        let zeros = || vec![T::zero(); n];
+        let (u, v) = (state.u(), state.v());
+        let kinetic = kinetic(building, v);
+        let recoverable = recoverable(building, state.history(), u);
+        let mut a = Self {
+            initial: kinetic + recoverable,
+            input: T::zero(),
+            kinetic,
+            recoverable,
+            viscous: T::zero(),
+            hysteretic: T::zero(),
+            storey_work: T::zero(),
+            recoverable0: recoverable,
+            max_input: T::zero(),
+            max_error: T::zero(),
+            u: u.to_vec(),
+            load: load.to_vec(),
+            damping_force: zeros(),
+            storey_force: zeros(),
+            history: state.history().to_vec(),
+            new_damping: zeros(),
+            new_storey: zeros(),
+            du: zeros(),
+            d_drift: zeros(),
+            sum: zeros(),
+        };
+        damping_force(building, v, &mut a.damping_force);
+        storey_forces(building, &a.history, u, v, &mut a.storey_force);
+        a
+    }
+
+    /// Account for one accepted step: `state` after it, `load` its end load (N, `N`
+    /// values). Call it only after a step succeeded. Cost: see [`DynEnergyAccount`]; no
+    /// allocation.
+    pub fn step<L: Law<T, History = H>>(
+        &mut self,
+        building: &DynShearBuilding<T, L>,
+        state: &DynBuildingState<T, H>,
+        load: &[T],
+    ) {
+        let half = T::from_f64_rounded(0.5);
+        let (u, v) = (state.u(), state.v());
+        for ((du, &u), &u0) in self.du.iter_mut().zip(u).zip(&self.u) {
+            *du = u - u0;
+        }
+        damping_force(building, v, &mut self.new_damping);
+        // The storey forces at the accepted (u, v) from the history before the step.
+        storey_forces(building, &self.history, u, v, &mut self.new_storey);
+        for i in 0..self.du.len() {
+            self.d_drift[i] = if i == 0 {
+                self.du[0]
+            } else {
+                self.du[i] - self.du[i - 1]
+            };
+        }
+        let dot = |sum: &mut [T], a: &[T], b: &[T], x: &[T]| {
+            for ((s, &a), &b) in sum.iter_mut().zip(a).zip(b) {
+                *s = a + b;
+            }
+            let n = x.len();
+            DVectorView::from_slice(sum, n).dot(&DVectorView::from_slice(x, n))
+        };
+        self.input += dot(&mut self.sum, &self.load, load, &self.du) * half;
+        self.viscous += dot(
+            &mut self.sum,
+            &self.damping_force,
+            &self.new_damping,
+            &self.du,
+        ) * half;
+        self.storey_work += dot(
+            &mut self.sum,
+            &self.storey_force,
+            &self.new_storey,
+            &self.d_drift,
+        ) * half;
+        self.kinetic = kinetic(building, v);
+        self.recoverable = recoverable(building, state.history(), u);
+        self.hysteretic = self.storey_work - (self.recoverable - self.recoverable0);
+        self.u.copy_from_slice(u);
+        self.load.copy_from_slice(load);
+        core::mem::swap(&mut self.damping_force, &mut self.new_damping);
+        core::mem::swap(&mut self.storey_force, &mut self.new_storey);
+        self.history.copy_from_slice(state.history());
+        self.max_input = self.max_input.max(self.input.abs());
+        // Not `max`, which drops a NaN: a non-finite balance sticks.
+        let e = self.balance_error().abs();
+        #[allow(clippy::eq_op)]
+        let nan = e != e;
+        if e > self.max_error || nan {
+            self.max_error = e;
+        }
+    }
+
+    /// `E₀ + E_in − (E_k + E_s + E_v + E_h)` now (J). Cost: 5 flops.
+    pub fn balance_error(&self) -> T {
+        self.initial + self.input
+            - (self.kinetic + self.recoverable + self.viscous + self.hysteretic)
+    }
+
+    /// The largest `|balance_error|` over the steps accounted so far (J).
+    ///
+    /// Errors: [`Error::NonFiniteState`] if the balance of a step accounted was NaN or
+    /// infinite. Cost: O(1).
+    pub fn max_balance_error(&self) -> Result<T, Error> {
+        if self.max_error.is_finite() {
+            Ok(self.max_error)
+        } else {
+            Err(Error::NonFiniteState)
+        }
+    }
+
+    /// The largest `|E_in|` over the steps accounted so far (J). Cost: O(1).
+    pub fn max_input(&self) -> T {
+        self.max_input
+    }
+}
+
+/// `½ vᵀ M v` with the lumped masses, summed in floor order as the const account.
+fn kinetic<T: Real, L: Law<T>>(building: &DynShearBuilding<T, L>, v: &[T]) -> T {
+    building
+        .masses
+        .iter()
+        .zip(v)
+        .fold(T::zero(), |e, (&m, &v)| e + m * v * v)
+        * T::from_f64_rounded(0.5)
+}
+
+/// The storeys' recoverable energy at `u` and `history`, summed in storey order.
+fn recoverable<T: Real, L: Law<T>>(
+    building: &DynShearBuilding<T, L>,
+    history: &[L::History],
+    u: &[T],
+) -> T {
+    (0..u.len()).fold(T::zero(), |e, i| {
+        let d = if i == 0 { u[0] } else { u[i] - u[i - 1] };
+        e + building.laws[i].recoverable_energy(&history[i], d)
+    })
+}
+
+/// `C v` into `out`: the band product with a tridiagonal `C` (the dense product's value:
+/// its other terms are exact zeros), else nalgebra's column order.
+fn damping_force<T: Real, L: Law<T>>(building: &DynShearBuilding<T, L>, v: &[T], out: &mut [T]) {
+    match (&building.band, &building.dense) {
+        (Some([d, e]), _) => mul_flat(d, e, v, out),
+        (None, Some([c, _])) => gemv(c, v, out),
+        (None, None) => {}
+    }
+}
+
+/// The storey forces `f_i` (not assembled) at `(u, v)` from `history`.
+fn storey_forces<T: Real, L: Law<T>>(
+    building: &DynShearBuilding<T, L>,
+    history: &[L::History],
+    u: &[T],
+    v: &[T],
+    out: &mut [T],
+) {
+    for i in 0..out.len() {
+        let (d, r) = if i == 0 {
+            (u[0], v[0])
+        } else {
+            (u[i] - u[i - 1], v[i] - v[i - 1])
+        };
+        out[i] = building.laws[i].trial(&history[i], d, r).force;
+    }
 }
