@@ -511,6 +511,7 @@ mod building {
                 ])
             };
             let f = |a: &DynEnergyAccount<T, L::History>| {
+                let a = a.totals();
                 energies([
                     a.input,
                     a.kinetic,

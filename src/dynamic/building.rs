@@ -9,12 +9,12 @@ use std::vec::Vec;
 
 use nalgebra::{DMatrix, DVectorView};
 
-use crate::hysteresis::{Bands, Law, check_building, storeys_flat};
+use crate::hysteresis::{Bands, EnergyAccount, Law, check_building, storeys_flat};
 use crate::kinematics::{AemKinematics, Kinematics};
 use crate::linalg::lu::solve_in_place_flat;
 use crate::linalg::tridiagonal::{mul_flat, solve_positive_flat};
-use crate::nonlinear::{Iterate, jacobian_flat, judge, norm_inf_flat};
-use crate::{Error, Iterations, NewtonReport, NewtonSettings, Nonlinear, Real};
+use crate::nonlinear::{Progress, jacobian_flat, norm_inf_flat};
+use crate::{Error, NewtonReport, NewtonSettings, Nonlinear, Real};
 
 /// An `N`-storey shear building of storey law `L` with `N` chosen at run time (feature
 /// `std`): [`ShearBuilding`](crate::hysteresis::ShearBuilding) on the heap, the same
@@ -246,34 +246,11 @@ struct Work<T, H> {
 }
 
 impl<T: Real, H: Copy> DynBuildingState<T, H> {
-    /// Displacements (m), `N` values. Cost: none.
-    pub fn u(&self) -> &[T] {
-        &self.u
-    }
-
-    /// Velocities (m/s), `N` values. Cost: none.
-    pub fn v(&self) -> &[T] {
-        &self.v
-    }
-
-    /// Accelerations (m/s²), `N` values. Cost: none.
-    pub fn a(&self) -> &[T] {
-        &self.a
-    }
+    super::state_accessors!();
 
     /// The storeys' committed history, ground storey first. Cost: none.
     pub fn history(&self) -> &[H] {
         &self.history
-    }
-
-    /// Steps taken since the start (`t = steps · h`). Cost: none.
-    pub fn steps(&self) -> u64 {
-        self.n
-    }
-
-    /// Storeys (degrees of freedom). Cost: none.
-    pub fn size(&self) -> usize {
-        self.u.len()
     }
 }
 
@@ -419,17 +396,8 @@ impl<T: Real> DynNonlinear<T> {
         for j in 0..s.u.len() {
             (w.vh[j], w.uh[j]) = self.kin.predict(s.u[j], s.v[j], s.a[j]);
         }
-        let (budget, fixed) = match self.settings.iterations {
-            Iterations::UpTo(k) => (k, false),
-            Iterations::Exactly(k) => (k, true),
-        };
-        let tol = self.settings.tolerance;
-        let p_size = norm_inf_flat(p);
+        let mut newton = Progress::new(self.settings, norm_inf_flat(p), (b, c));
         w.q.copy_from_slice(&s.a);
-        let mut iterations = 0u32;
-        let mut last_delta = T::zero();
-        let mut branch_changes = 0u32;
-        let mut last_branch = 0u64;
         loop {
             for j in 0..w.q.len() {
                 (w.vn[j], w.un[j]) = self.kin.correct(w.vh[j], w.uh[j], w.q[j]);
@@ -438,48 +406,22 @@ impl<T: Real> DynNonlinear<T> {
             if !w.f.iter().all(|x| x.is_finite()) {
                 return Err(Error::NonFiniteForce);
             }
-            if iterations > 0 && branch != last_branch {
-                branch_changes += 1;
-            }
-            last_branch = branch;
             for ((r, (&mq, &f)), &p) in w.r.iter_mut().zip(w.mq.iter().zip(&w.f)).zip(p) {
                 *r = mq + f - p;
             }
-            let (residual, correction, converged) = judge(
-                Iterate {
-                    r: &w.r,
-                    mq: &w.mq,
-                    f: &w.f,
-                    q: &w.q,
-                    u: &w.un,
-                    v: &w.vn,
-                },
-                p_size,
-                (b, c),
-                iterations,
-                last_delta,
-                tol,
-            );
-            let done = iterations >= budget || (!fixed && converged);
-            if done {
+            let forces = [&w.r[..], &w.mq, &w.f];
+            if let Some(report) = newton.judge(branch, forces, [&w.q[..], &w.un, &w.vn]) {
                 let finite = |x: &[T]| x.iter().all(|x| x.is_finite());
                 if !(finite(&w.un) && finite(&w.vn) && finite(&w.q)) {
                     return Err(Error::NonFiniteState);
                 }
-                return Ok(NewtonReport {
-                    iterations,
-                    residual,
-                    correction,
-                    converged,
-                    branch_changes,
-                });
+                return Ok(report);
             }
             solve(building, &s.history, w, b, c)?;
             for (q, &d) in w.q.iter_mut().zip(&w.r) {
                 *q -= d;
             }
-            last_delta = norm_inf_flat(&w.r);
-            iterations += 1;
+            newton.corrected(norm_inf_flat(&w.r));
         }
     }
 }
@@ -661,28 +603,15 @@ fn dense_jacobian<T: Real, L: Law<T>>(
 ///     stepper.try_step(&building, &mut s, &p)?;
 ///     account.step(&building, &s, &p);
 /// }
-/// assert!(account.hysteretic > 0.0); // it yielded
-/// assert!(account.max_balance_error()? <= 1e-6 * account.max_input());
+/// let e = account.totals();
+/// assert!(e.hysteretic > 0.0); // it yielded
+/// assert!(e.max_balance_error()? <= 1e-6 * e.max_input());
 /// # Ok::<(), aemstep::Error>(())
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct DynEnergyAccount<T, H> {
-    /// `E₀`: kinetic plus recoverable energy at the start (J).
-    pub initial: T,
-    /// `E_in = ∫ p·du`: work of the loads since the start (J).
-    pub input: T,
-    /// `E_k = ½ vᵀ M v` now (J).
-    pub kinetic: T,
-    /// `E_s`: the storeys' recoverable strain energy now (J).
-    pub recoverable: T,
-    /// `E_v = ∫ (C v)·du`: dissipated by the linear damping since the start (J).
-    pub viscous: T,
-    /// `E_h`: dissipated by the storey laws since the start (J).
-    pub hysteretic: T,
-    storey_work: T,
-    recoverable0: T,
-    max_input: T,
-    max_error: T,
+    /// The energies (their fields and methods; its own vectors are empty).
+    totals: EnergyAccount<T, 0>,
     /// At the last accounted step: `u`, the load, `C v`, the storey forces `f_i`, the
     /// committed history.
     u: Vec<T>,
@@ -712,16 +641,7 @@ impl<T: Real, H: Copy> DynEnergyAccount<T, H> {
         let kinetic = kinetic(building, v);
         let recoverable = recoverable(building, state.history(), u);
         let mut a = Self {
-            initial: kinetic + recoverable,
-            input: T::zero(),
-            kinetic,
-            recoverable,
-            viscous: T::zero(),
-            hysteretic: T::zero(),
-            storey_work: T::zero(),
-            recoverable0: recoverable,
-            max_input: T::zero(),
-            max_error: T::zero(),
+            totals: EnergyAccount::totals(kinetic, recoverable),
             u: u.to_vec(),
             load: load.to_vec(),
             damping_force: zeros(),
@@ -769,58 +689,40 @@ impl<T: Real, H: Copy> DynEnergyAccount<T, H> {
             let n = x.len();
             DVectorView::from_slice(sum, n).dot(&DVectorView::from_slice(x, n))
         };
-        self.input += dot(&mut self.sum, &self.load, load, &self.du) * half;
-        self.viscous += dot(
-            &mut self.sum,
-            &self.damping_force,
-            &self.new_damping,
-            &self.du,
-        ) * half;
-        self.storey_work += dot(
-            &mut self.sum,
-            &self.storey_force,
-            &self.new_storey,
-            &self.d_drift,
-        ) * half;
-        self.kinetic = kinetic(building, v);
-        self.recoverable = recoverable(building, state.history(), u);
-        self.hysteretic = self.storey_work - (self.recoverable - self.recoverable0);
+        let works = [
+            dot(&mut self.sum, &self.load, load, &self.du) * half,
+            dot(
+                &mut self.sum,
+                &self.damping_force,
+                &self.new_damping,
+                &self.du,
+            ) * half,
+            dot(
+                &mut self.sum,
+                &self.storey_force,
+                &self.new_storey,
+                &self.d_drift,
+            ) * half,
+        ];
         self.u.copy_from_slice(u);
         self.load.copy_from_slice(load);
         core::mem::swap(&mut self.damping_force, &mut self.new_damping);
         core::mem::swap(&mut self.storey_force, &mut self.new_storey);
         self.history.copy_from_slice(state.history());
-        self.max_input = self.max_input.max(self.input.abs());
-        // Not `max`, which drops a NaN: a non-finite balance sticks.
-        let e = self.balance_error().abs();
-        #[allow(clippy::eq_op)]
-        let nan = e != e;
-        if e > self.max_error || nan {
-            self.max_error = e;
-        }
+        self.totals.settle(
+            works,
+            kinetic(building, v),
+            recoverable(building, state.history(), u),
+        );
     }
 
-    /// `E₀ + E_in − (E_k + E_s + E_v + E_h)` now (J). Cost: 5 flops.
-    pub fn balance_error(&self) -> T {
-        self.initial + self.input
-            - (self.kinetic + self.recoverable + self.viscous + self.hysteretic)
-    }
-
-    /// The largest `|balance_error|` over the steps accounted so far (J).
-    ///
-    /// Errors: [`Error::NonFiniteState`] if the balance of a step accounted was NaN or
-    /// infinite. Cost: O(1).
-    pub fn max_balance_error(&self) -> Result<T, Error> {
-        if self.max_error.is_finite() {
-            Ok(self.max_error)
-        } else {
-            Err(Error::NonFiniteState)
-        }
-    }
-
-    /// The largest `|E_in|` over the steps accounted so far (J). Cost: O(1).
-    pub fn max_input(&self) -> T {
-        self.max_input
+    /// The energies now (J): `input`, `kinetic`, `recoverable`, `viscous`, `hysteretic`,
+    /// `initial`, and [`balance_error`](EnergyAccount::balance_error),
+    /// [`max_balance_error`](EnergyAccount::max_balance_error),
+    /// [`max_input`](EnergyAccount::max_input), as an [`EnergyAccount`] of the totals
+    /// (whose own per-floor vectors are empty). Cost: none.
+    pub fn totals(&self) -> &EnergyAccount<T, 0> {
+        &self.totals
     }
 }
 

@@ -156,16 +156,7 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
             None => (self.damping * v).data.0[0],
         };
         let mut history = *committed;
-        let bands = tangent.map(|t| Bands {
-            stiffness: [
-                &mut t.stiffness.diagonal.data.0[0],
-                &mut t.stiffness.off.data.0[0],
-            ],
-            damping: [
-                &mut t.damping.diagonal.data.0[0],
-                &mut t.damping.off.data.0[0],
-            ],
-        });
+        let bands = tangent.map(Bands::of);
         let branch = storeys_flat(
             &self.laws,
             committed,
@@ -225,16 +216,7 @@ impl<T: Real, L: Law<T>, const N: usize> HistoryModel<T, N> for ShearBuilding<T,
             stiffness: SymTridiagonal::zero(),
             damping: SymTridiagonal::zero(),
         };
-        let mut bands = Bands {
-            stiffness: [
-                &mut t.stiffness.diagonal.data.0[0],
-                &mut t.stiffness.off.data.0[0],
-            ],
-            damping: [
-                &mut t.damping.diagonal.data.0[0],
-                &mut t.damping.off.data.0[0],
-            ],
-        };
+        let mut bands = Bands::of(&mut t);
         for (i, s) in storeys.iter().enumerate() {
             add_storey(&mut bands, i, s.stiffness, s.damping);
         }
@@ -305,6 +287,18 @@ pub(crate) fn check_building<T: Real>(masses: &[f64], damping: &[f64]) -> Result
 pub(crate) struct Bands<'a, T> {
     pub(crate) stiffness: [&'a mut [T]; 2],
     pub(crate) damping: [&'a mut [T]; 2],
+}
+
+impl<'a, T: Real> Bands<'a, T> {
+    /// The stiffness and damping bands of `t`.
+    #[inline(always)]
+    fn of<const N: usize>(t: &'a mut TridiagonalTangent<T, N>) -> Self {
+        let (k, c) = (&mut t.stiffness, &mut t.damping);
+        Bands {
+            stiffness: [&mut k.diagonal.data.0[0], &mut k.off.data.0[0]],
+            damping: [&mut c.diagonal.data.0[0], &mut c.off.data.0[0]],
+        }
+    }
 }
 
 /// The storey loop of every shear-building trial, on slices of `N = laws.len()` values:

@@ -481,17 +481,8 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
     ) -> Result<Candidate<T, N, Mo::History>, Error> {
         let (b, c) = (self.kin.half_h, self.kin.quarter_h2);
         let (vh, uh) = self.kin.predict_all(&state.u, &state.v, &state.a);
-        let (budget, fixed) = match self.settings.iterations {
-            Iterations::UpTo(k) => (k, false),
-            Iterations::Exactly(k) => (k, true),
-        };
-        let tol = self.settings.tolerance;
-        let p_size = norm_inf(p);
+        let mut newton = Progress::new(self.settings, norm_inf(p), (b, c));
         let mut q = state.a;
-        let mut iterations = 0u32;
-        let mut last_delta = T::zero();
-        let mut branch_changes = 0u32;
-        let mut last_branch = 0u64;
         loop {
             let (v, u) = self.kin.correct_all(&vh, &uh, &q);
             let (trial, mq) = path.evaluate(&u, &v, &q)?;
@@ -503,46 +494,19 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
             if !all_finite(&f) {
                 return Err(Error::NonFiniteForce);
             }
-            if iterations > 0 && branch != last_branch {
-                branch_changes += 1;
-            }
-            last_branch = branch;
             let r = mq + f - p;
-            let (residual, correction, converged) = judge(
-                Iterate {
-                    r: r.as_slice(),
-                    mq: mq.as_slice(),
-                    f: f.as_slice(),
-                    q: q.as_slice(),
-                    u: u.as_slice(),
-                    v: v.as_slice(),
-                },
-                p_size,
-                (b, c),
-                iterations,
-                last_delta,
-                tol,
-            );
-            let done = iterations >= budget || (!fixed && converged);
-            if done {
+            let forces = [r.as_slice(), mq.as_slice(), f.as_slice()];
+            if let Some(report) = newton.judge(branch, forces, [&q, &u, &v].map(|x| x.as_slice())) {
                 let next = State::unchecked(u, v, q, state.n.wrapping_add(1));
                 if !next.is_finite() {
                     return Err(Error::NonFiniteState);
                 }
-                let report = NewtonReport {
-                    iterations,
-                    residual,
-                    correction,
-                    converged,
-                    branch_changes,
-                };
                 return Ok((next, history, report));
             }
             let mut delta = r;
             path.solve(&u, &v, &f, b, c, &mut delta)?;
             q -= delta;
-            last_delta = norm_inf(&delta);
-            iterations += 1;
+            newton.corrected(norm_inf(&delta));
         }
     }
 }
@@ -779,55 +743,102 @@ pub(crate) fn norm_inf_flat<T: Real>(x: &[T]) -> T {
     x.iter().fold(T::zero(), |s, e| s.max(e.abs()))
 }
 
-/// One Newton iterate as the convergence test reads it (each slice of `N` values): the
-/// residual `r = M q + F − p`, `M q`, `F`, and the iterate's `q`, `u`, `v`.
-#[derive(Clone, Copy)]
-pub(crate) struct Iterate<'a, T> {
-    pub(crate) r: &'a [T],
-    pub(crate) mq: &'a [T],
-    pub(crate) f: &'a [T],
-    pub(crate) q: &'a [T],
-    pub(crate) u: &'a [T],
-    pub(crate) v: &'a [T],
+/// The bookkeeping of one step's Newton iteration, shared by the const-generic and the
+/// run-time-sized (`std`) iterations: the budget, the tolerance, the iterations and the
+/// last correction, the branch changes. Cost: none beyond [`Progress::judge`].
+pub(crate) struct Progress<T> {
+    budget: u32,
+    fixed: bool,
+    tol: T,
+    /// `‖p‖∞`.
+    p_size: T,
+    /// `(h/2, h²/4)`.
+    bc: (T, T),
+    iterations: u32,
+    /// `‖δq‖∞` of the last correction.
+    last_delta: T,
+    branch_changes: u32,
+    last_branch: u64,
 }
 
-/// The convergence test of every Newton iterate ([`NewtonSettings::tolerance`]), shared by
-/// the const-generic and the run-time-sized (`std`) iterations: `(residual, correction,
-/// converged)` of iterate `x` after `iterations` Newton corrections, the last of size
-/// `last_delta` (`‖δq‖∞`), with `p_size = ‖p‖∞` and `(b, c) = (h/2, h²/4)`. The relative
-/// residual `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` is `0` when the denominator is (then
-/// `r = 0` too). Cost: `7N` comparisons, 3 divisions.
-#[inline(always)]
-pub(crate) fn judge<T: Real>(
-    x: Iterate<'_, T>,
-    p_size: T,
-    (b, c): (T, T),
-    iterations: u32,
-    last_delta: T,
-    tol: T,
-) -> (T, T, bool) {
-    let scale = norm_inf_flat(x.mq).max(norm_inf_flat(x.f)).max(p_size);
-    let residual = if scale > T::zero() {
-        norm_inf_flat(x.r) / scale
-    } else {
-        T::zero()
-    };
-    let correction = if iterations == 0 {
-        T::zero()
-    } else {
-        let reference = norm_inf_flat(x.q)
-            .max(norm_inf_flat(x.u) / c)
-            .max(norm_inf_flat(x.v) / b);
-        if last_delta <= T::zero() {
-            T::zero()
-        } else if reference > T::zero() {
-            last_delta / reference
-        } else {
-            T::one()
+impl<T: Real> Progress<T> {
+    /// Before the first iterate, for a step with `settings`, load size `p_size = ‖p‖∞`
+    /// and kinematics `bc = (h/2, h²/4)`.
+    #[inline(always)]
+    pub(crate) fn new(settings: NewtonSettings<T>, p_size: T, bc: (T, T)) -> Self {
+        let (budget, fixed) = match settings.iterations {
+            Iterations::UpTo(k) => (k, false),
+            Iterations::Exactly(k) => (k, true),
+        };
+        Self {
+            budget,
+            fixed,
+            tol: settings.tolerance,
+            p_size,
+            bc,
+            iterations: 0,
+            last_delta: T::zero(),
+            branch_changes: 0,
+            last_branch: 0,
         }
-    };
-    let converged = residual <= tol || (iterations > 0 && correction <= tol);
-    (residual, correction, converged)
+    }
+
+    /// The convergence test of an iterate ([`NewtonSettings::tolerance`]): its residual
+    /// `r = M q + F − p`, `M q` and `F`, its `q`, `u`, `v` (each `N` values) and its
+    /// trial's `branch`. The report when the iteration stops here (converged, or the
+    /// budget spent), else `None` (correct and judge the next iterate). The relative
+    /// residual `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` is `0` when the denominator is (then
+    /// `r = 0` too). Cost: `7N` comparisons, 3 divisions.
+    #[inline(always)]
+    pub(crate) fn judge(
+        &mut self,
+        branch: u64,
+        [r, mq, f]: [&[T]; 3],
+        [q, u, v]: [&[T]; 3],
+    ) -> Option<NewtonReport<T>> {
+        let iterations = self.iterations;
+        if iterations > 0 && branch != self.last_branch {
+            self.branch_changes += 1;
+        }
+        self.last_branch = branch;
+        let (b, c) = self.bc;
+        let scale = norm_inf_flat(mq).max(norm_inf_flat(f)).max(self.p_size);
+        let residual = if scale > T::zero() {
+            norm_inf_flat(r) / scale
+        } else {
+            T::zero()
+        };
+        let correction = if iterations == 0 {
+            T::zero()
+        } else {
+            let reference = norm_inf_flat(q)
+                .max(norm_inf_flat(u) / c)
+                .max(norm_inf_flat(v) / b);
+            if self.last_delta <= T::zero() {
+                T::zero()
+            } else if reference > T::zero() {
+                self.last_delta / reference
+            } else {
+                T::one()
+            }
+        };
+        let converged = residual <= self.tol || (iterations > 0 && correction <= self.tol);
+        let done = iterations >= self.budget || (!self.fixed && converged);
+        done.then_some(NewtonReport {
+            iterations,
+            residual,
+            correction,
+            converged,
+            branch_changes: self.branch_changes,
+        })
+    }
+
+    /// After a Newton correction of size `delta = ‖δq‖∞`.
+    #[inline(always)]
+    pub(crate) fn corrected(&mut self, delta: T) {
+        self.last_delta = delta;
+        self.iterations += 1;
+    }
 }
 
 /// The Newton matrix `J = M + b ∂F/∂v + c ∂F/∂u` on three diagonals (`jd`, `jo`; `jo[0]`
