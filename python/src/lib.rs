@@ -946,6 +946,9 @@ fn shear_building<'py>(
     let prepare = || -> Res<(BuildingJob, usize)> {
         let masses = read1(&masses);
         let n = masses.len();
+        if n == 0 {
+            return shape("masses must have at least one storey".into());
+        }
         let (p, r, cols) = read2(&params);
         if r != n || cols != width {
             return shape(format!(
