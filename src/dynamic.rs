@@ -1,18 +1,36 @@
 //! Models of any size on the host (feature `std`): the linear AEM stepper with its number
-//! of degrees of freedom chosen at run time, [`DynLinear`].
+//! of degrees of freedom chosen at run time, [`DynLinear`], and the yielding shear building
+//! with its number of storeys chosen at run time, [`DynShearBuilding`] stepped by
+//! [`DynNonlinear`] (with [`DynEnergyAccount`]).
 //!
-//! It is the const-generic [`Linear`](crate::Linear) with heap storage, not a second
-//! implementation: the operators are built by the same `const fn` build on flat slices
-//! (the kernel's `newmark_operators_flat`, the LU's `factor` and `solve_flat`: the same
-//! checks in the same order, the same arithmetic), rounded once to `T` the same way,
+//! `DynLinear` is the const-generic [`Linear`](crate::Linear) with heap storage, not a
+//! second implementation: the operators are built by the same `const fn` build on flat
+//! slices (the kernel's `newmark_operators_flat`, the LU's `factor` and `solve_flat`: the
+//! same checks in the same order, the same arithmetic), rounded once to `T` the same way,
 //! stored in the column-blocked layout and multiplied by the same per-row product
 //! (`op_rows`' `wide_blocks_flat`), with the same predictor and corrector
 //! (`Kinematics`). So at every size both serve, `DynLinear<T>` and `Linear<T, N>` give
 //! bit-identical histories (`tests/runtime_size.rs` checks `u`, `v`, `a` at every sample).
 //!
+//! Likewise `DynNonlinear` is [`Nonlinear::try_step_with_history`](crate::Nonlinear::try_step_with_history)
+//! on a [`ShearBuilding`](crate::hysteresis::ShearBuilding) with heap storage: the
+//! const-generic Newton step calls its per-step arithmetic as functions on flat slices
+//! (`#[inline(always)]`: the storey loop of the trial, the banded products, the assembly of
+//! `J` on three diagonals, its `L D Lᵀ` solve and the pivoted LU fallback, the convergence
+//! test, the building's checks) and the run-time-sized step calls the same functions in
+//! the same order. Bit-identical `u`, `v`, `a`, histories and Newton reports at every size
+//! both serve (`tests/runtime_size.rs`, every exposed law, tridiagonal and full damping,
+//! `f64` and `f32`).
+//!
 //! Memory is allocated once, by [`DynLinear::new`] (`6N²` values of `T` and a few `N×N`
-//! `f64` temporaries) and [`DynLinear::start`] (`7N` values of `T` in the state); stepping
-//! allocates nothing.
+//! `f64` temporaries) and [`DynLinear::start`] (`7N` values of `T` in the state); by
+//! [`DynShearBuilding::new`] (`4N` values, `N²` more for a full damping matrix) and
+//! [`DynNonlinear::start`] (about `20N` values, `N` histories and `N²` values of Newton
+//! work space); stepping allocates nothing.
+
+mod building;
+
+pub use building::{DynBuildingState, DynEnergyAccount, DynNonlinear, DynShearBuilding};
 
 use std::vec;
 use std::vec::Vec;
@@ -94,31 +112,40 @@ impl<T: PartialEq> PartialEq for DynState<T> {
     }
 }
 
+/// The accessors of a run-time-sized state with fields `u`, `v`, `a` (`Vec<T>`) and `n`
+/// (steps): `u()`, `v()`, `a()`, `steps()`, `size()`. Expands inside its `impl` block.
+macro_rules! state_accessors {
+    () => {
+        /// Displacements (m), `N` values. Cost: none.
+        pub fn u(&self) -> &[T] {
+            &self.u
+        }
+
+        /// Velocities (m/s), `N` values. Cost: none.
+        pub fn v(&self) -> &[T] {
+            &self.v
+        }
+
+        /// Accelerations (m/s²), `N` values. Cost: none.
+        pub fn a(&self) -> &[T] {
+            &self.a
+        }
+
+        /// Steps taken since the start (`t = steps · h`). Cost: none.
+        pub fn steps(&self) -> u64 {
+            self.n
+        }
+
+        /// Degrees of freedom. Cost: none.
+        pub fn size(&self) -> usize {
+            self.u.len()
+        }
+    };
+}
+use state_accessors;
+
 impl<T: Real> DynState<T> {
-    /// Displacements (m), `N` values. Cost: none.
-    pub fn u(&self) -> &[T] {
-        &self.u
-    }
-
-    /// Velocities (m/s), `N` values. Cost: none.
-    pub fn v(&self) -> &[T] {
-        &self.v
-    }
-
-    /// Accelerations (m/s²), `N` values. Cost: none.
-    pub fn a(&self) -> &[T] {
-        &self.a
-    }
-
-    /// Steps taken since the start (`t = steps · h`). Cost: none.
-    pub fn steps(&self) -> u64 {
-        self.n
-    }
-
-    /// Degrees of freedom. Cost: none.
-    pub fn size(&self) -> usize {
-        self.u.len()
-    }
+    state_accessors!();
 
     fn new(u: Vec<T>, v: Vec<T>, a: Vec<T>) -> Result<Self, Error> {
         let n = u.len();

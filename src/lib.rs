@@ -228,7 +228,9 @@ pub mod batch;
 pub mod dynamic;
 #[cfg(feature = "std")]
 #[cfg_attr(docsrs, doc(cfg(feature = "std")))]
-pub use dynamic::{DynLinear, DynState};
+pub use dynamic::{
+    DynBuildingState, DynEnergyAccount, DynLinear, DynNonlinear, DynShearBuilding, DynState,
+};
 
 // Incremental dynamic analysis over a suite of records on the batch pool (host only).
 #[cfg(feature = "std")]

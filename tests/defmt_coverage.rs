@@ -36,6 +36,10 @@ const SKIP: &[(&str, &str)] = &[
     ("Curve", "std only"),
     ("DynLinear", "std only"),
     ("DynState", "std only"),
+    ("DynShearBuilding", "std only"),
+    ("DynNonlinear", "std only"),
+    ("DynBuildingState", "std only"),
+    ("DynEnergyAccount", "std only"),
 ];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {

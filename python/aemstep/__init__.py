@@ -285,8 +285,8 @@ def shear_building(
 ) -> BuildingResponse:
     """Step a hysteretic shear building over a ground-acceleration record.
 
-    ``masses``: floor masses (kg), ground storey first (``n`` storeys, ``n`` in
-    ``SIZES``). ``c``: damping matrix (N·s/m, ``n×n``; e.g. Rayleigh). ``h``: time step
+    ``masses``: floor masses (kg), ground storey first (``n`` storeys, any ``n ≥ 1``:
+    ``SIZES`` compiled, others run-time-sized, bit-identical where both serve). ``c``: damping matrix (N·s/m, ``n×n``; e.g. Rayleigh). ``h``: time step
     (s). ``ground_acceleration``: m/s² at ``t = i·h``. Storey laws (scalars or one value
     per storey): ``k`` elastic stiffness (N/m), ``fy`` yield force (N), ``alpha``
     post-yield ratio; ``law="bouc_wen"`` adds ``beta``, ``gamma``, ``n``;

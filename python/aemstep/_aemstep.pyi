@@ -119,8 +119,12 @@ def shear_building(
     tolerance: float = 1e-10,
     energy: bool = True,
     histories: bool = True,
+    compiled: bool = True,
 ) -> Dict[str, Any]:
     """A hysteretic shear building (Nonlinear AEM stepper, Newton) over a record.
+
+    Any number of storeys: those in ``SIZES`` run compiled, others run-time-sized
+    (bit-identical where both serve; compiled=False forces the run-time path).
 
     masses: floor masses (kg), ground storey first; law: ``"bilinear"`` (params columns
     k N/m, fy N, alpha), ``"bouc_wen"`` (k, fy, alpha, beta, gamma, n) or

@@ -33,13 +33,15 @@ pub(crate) trait WithLaws<const N: usize> {
     fn run<L: LaneLaw<f64> + Send + Sync>(self, laws: [L; N]) -> Res<Self::Out>;
 }
 
-/// `N` laws, the `i`-th from `f(i)`.
-fn build<const N: usize, L>(f: impl Fn(usize) -> Result<L, Error>) -> Result<[L; N], Error> {
-    let mut v = Vec::with_capacity(N);
-    for i in 0..N {
-        v.push(f(i)?);
-    }
-    v.try_into().map_err(|_| unreachable!("N laws pushed"))
+/// What to do with storey laws of a run-time count once built.
+pub(crate) trait WithLawVec {
+    type Out;
+    fn run<L: LaneLaw<f64> + Send + Sync>(self, laws: Vec<L>) -> Res<Self::Out>;
+}
+
+/// `n` laws, the `i`-th from `f(i)`.
+fn build<L>(n: usize, f: impl Fn(usize) -> Result<L, Error>) -> Result<Vec<L>, Error> {
+    (0..n).map(f).collect()
 }
 
 /// Builds the `N` laws named `law` from `params` (row-major, `N × width`, one row a storey,
@@ -53,23 +55,47 @@ pub(crate) fn with_laws<const N: usize, V: WithLaws<N>>(
     width: usize,
     v: V,
 ) -> Res<V::Out> {
-    if law_width(law) != Some(width) || params.len() != N * width {
+    /// The laws as an array of `N`.
+    struct Array<V, const N: usize>(V);
+    impl<V: WithLaws<N>, const N: usize> WithLawVec for Array<V, N> {
+        type Out = V::Out;
+        fn run<L: LaneLaw<f64> + Send + Sync>(self, laws: Vec<L>) -> Res<V::Out> {
+            match <[L; N]>::try_from(laws) {
+                Ok(laws) => self.0.run(laws),
+                Err(_) => unreachable!("N laws built"),
+            }
+        }
+    }
+    with_law_vec(law, params, width, N, Array::<V, N>(v))
+}
+
+/// [`with_laws`] for `n` storeys chosen at run time: the laws in a `Vec`.
+///
+/// Errors: as [`with_laws`].
+pub(crate) fn with_law_vec<V: WithLawVec>(
+    law: &str,
+    params: &[f64],
+    width: usize,
+    n: usize,
+    v: V,
+) -> Res<V::Out> {
+    if law_width(law) != Some(width) || params.len() != n * width {
         return Err(Fail::Shape(format!(
-            "law {law:?} with a {N}x{width} parameter table of {} values",
+            "law {law:?} with a {n}x{width} parameter table of {} values",
             params.len()
         )));
     }
     let row = |i: usize| &params[i * width..(i + 1) * width];
     match law {
-        "bilinear" => v.run(build::<N, _>(|i| {
+        "bilinear" => v.run(build(n, |i| {
             let r = row(i);
             Bilinear::<f64>::new(r[0], r[1], r[2])
         })?),
-        "bouc_wen" => v.run(build::<N, _>(|i| {
+        "bouc_wen" => v.run(build(n, |i| {
             let r = row(i);
             BoucWen::<f64>::new(r[0], r[1], r[2], r[3], r[4], r[5])
         })?),
-        _ => v.run(build::<N, _>(|i| {
+        _ => v.run(build(n, |i| {
             let r = row(i);
             Ok(Parallel(
                 Bilinear::<f64>::new(r[0], r[1], r[2])?,

@@ -9,8 +9,9 @@
 //!
 //! **Sizes.** The library's sizes are const generics. Structures (`n` degrees of freedom,
 //! storeys) are dispatched over [`SIZES`] (1 to 10, 12, 15, 20); `linear_response` with
-//! the AEM takes any other `n` on the run-time-sized `DynLinear` (bit-identical where both
-//! serve), other `n` elsewhere raise `UnsupportedSize`. Spectra take any number of periods: they are stepped in banks of
+//! the AEM takes any other `n` on the run-time-sized `DynLinear`, `shear_building` on
+//! `DynShearBuilding` (bit-identical where both serve), other `n` elsewhere raise
+//! `UnsupportedSize`. Spectra take any number of periods: they are stepped in banks of
 //! [`CHUNK`] oscillators, the last bank padded with copies of the longest period. Observers
 //! take 1 to [`MAX_SENSORS`] sensors.
 //!
@@ -30,8 +31,8 @@ use aemstep::observer::{Kalman, Observer, Outputs, StateSpace, SteadyState};
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
 use aemstep::spectrum::{Bank, RotD, Scheme, Substeps};
 use aemstep::{
-    Damping, DynLinear, DynState, Error, Exact, GeneralizedAlpha, Linear, Modal, Newmark,
-    NewtonSettings, Nonlinear, Stepper, batch,
+    Damping, DynEnergyAccount, DynLinear, DynNonlinear, DynShearBuilding, DynState, Error, Exact,
+    GeneralizedAlpha, Linear, Modal, Newmark, NewtonSettings, Nonlinear, Stepper, batch,
 };
 use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -706,60 +707,78 @@ struct BuildingOut {
     total_iterations: u64,
 }
 
-fn building_run<const N: usize, L: Law<f64>>(
-    laws: [L; N],
-    job: &BuildingJob,
-    stop: &AtomicBool,
-) -> Res<BuildingOut> {
-    let masses: [f64; N] = core::array::from_fn(|i| job.masses[i]);
-    let building = ShearBuilding::<f64, L, N>::new(masses, laws, &rows::<N>(&job.c))?;
-    let stepper = Nonlinear::<f64, N>::new(job.h, job.settings)?;
-    let steps = job.ag.len();
-    let zero = SVector::<f64, N>::zeros();
-    let p0 = building.ground_load(job.ag[0]);
-    let (mut s, mut history) = stepper
-        .start_with_history(&building, &zero, &zero, &p0, &building.initial_history())
-        .map_err(at(0))?;
-    let mut account = job
-        .energy
-        .then(|| EnergyAccount::start(&building, &s, &history, &p0));
-    // Capacity only when the histories are kept: the run then writes each value once into
-    // memory handed to numpy as it is (no copy on the way out).
-    let kept = if job.histories { steps } else { 0 };
-    let mut o = BuildingOut {
-        u: buffer(kept, N)?,
-        v: buffer(kept, N)?,
-        a: buffer(kept, N)?,
-        drifts: buffer(kept, N)?,
-        energy: buffer(if job.energy { kept.max(1) } else { 0 }, 6)?,
-        iterations: buffer(kept, 1)?,
-        initial_energy: account.as_ref().map_or(f64::NAN, |e| e.initial),
-        peak_drifts: Vec::new(),
-        total_iterations: 0,
-    };
-    let mut peaks = [0.0f64; N];
-    let histories = job.histories;
-    // The drifts as numpy's `np.diff(u, axis=1, prepend=0.0)` forms them (`u_0 − 0` first),
-    // so the peaks are bitwise those of the histories.
-    let mut keep = |o: &mut BuildingOut, s: &aemstep::State<f64, N>, iterations: u32| {
-        let u = s.u();
+/// The outputs of a building run as they are produced: the histories when kept, the peak
+/// drifts and iteration count always; one recorder for the compiled and the run-time
+/// paths.
+struct Recorder {
+    o: BuildingOut,
+    peaks: Vec<f64>,
+    drifts: Vec<f64>,
+    histories: bool,
+}
+
+impl Recorder {
+    /// Capacity only when the histories are kept: the run then writes each value once into
+    /// memory handed to numpy as it is (no copy on the way out).
+    fn new(job: &BuildingJob, n: usize, initial_energy: f64) -> Res<Self> {
+        let kept = if job.histories { job.ag.len() } else { 0 };
+        Ok(Self {
+            o: BuildingOut {
+                u: buffer(kept, n)?,
+                v: buffer(kept, n)?,
+                a: buffer(kept, n)?,
+                drifts: buffer(kept, n)?,
+                energy: buffer(if job.energy { kept.max(1) } else { 0 }, 6)?,
+                iterations: buffer(kept, 1)?,
+                initial_energy,
+                peak_drifts: Vec::new(),
+                total_iterations: 0,
+            },
+            peaks: vec![0.0; n],
+            drifts: vec![0.0; n],
+            histories: job.histories,
+        })
+    }
+
+    /// One sample: the drifts as numpy's `np.diff(u, axis=1, prepend=0.0)` forms them
+    /// (`u_0 − 0` first), so the peaks are bitwise those of the histories.
+    fn keep(&mut self, u: &[f64], v: &[f64], a: &[f64], iterations: u32) {
         let mut below = 0.0;
-        let mut drifts = [0.0f64; N];
-        for i in 0..N {
-            drifts[i] = u[i] - below;
-            below = u[i];
-            peaks[i] = peaks[i].max(drifts[i].abs());
+        for (i, &ui) in u.iter().enumerate() {
+            self.drifts[i] = ui - below;
+            below = ui;
+            self.peaks[i] = self.peaks[i].max(self.drifts[i].abs());
         }
-        o.total_iterations += u64::from(iterations);
-        if histories {
-            o.u.extend_from_slice(u.as_slice());
-            o.v.extend_from_slice(s.v().as_slice());
-            o.a.extend_from_slice(s.a().as_slice());
-            o.drifts.extend_from_slice(&drifts);
-            o.iterations.push(f64::from(iterations));
+        self.o.total_iterations += u64::from(iterations);
+        if self.histories {
+            self.o.u.extend_from_slice(u);
+            self.o.v.extend_from_slice(v);
+            self.o.a.extend_from_slice(a);
+            self.o.drifts.extend_from_slice(&self.drifts);
+            self.o.iterations.push(f64::from(iterations));
         }
-    };
-    let row = |e: &EnergyAccount<f64, N>| {
+    }
+
+    /// The energy row of a step: every step's with the histories (`last` false), else
+    /// only the run's last (`last` true, at the end).
+    fn energy(&mut self, row: Option<[f64; 6]>, last: bool) {
+        if let Some(row) = row
+            && self.histories != last
+        {
+            self.o.energy.extend_from_slice(&row);
+        }
+    }
+
+    fn finish(mut self) -> BuildingOut {
+        self.o.peak_drifts = self.peaks;
+        self.o
+    }
+}
+
+/// The energy row `E_in, E_k, E_s, E_v, E_h, error` of an account (either path's).
+macro_rules! energy_row {
+    ($e:expr) => {{
+        let e = $e;
         [
             e.input,
             e.kinetic,
@@ -768,12 +787,29 @@ fn building_run<const N: usize, L: Law<f64>>(
             e.hysteretic,
             e.balance_error(),
         ]
-    };
-    keep(&mut o, &s, 0);
-    if let (Some(e), true) = (account.as_ref(), histories) {
-        o.energy.extend_from_slice(&row(e));
-    }
-    for n in 1..steps {
+    }};
+}
+
+fn building_run<const N: usize, L: Law<f64>>(
+    laws: [L; N],
+    job: &BuildingJob,
+    stop: &AtomicBool,
+) -> Res<BuildingOut> {
+    let masses: [f64; N] = core::array::from_fn(|i| job.masses[i]);
+    let building = ShearBuilding::<f64, L, N>::new(masses, laws, &rows::<N>(&job.c))?;
+    let stepper = Nonlinear::<f64, N>::new(job.h, job.settings)?;
+    let zero = SVector::<f64, N>::zeros();
+    let p0 = building.ground_load(job.ag[0]);
+    let (mut s, mut history) = stepper
+        .start_with_history(&building, &zero, &zero, &p0, &building.initial_history())
+        .map_err(at(0))?;
+    let mut account = job
+        .energy
+        .then(|| EnergyAccount::start(&building, &s, &history, &p0));
+    let mut o = Recorder::new(job, N, account.as_ref().map_or(f64::NAN, |e| e.initial))?;
+    o.keep(s.u().as_slice(), s.v().as_slice(), s.a().as_slice(), 0);
+    o.energy(account.as_ref().map(|e| energy_row!(e)), false);
+    for n in 1..job.ag.len() {
         stopped(stop, n)?;
         let p = building.ground_load(job.ag[n]);
         let previous = history;
@@ -782,17 +818,55 @@ fn building_run<const N: usize, L: Law<f64>>(
             .map_err(at(n))?;
         if let Some(e) = account.as_mut() {
             e.step(&building, &previous, &s, &history, &p);
-            if histories {
-                o.energy.extend_from_slice(&row(e));
-            }
         }
-        keep(&mut o, &s, report.iterations);
+        o.energy(account.as_ref().map(|e| energy_row!(e)), false);
+        o.keep(
+            s.u().as_slice(),
+            s.v().as_slice(),
+            s.a().as_slice(),
+            report.iterations,
+        );
     }
-    if let (Some(e), false) = (account.as_ref(), histories) {
-        o.energy.extend_from_slice(&row(e));
+    o.energy(account.as_ref().map(|e| energy_row!(e)), true);
+    Ok(o.finish())
+}
+
+/// [`building_run`] at a run-time size (`DynShearBuilding`, `DynNonlinear`,
+/// `DynEnergyAccount`: bit-identical to the compiled path where both serve).
+fn building_any<L: Law<f64>>(
+    laws: Vec<L>,
+    job: &BuildingJob,
+    stop: &AtomicBool,
+) -> Res<BuildingOut> {
+    let n = laws.len();
+    let c = DMatrix::from_row_slice(n, n, &job.c);
+    let building = DynShearBuilding::<f64, L>::new(&job.masses, laws, &c)?;
+    let stepper = DynNonlinear::<f64>::new(job.h, job.settings)?;
+    let (zero, mut p) = (vec![0.0; n], vec![0.0; n]);
+    building.ground_load(job.ag[0], &mut p);
+    let mut s = stepper.start(&building, &zero, &zero, &p).map_err(at(0))?;
+    let mut account = job
+        .energy
+        .then(|| DynEnergyAccount::start(&building, &s, &p));
+    let mut o = Recorder::new(
+        job,
+        n,
+        account.as_ref().map_or(f64::NAN, |e| e.totals().initial),
+    )?;
+    o.keep(s.u(), s.v(), s.a(), 0);
+    o.energy(account.as_ref().map(|e| energy_row!(e.totals())), false);
+    for step in 1..job.ag.len() {
+        stopped(stop, step)?;
+        building.ground_load(job.ag[step], &mut p);
+        let report = stepper.try_step(&building, &mut s, &p).map_err(at(step))?;
+        if let Some(e) = account.as_mut() {
+            e.step(&building, &s, &p);
+        }
+        o.energy(account.as_ref().map(|e| energy_row!(e.totals())), false);
+        o.keep(s.u(), s.v(), s.a(), report.iterations);
     }
-    o.peak_drifts = peaks.to_vec();
-    Ok(o)
+    o.energy(account.as_ref().map(|e| energy_row!(e.totals())), true);
+    Ok(o.finish())
 }
 
 /// The storey laws from the parameter rows (`laws.rs`), then the run.
@@ -809,6 +883,19 @@ fn building_n<const N: usize, const S: usize>(
         }
     }
     laws::with_laws::<N, _>(law, &job.params, job.width, Run(job, stop))
+}
+
+/// [`building_n`] for `n` storeys outside the compiled sizes (or any `n` with
+/// `compiled=False`): the run-time-sized path.
+fn building_vec(law: &str, job: &BuildingJob, n: usize, stop: &AtomicBool) -> Res<BuildingOut> {
+    struct Run<'a>(&'a BuildingJob, &'a AtomicBool);
+    impl laws::WithLawVec for Run<'_> {
+        type Out = BuildingOut;
+        fn run<L: Law<f64> + Send + Sync>(self, laws: Vec<L>) -> Res<BuildingOut> {
+            building_any::<L>(laws, self.0, self.1)
+        }
+    }
+    laws::with_law_vec(law, &job.params, job.width, n, Run(job, stop))
 }
 
 /// Step a hysteretic shear building (`ShearBuilding` with the `Nonlinear` AEM stepper and
@@ -834,8 +921,12 @@ fn building_n<const N: usize, const S: usize>(
 /// kinetic, recoverable strain, viscous, hysteretic energies and the balance error (J);
 /// `initial_energy` (J). Raises the library's errors (`NotConverged` with `.step`,
 /// `InvalidMaterial`, `InvalidNewtonSettings`, …).
+///
+/// Any `n ≥ 1`: sizes in [`SIZES`] run the compiled `Nonlinear<f64, N>`, others the
+/// run-time-sized `DynNonlinear` on a `DynShearBuilding` (bit-identical where both serve;
+/// `compiled=False` takes the run-time path at every size, to compare).
 #[pyfunction]
-#[pyo3(signature = (masses, law, params, c, h, ag, max_iterations=20, tolerance=1e-10, energy=true, histories=true))]
+#[pyo3(signature = (masses, law, params, c, h, ag, max_iterations=20, tolerance=1e-10, energy=true, histories=true, compiled=true))]
 #[allow(clippy::too_many_arguments)]
 fn shear_building<'py>(
     py: Python<'py>,
@@ -849,11 +940,15 @@ fn shear_building<'py>(
     tolerance: f64,
     energy: bool,
     histories: bool,
+    compiled: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let width = laws::known_law(law)?;
     let prepare = || -> Res<(BuildingJob, usize)> {
         let masses = read1(&masses);
         let n = masses.len();
+        if n == 0 {
+            return shape("masses must have at least one storey".into());
+        }
         let (p, r, cols) = read2(&params);
         if r != n || cols != width {
             return shape(format!(
@@ -864,6 +959,7 @@ fn shear_building<'py>(
         let steps = ag.as_array().dim();
         let kept = if histories { steps } else { 0 };
         let rows = if energy { kept.max(1) } else { 0 };
+        // The run-time path also holds `C` twice and `n²` of Newton work space.
         fits(
             "shear_building",
             &[
@@ -873,6 +969,9 @@ fn shear_building<'py>(
                 (kept, n),
                 (kept, 1),
                 (rows, 6),
+                (n, n),
+                (n, n),
+                (n, n),
             ],
         )?;
         let ag = read1(&ag);
@@ -896,7 +995,11 @@ fn shear_building<'py>(
     };
     let (job, n) = prepare().map_err(|f| f.raise(py))?;
     let o = interruptible(py, work_units(job.ag.len(), n, 2), |stop| {
-        by_size!(n, building_n(law, &job, stop))
+        if compiled {
+            by_size!(n, building_n(law, &job, stop) else building_vec(law, &job, n, stop))
+        } else {
+            building_vec(law, &job, n, stop)
+        }
     })?;
     let d = PyDict::new(py);
     let peak = o.peak_drifts.iter().fold(0.0f64, |m, &x| m.max(x));

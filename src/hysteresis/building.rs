@@ -72,32 +72,7 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
     /// smallest normal number of `T`: subnormal or rounded to zero, e.g. `6e-322` kg in
     /// `f32`, whose start then failed with a singular mass). Cost: O(N²).
     pub fn new(masses: [f64; N], laws: [L; N], damping: &Rows<N>) -> Result<Self, Error> {
-        if !masses
-            .iter()
-            .chain(damping.iter().flatten())
-            .all(|x| x.is_finite())
-        {
-            return Err(Error::NonFiniteInput);
-        }
-        if masses.iter().any(|&m| m <= 0.0) {
-            return Err(Error::MassNotSpd);
-        }
-        super::fits::<T>(&masses)?;
-        let smallest = if T::MAX < f64::MAX {
-            f64::from(f32::MIN_POSITIVE)
-        } else {
-            f64::MIN_POSITIVE
-        };
-        if masses.iter().any(|&m| m < smallest) {
-            return Err(Error::OperatorUnderflow);
-        }
-        for row in damping {
-            super::fits::<T>(row)?;
-        }
-        let tridiagonal = (0..N).all(|i| {
-            (0..N).all(|j| i.abs_diff(j) <= 1 || damping[i][j] == 0.0)
-                && (i == 0 || damping[i][i - 1] == damping[i - 1][i])
-        });
+        let tridiagonal = check_building::<T>(&masses, damping.as_flattened())?;
         let band = tridiagonal.then(|| SymTridiagonal {
             diagonal: SVector::from_fn(|i, _| T::from_f64_rounded(damping[i][i])),
             off: SVector::from_fn(|i, _| {
@@ -174,37 +149,22 @@ impl<T: Real, L: Law<T>, const N: usize> ShearBuilding<T, L, N> {
         committed: &[L::History; N],
         u: &SVector<T, N>,
         v: &SVector<T, N>,
-        mut tangent: Option<&mut TridiagonalTangent<T, N>>,
+        tangent: Option<&mut TridiagonalTangent<T, N>>,
     ) -> Trial<T, N, [L::History; N]> {
-        let (ua, va) = (&u.data.0[0], &v.data.0[0]);
         let mut force = match &self.band {
             Some(band) => band.mul(v).data.0[0],
             None => (self.damping * v).data.0[0],
         };
         let mut history = *committed;
-        let mut branch = 0u64;
-        let (mut u_below, mut v_below) = (T::zero(), T::zero());
-        for i in 0..N {
-            // δ_i = u_i − u_{i−1} (u_{−1} = 0: δ_0 = u_0 exactly), as `drifts`.
-            let (d, r) = if i == 0 {
-                (ua[0], va[0])
-            } else {
-                (ua[i] - u_below, va[i] - v_below)
-            };
-            (u_below, v_below) = (ua[i], va[i]);
-            let s = self.laws[i].trial(&committed[i], d, r);
-            force[i] += s.force;
-            if i > 0 {
-                force[i - 1] -= s.force;
-            }
-            if s.inelastic {
-                branch |= 1 << (i % 64);
-            }
-            history[i] = s.history;
-            if let Some(t) = tangent.as_deref_mut() {
-                add_storey(t, i, s.stiffness, s.damping);
-            }
-        }
+        let bands = tangent.map(Bands::of);
+        let branch = storeys_flat(
+            &self.laws,
+            committed,
+            (&u.data.0[0], &v.data.0[0]),
+            &mut force,
+            &mut history,
+            bands,
+        );
         Trial {
             force: SVector::from(force),
             history,
@@ -256,8 +216,9 @@ impl<T: Real, L: Law<T>, const N: usize> HistoryModel<T, N> for ShearBuilding<T,
             stiffness: SymTridiagonal::zero(),
             damping: SymTridiagonal::zero(),
         };
+        let mut bands = Bands::of(&mut t);
         for (i, s) in storeys.iter().enumerate() {
-            add_storey(&mut t, i, s.stiffness, s.damping);
+            add_storey(&mut bands, i, s.stiffness, s.damping);
         }
         Some(Tangent {
             stiffness: t.stiffness.to_matrix(),
@@ -288,17 +249,114 @@ impl<T: Real, L: Law<T>, const N: usize> HistoryModel<T, N> for ShearBuilding<T,
     }
 }
 
-/// Add storey `i`'s tangent stiffness `k` and damping `c` (between floors `i − 1` and `i`;
-/// floor `−1` the ground) to `t`'s stiffness and damping bands: `k` on the diagonal at
-/// `i` and `i − 1`, `−k` off it. Cost: `4` additions.
+/// The checks of a shear building's floor masses (kg) and damping matrix (row-major
+/// `N×N`, N·s/m) in the documented order of [`ShearBuilding::new`]; `Ok(true)` when the
+/// damping matrix is symmetric tridiagonal (every other entry zero). The one check of the
+/// const-generic and the run-time-sized (`std`) buildings. Cost: O(N²).
+///
+/// Errors: [`Error::NonFiniteInput`], [`Error::MassNotSpd`], [`Error::OperatorOverflow`],
+/// [`Error::OperatorUnderflow`].
+pub(crate) fn check_building<T: Real>(masses: &[f64], damping: &[f64]) -> Result<bool, Error> {
+    let n = masses.len();
+    if !masses.iter().chain(damping).all(|x| x.is_finite()) {
+        return Err(Error::NonFiniteInput);
+    }
+    if masses.iter().any(|&m| m <= 0.0) {
+        return Err(Error::MassNotSpd);
+    }
+    super::fits::<T>(masses)?;
+    let smallest = if T::MAX < f64::MAX {
+        f64::from(f32::MIN_POSITIVE)
+    } else {
+        f64::MIN_POSITIVE
+    };
+    if masses.iter().any(|&m| m < smallest) {
+        return Err(Error::OperatorUnderflow);
+    }
+    for row in damping.chunks(n.max(1)) {
+        super::fits::<T>(row)?;
+    }
+    Ok((0..n).all(|i| {
+        (0..n).all(|j| i.abs_diff(j) <= 1 || damping[i * n + j] == 0.0)
+            && (i == 0 || damping[i * n + i - 1] == damping[(i - 1) * n + i])
+    }))
+}
+
+/// The tangent bands a trial adds its storeys to: `[diagonal, off]` of `∂F/∂u` and of
+/// `∂F/∂v` (each `N` values; `off[0]` not written).
+pub(crate) struct Bands<'a, T> {
+    pub(crate) stiffness: [&'a mut [T]; 2],
+    pub(crate) damping: [&'a mut [T]; 2],
+}
+
+impl<'a, T: Real> Bands<'a, T> {
+    /// The stiffness and damping bands of `t`.
+    #[inline(always)]
+    fn of<const N: usize>(t: &'a mut TridiagonalTangent<T, N>) -> Self {
+        let (k, c) = (&mut t.stiffness, &mut t.damping);
+        Bands {
+            stiffness: [&mut k.diagonal.data.0[0], &mut k.off.data.0[0]],
+            damping: [&mut c.diagonal.data.0[0], &mut c.off.data.0[0]],
+        }
+    }
+}
+
+/// The storey loop of every shear-building trial, on slices of `N = laws.len()` values:
+/// each storey's law at its drift `δ_i = u_i − u_{i−1}` and drift rate (`u_{−1} = 0`:
+/// `δ_0 = u_0` exactly, as [`models::drifts`](crate::models::drifts)) from its `committed`
+/// history, its force added to `force` (`+f_i` at `i`, `−f_i` at `i − 1`; `force` holds
+/// `C v` on entry), its trial history into `history`, and — with `bands` — its tangent
+/// added to them. Returns the branch signature (bit `i mod 64` set when storey `i` is
+/// inelastic). The one loop of the const-generic [`ShearBuilding`] and the run-time-sized
+/// one (`std`). Cost: `N` law trials and `2N` adds (`4N` more with `bands`).
 #[inline(always)]
-fn add_storey<T: Real, const N: usize>(t: &mut TridiagonalTangent<T, N>, i: usize, k: T, c: T) {
-    t.stiffness.diagonal[i] += k;
-    t.damping.diagonal[i] += c;
+pub(crate) fn storeys_flat<T: Real, L: Law<T>>(
+    laws: &[L],
+    committed: &[L::History],
+    (ua, va): (&[T], &[T]),
+    force: &mut [T],
+    history: &mut [L::History],
+    mut bands: Option<Bands<'_, T>>,
+) -> u64 {
+    let mut branch = 0u64;
+    let (mut u_below, mut v_below) = (T::zero(), T::zero());
+    for i in 0..laws.len() {
+        // δ_i = u_i − u_{i−1} (u_{−1} = 0: δ_0 = u_0 exactly), as `drifts`.
+        let (d, r) = if i == 0 {
+            (ua[0], va[0])
+        } else {
+            (ua[i] - u_below, va[i] - v_below)
+        };
+        (u_below, v_below) = (ua[i], va[i]);
+        let s = laws[i].trial(&committed[i], d, r);
+        force[i] += s.force;
+        if i > 0 {
+            force[i - 1] -= s.force;
+        }
+        if s.inelastic {
+            branch |= 1 << (i % 64);
+        }
+        history[i] = s.history;
+        if let Some(t) = bands.as_mut() {
+            add_storey(t, i, s.stiffness, s.damping);
+        }
+    }
+    branch
+}
+
+/// Add storey `i`'s tangent stiffness `k` and damping `c` (between floors `i − 1` and `i`;
+/// floor `−1` the ground) to the stiffness and damping bands: `k` on the diagonal at `i`
+/// and `i − 1`, `−k` off it. Cost: `4` additions.
+#[inline(always)]
+fn add_storey<T: Real>(t: &mut Bands<'_, T>, i: usize, k: T, c: T) {
+    let [kd, ko] = &mut t.stiffness;
+    let [cd, co] = &mut t.damping;
+    kd[i] += k;
+    cd[i] += c;
     if i > 0 {
-        t.stiffness.diagonal[i - 1] += k;
-        t.stiffness.off[i] -= k;
-        t.damping.diagonal[i - 1] += c;
-        t.damping.off[i] -= c;
+        kd[i - 1] += k;
+        ko[i] -= k;
+        cd[i - 1] += c;
+        co[i] -= c;
     }
 }

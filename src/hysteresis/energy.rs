@@ -98,6 +98,25 @@ impl<T: Real, const N: usize> EnergyAccount<T, N> {
         let kinetic = kinetic(building, v);
         let recoverable = building.recoverable_energy(history, u);
         let storeys = building.storeys(history, u, v);
+        Self::begin(
+            kinetic,
+            recoverable,
+            [
+                *u,
+                *load,
+                building.damping() * v,
+                SVector::from_fn(|i, _| storeys[i].force),
+            ],
+        )
+    }
+
+    /// An account at a start with kinetic and recoverable energies `kinetic`,
+    /// `recoverable` (J), every integral zero, and `[u, load, C v, storey forces]` there.
+    fn begin(
+        kinetic: T,
+        recoverable: T,
+        [u, load, damping_force, storey_force]: [SVector<T, N>; 4],
+    ) -> Self {
         Self {
             initial: kinetic + recoverable,
             input: T::zero(),
@@ -109,10 +128,10 @@ impl<T: Real, const N: usize> EnergyAccount<T, N> {
             recoverable0: recoverable,
             max_input: T::zero(),
             max_error: T::zero(),
-            u: *u,
-            load: *load,
-            damping_force: building.damping() * v,
-            storey_force: SVector::from_fn(|i, _| storeys[i].force),
+            u,
+            load,
+            damping_force,
+            storey_force,
         }
     }
 
@@ -137,16 +156,33 @@ impl<T: Real, const N: usize> EnergyAccount<T, N> {
         let storeys = building.storeys(previous, u, v);
         let storey_force = SVector::<T, N>::from_fn(|i, _| storeys[i].force);
         let d_drift = crate::models::drifts(&du);
-        self.input += (self.load + load).dot(&du) * half;
-        self.viscous += (self.damping_force + damping_force).dot(&du) * half;
-        self.storey_work += (self.storey_force + storey_force).dot(&d_drift) * half;
-        self.kinetic = kinetic(building, v);
-        self.recoverable = building.recoverable_energy(history, u);
-        self.hysteretic = self.storey_work - (self.recoverable - self.recoverable0);
+        let works = [
+            (self.load + load).dot(&du) * half,
+            (self.damping_force + damping_force).dot(&du) * half,
+            (self.storey_force + storey_force).dot(&d_drift) * half,
+        ];
         self.u = *u;
         self.load = *load;
         self.damping_force = damping_force;
         self.storey_force = storey_force;
+        self.settle(
+            works,
+            kinetic(building, v),
+            building.recoverable_energy(history, u),
+        );
+    }
+    /// The end of an accounted step: the works of the step (`input`, `viscous`, `storey`:
+    /// mean force times increment, J) added, the kinetic and recoverable energies now,
+    /// `E_h`, the running maxima. The one update of this account and the run-time-sized
+    /// one (`std`, which keeps an `EnergyAccount<T, 0>` for its totals).
+    #[inline]
+    pub(crate) fn settle(&mut self, [input, viscous, storey]: [T; 3], kinetic: T, recoverable: T) {
+        self.input += input;
+        self.viscous += viscous;
+        self.storey_work += storey;
+        self.kinetic = kinetic;
+        self.recoverable = recoverable;
+        self.hysteretic = self.storey_work - (self.recoverable - self.recoverable0);
         self.max_input = self.max_input.max(self.input.abs());
         // Not `max`, which drops a NaN: a non-finite balance sticks (`max_balance_error`).
         let e = self.balance_error().abs();
@@ -166,8 +202,8 @@ impl<T: Real, const N: usize> EnergyAccount<T, N> {
     /// The largest `|balance_error|` over the steps accounted so far (J).
     ///
     /// Errors: [`Error::NonFiniteState`] if the balance of a step accounted was NaN or
-    /// infinite (an energy overflowed, or a NaN reached the account): the largest error is
-    /// then unknown, not the largest of the finite ones. Cost: O(1).
+    /// infinite (an energy overflowed, or a NaN reached the account): the largest error
+    /// is then unknown, not the largest of the finite ones. Cost: O(1).
     pub fn max_balance_error(&self) -> Result<T, Error> {
         if self.max_error.is_finite() {
             Ok(self.max_error)
@@ -180,6 +216,15 @@ impl<T: Real, const N: usize> EnergyAccount<T, N> {
     /// balance error against. Cost: O(1).
     pub fn max_input(&self) -> T {
         self.max_input
+    }
+}
+
+impl<T: Real> EnergyAccount<T, 0> {
+    /// The totals of a run-time-sized account (`std`) at its start: `E_k` and `E_s` there,
+    /// every integral zero.
+    #[cfg(feature = "std")]
+    pub(crate) fn totals(kinetic: T, recoverable: T) -> Self {
+        Self::begin(kinetic, recoverable, [SVector::zeros(); 4])
     }
 }
 

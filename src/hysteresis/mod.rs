@@ -38,6 +38,8 @@ mod parallel;
 pub use bilinear::{Bilinear, BilinearHistory};
 pub use bouc_wen::{BoucWen, BoucWenHistory};
 pub use building::ShearBuilding;
+#[cfg(feature = "std")]
+pub(crate) use building::{Bands, check_building, storeys_flat};
 pub use energy::EnergyAccount;
 pub use friction::Friction;
 pub use parallel::Parallel;

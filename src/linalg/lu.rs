@@ -266,17 +266,28 @@ pub(crate) fn solve_in_place_scaled<T: Real, const N: usize>(
     b: &mut SVector<T, N>,
     scales: &SVector<T, N>,
 ) -> bool {
-    let tiny = T::from_f64_rounded(N as f64) * T::default_epsilon();
-    // Column-major storage, `a[c][r]` = A(r, c); plain array indexing with loop-bounded
-    // indices, which the compiler proves in bounds (no panic path in the binary).
-    let a = &mut a.data.0;
-    let x = &mut b.data.0[0];
     let mut s = scales.data.0[0];
-    for col in 0..N {
+    solve_in_place_flat(a.as_mut_slice(), &mut b.data.0[0], &mut s)
+}
+
+/// [`solve_in_place_scaled`] on slices: `a` the `n×n` matrix column by column (`a[c·n + r]`
+/// = A(r, c), overwritten), `b` the right-hand side of `n = b.len()` values (becomes `x`),
+/// `s` the row scales (permuted alongside): the one elimination of the const-generic steps
+/// and the run-time-sized shear building (`std`). `false` — with `b` unspecified — when a
+/// pivot is not finite or at most `n·ε·s[r]`, or a slice has the wrong length. Cost:
+/// `n³/3 + n²` multiply-adds; no allocation.
+#[inline(always)]
+pub(crate) fn solve_in_place_flat<T: Real>(a: &mut [T], x: &mut [T], s: &mut [T]) -> bool {
+    let n = x.len();
+    if a.len() != n * n || s.len() != n {
+        return false;
+    }
+    let tiny = T::from_f64_rounded(n as f64) * T::default_epsilon();
+    for col in 0..n {
         let mut piv = col;
-        let mut best = a[col][col].abs() / s[col];
-        for r in col + 1..N {
-            let e = a[col][r].abs() / s[r];
+        let mut best = a[col * n + col].abs() / s[col];
+        for r in col + 1..n {
+            let e = a[col * n + r].abs() / s[r];
             if e > best {
                 best = e;
                 piv = r;
@@ -287,31 +298,33 @@ pub(crate) fn solve_in_place_scaled<T: Real, const N: usize>(
             return false;
         }
         if piv != col {
-            for column in a.iter_mut() {
+            for column in a.chunks_exact_mut(n) {
                 column.swap(piv, col);
             }
             x.swap(piv, col);
             s.swap(piv, col);
         }
-        let d = a[col][col];
-        for r in col + 1..N {
-            let f = a[col][r] / d;
+        let (head, tail) = a.split_at_mut((col + 1) * n);
+        let pivot = &head[col * n..];
+        let d = pivot[col];
+        for r in col + 1..n {
+            let f = pivot[r] / d;
             if f != T::zero() {
-                for k in col + 1..N {
-                    let p = a[k][col];
-                    a[k][r] -= f * p;
+                for column in tail.chunks_exact_mut(n) {
+                    let p = column[col];
+                    column[r] -= f * p;
                 }
                 let xc = x[col];
                 x[r] -= f * xc;
             }
         }
     }
-    for col in (0..N).rev() {
+    for col in (0..n).rev() {
         let mut t = x[col];
-        for k in col + 1..N {
-            t -= a[k][col] * x[k];
+        for k in col + 1..n {
+            t -= a[k * n + col] * x[k];
         }
-        x[col] = t / a[col][col];
+        x[col] = t / a[col * n + col];
     }
     true
 }

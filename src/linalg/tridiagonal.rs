@@ -28,19 +28,13 @@ impl<T: Real, const N: usize> SymTridiagonal<T, N> {
     /// A_{i,i+1} x_{i+1}`): the same value as the dense product, whose other terms are
     /// exact zeros. Cost: `3N` multiplies, `2N` adds.
     pub fn mul(&self, x: &SVector<T, N>) -> SVector<T, N> {
-        let (d, e, x) = (&self.diagonal.data.0[0], &self.off.data.0[0], &x.data.0[0]);
         let mut y = [T::zero(); N];
-        for i in 0..N {
-            let mut s = T::zero();
-            if i > 0 {
-                s = e[i] * x[i - 1];
-            }
-            s += d[i] * x[i];
-            if i + 1 < N {
-                s += e[i + 1] * x[i + 1];
-            }
-            y[i] = s;
-        }
+        mul_flat(
+            &self.diagonal.data.0[0],
+            &self.off.data.0[0],
+            &x.data.0[0],
+            &mut y,
+        );
         SVector::from(y)
     }
 
@@ -79,14 +73,54 @@ pub(crate) fn solve_positive<T: Real, const N: usize>(
     b: &mut SVector<T, N>,
     scale: T,
 ) -> bool {
-    let tiny = T::from_f64_rounded(N as f64) * T::default_epsilon() * scale;
-    // Plain array indexing with loop-bounded indices, proved in bounds by the compiler.
-    let (d, e) = (&a.diagonal.data.0[0], &a.off.data.0[0]);
-    let x = &mut b.data.0[0];
-    // 1 / d_i of the factorization: one division a row, multiplications after it.
     let mut inv = [T::zero(); N];
+    solve_positive_flat(
+        &a.diagonal.data.0[0],
+        &a.off.data.0[0],
+        &mut b.data.0[0],
+        &mut inv,
+        scale,
+    )
+}
+
+/// `y = A x` for the symmetric tridiagonal `A` of diagonal `d` and off-diagonal `e`
+/// (`e[0]` not read), `n = y.len()` rows, each summed in column order: the one product
+/// behind [`SymTridiagonal::mul`] and the run-time-sized shear building (`std`). Every
+/// slice holds `n` values. Cost: `3n` multiplies, `2n` adds.
+#[inline(always)]
+pub(crate) fn mul_flat<T: Real>(d: &[T], e: &[T], x: &[T], y: &mut [T]) {
+    let n = y.len();
+    for i in 0..n {
+        let mut s = T::zero();
+        if i > 0 {
+            s = e[i] * x[i - 1];
+        }
+        s += d[i] * x[i];
+        if i + 1 < n {
+            s += e[i + 1] * x[i + 1];
+        }
+        y[i] = s;
+    }
+}
+
+/// [`solve_positive`] on slices (`n = b.len()`; `d`, `e` and the work space `inv`, which
+/// receives `1/d_i` of the factorization, hold `n` values each): the one `L D Lᵀ` solve
+/// of the const-generic and the run-time-sized (`std`) Newton iterations. Returns `false`
+/// — with `b` unspecified — as [`solve_positive`]. Cost: `n` divisions, `6n`
+/// multiply-or-adds; no allocation.
+#[inline(always)]
+pub(crate) fn solve_positive_flat<T: Real>(
+    d: &[T],
+    e: &[T],
+    b: &mut [T],
+    inv: &mut [T],
+    scale: T,
+) -> bool {
+    let n = b.len();
+    let tiny = T::from_f64_rounded(n as f64) * T::default_epsilon() * scale;
+    let x = b;
     let mut prev = T::zero(); // 1 / d_{i−1}
-    for i in 0..N {
+    for i in 0..n {
         let l = e[i] * prev; // l_i = e_i / d_{i−1}; e_0 is not read (prev = 0)
         let di = if i == 0 { d[0] } else { d[i] - l * e[i] };
         // A NaN pivot fails `di > tiny` too.
@@ -100,8 +134,8 @@ pub(crate) fn solve_positive<T: Real, const N: usize>(
         prev = T::one() / di;
         inv[i] = prev;
     }
-    for i in (0..N).rev() {
-        let upper = if i + 1 < N {
+    for i in (0..n).rev() {
+        let upper = if i + 1 < n {
             e[i + 1] * x[i + 1]
         } else {
             T::zero()

@@ -304,6 +304,13 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
         self.settings
     }
 
+    /// The step's kinematics `h`, `h/2`, `h²/4` in `T` (the run-time-sized stepper, `std`,
+    /// takes them from here: one check and one rounding). Cost: O(1).
+    #[cfg(feature = "std")]
+    pub(crate) fn kinematics(&self) -> AemKinematics<T> {
+        self.kin
+    }
+
     /// The state at `t = 0`, with `q0 = M⁻¹ (p0 − F(u0, v0))` (paper eq. 45).
     ///
     /// Errors: [`Error::NonFiniteInput`] (`u0`, `v0`, `p0` or `M`),
@@ -474,17 +481,8 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
     ) -> Result<Candidate<T, N, Mo::History>, Error> {
         let (b, c) = (self.kin.half_h, self.kin.quarter_h2);
         let (vh, uh) = self.kin.predict_all(&state.u, &state.v, &state.a);
-        let (budget, fixed) = match self.settings.iterations {
-            Iterations::UpTo(k) => (k, false),
-            Iterations::Exactly(k) => (k, true),
-        };
-        let tol = self.settings.tolerance;
-        let p_size = norm_inf(p);
+        let mut newton = Progress::new(self.settings, norm_inf(p), (b, c));
         let mut q = state.a;
-        let mut iterations = 0u32;
-        let mut last_delta = T::zero();
-        let mut branch_changes = 0u32;
-        let mut last_branch = 0u64;
         loop {
             let (v, u) = self.kin.correct_all(&vh, &uh, &q);
             let (trial, mq) = path.evaluate(&u, &v, &q)?;
@@ -496,45 +494,19 @@ impl<T: Real, const N: usize> Nonlinear<T, N> {
             if !all_finite(&f) {
                 return Err(Error::NonFiniteForce);
             }
-            if iterations > 0 && branch != last_branch {
-                branch_changes += 1;
-            }
-            last_branch = branch;
             let r = mq + f - p;
-            let residual = relative_residual(&r, &mq, &f, p_size);
-            let correction = if iterations == 0 {
-                T::zero()
-            } else {
-                let reference = norm_inf(&q).max(norm_inf(&u) / c).max(norm_inf(&v) / b);
-                if last_delta <= T::zero() {
-                    T::zero()
-                } else if reference > T::zero() {
-                    last_delta / reference
-                } else {
-                    T::one()
-                }
-            };
-            let converged = residual <= tol || (iterations > 0 && correction <= tol);
-            let done = iterations >= budget || (!fixed && converged);
-            if done {
+            let forces = [r.as_slice(), mq.as_slice(), f.as_slice()];
+            if let Some(report) = newton.judge(branch, forces, [&q, &u, &v].map(|x| x.as_slice())) {
                 let next = State::unchecked(u, v, q, state.n.wrapping_add(1));
                 if !next.is_finite() {
                     return Err(Error::NonFiniteState);
                 }
-                let report = NewtonReport {
-                    iterations,
-                    residual,
-                    correction,
-                    converged,
-                    branch_changes,
-                };
                 return Ok((next, history, report));
             }
             let mut delta = r;
             path.solve(&u, &v, &f, b, c, &mut delta)?;
             q -= delta;
-            last_delta = norm_inf(&delta);
-            iterations += 1;
+            newton.corrected(norm_inf(&delta));
         }
     }
 }
@@ -620,18 +592,16 @@ impl<T: Real, const N: usize, Mo: HistoryModel<T, N> + ?Sized>
         if !t.stiffness.is_finite() || !t.damping.is_finite() {
             return Err(Error::NonFiniteForce);
         }
-        let (m, d, k) = (&t.mass, &t.damping, &t.stiffness);
-        let mut scale = T::zero();
         let mut j = SymTridiagonal::zero();
-        for i in 0..N {
-            j.diagonal[i] = m.diagonal[i] + b * d.diagonal[i] + c * k.diagonal[i];
-            scale =
-                scale.max(m.diagonal[i].abs() + b * d.diagonal[i].abs() + c * k.diagonal[i].abs());
-            if i > 0 {
-                j.off[i] = m.off[i] + b * d.off[i] + c * k.off[i];
-                scale = scale.max(m.off[i].abs() + b * d.off[i].abs() + c * k.off[i].abs());
-            }
-        }
+        let scale = jacobian_flat(
+            [t.mass.diagonal.as_slice(), t.mass.off.as_slice()],
+            [t.damping.diagonal.as_slice(), t.damping.off.as_slice()],
+            [t.stiffness.diagonal.as_slice(), t.stiffness.off.as_slice()],
+            b,
+            c,
+            &mut j.diagonal.data.0[0],
+            &mut j.off.data.0[0],
+        );
         let rhs = *r;
         if tridiagonal::solve_positive(&j, r, scale) {
             return Ok(());
@@ -764,23 +734,138 @@ fn all_finite<T: Real, const N: usize>(x: &SVector<T, N>) -> bool {
 }
 
 fn norm_inf<T: Real, const N: usize>(x: &SVector<T, N>) -> T {
+    norm_inf_flat(x.as_slice())
+}
+
+/// `‖x‖∞`, folded in index order. Cost: `n`.
+#[inline(always)]
+pub(crate) fn norm_inf_flat<T: Real>(x: &[T]) -> T {
     x.iter().fold(T::zero(), |s, e| s.max(e.abs()))
 }
 
-/// `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` (`p_size = ‖p‖∞`), `0` when the denominator is zero
-/// (then `r = 0` too).
-fn relative_residual<T: Real, const N: usize>(
-    r: &SVector<T, N>,
-    mq: &SVector<T, N>,
-    f: &SVector<T, N>,
+/// The bookkeeping of one step's Newton iteration, shared by the const-generic and the
+/// run-time-sized (`std`) iterations: the budget, the tolerance, the iterations and the
+/// last correction, the branch changes. Cost: none beyond [`Progress::judge`].
+pub(crate) struct Progress<T> {
+    budget: u32,
+    fixed: bool,
+    tol: T,
+    /// `‖p‖∞`.
     p_size: T,
-) -> T {
-    let scale = norm_inf(mq).max(norm_inf(f)).max(p_size);
-    if scale > T::zero() {
-        norm_inf(r) / scale
-    } else {
-        T::zero()
+    /// `(h/2, h²/4)`.
+    bc: (T, T),
+    iterations: u32,
+    /// `‖δq‖∞` of the last correction.
+    last_delta: T,
+    branch_changes: u32,
+    last_branch: u64,
+}
+
+impl<T: Real> Progress<T> {
+    /// Before the first iterate, for a step with `settings`, load size `p_size = ‖p‖∞`
+    /// and kinematics `bc = (h/2, h²/4)`.
+    #[inline(always)]
+    pub(crate) fn new(settings: NewtonSettings<T>, p_size: T, bc: (T, T)) -> Self {
+        let (budget, fixed) = match settings.iterations {
+            Iterations::UpTo(k) => (k, false),
+            Iterations::Exactly(k) => (k, true),
+        };
+        Self {
+            budget,
+            fixed,
+            tol: settings.tolerance,
+            p_size,
+            bc,
+            iterations: 0,
+            last_delta: T::zero(),
+            branch_changes: 0,
+            last_branch: 0,
+        }
     }
+
+    /// The convergence test of an iterate ([`NewtonSettings::tolerance`]): its residual
+    /// `r = M q + F − p`, `M q` and `F`, its `q`, `u`, `v` (each `N` values) and its
+    /// trial's `branch`. The report when the iteration stops here (converged, or the
+    /// budget spent), else `None` (correct and judge the next iterate). The relative
+    /// residual `‖r‖∞ / max(‖M q‖∞, ‖F‖∞, ‖p‖∞)` is `0` when the denominator is (then
+    /// `r = 0` too). Cost: `7N` comparisons, 3 divisions.
+    #[inline(always)]
+    pub(crate) fn judge(
+        &mut self,
+        branch: u64,
+        [r, mq, f]: [&[T]; 3],
+        [q, u, v]: [&[T]; 3],
+    ) -> Option<NewtonReport<T>> {
+        let iterations = self.iterations;
+        if iterations > 0 && branch != self.last_branch {
+            self.branch_changes += 1;
+        }
+        self.last_branch = branch;
+        let (b, c) = self.bc;
+        let scale = norm_inf_flat(mq).max(norm_inf_flat(f)).max(self.p_size);
+        let residual = if scale > T::zero() {
+            norm_inf_flat(r) / scale
+        } else {
+            T::zero()
+        };
+        let correction = if iterations == 0 {
+            T::zero()
+        } else {
+            let reference = norm_inf_flat(q)
+                .max(norm_inf_flat(u) / c)
+                .max(norm_inf_flat(v) / b);
+            if self.last_delta <= T::zero() {
+                T::zero()
+            } else if reference > T::zero() {
+                self.last_delta / reference
+            } else {
+                T::one()
+            }
+        };
+        let converged = residual <= self.tol || (iterations > 0 && correction <= self.tol);
+        let done = iterations >= self.budget || (!self.fixed && converged);
+        done.then_some(NewtonReport {
+            iterations,
+            residual,
+            correction,
+            converged,
+            branch_changes: self.branch_changes,
+        })
+    }
+
+    /// After a Newton correction of size `delta = ‖δq‖∞`.
+    #[inline(always)]
+    pub(crate) fn corrected(&mut self, delta: T) {
+        self.last_delta = delta;
+        self.iterations += 1;
+    }
+}
+
+/// The Newton matrix `J = M + b ∂F/∂v + c ∂F/∂u` on three diagonals (`jd`, `jo`; `jo[0]`
+/// left as it is) from the bands `[diagonal, off]` of `M`, `∂F/∂v` (`d`) and `∂F/∂u`
+/// (`k`), and its entry scale `max |M| + b |∂F/∂v| + c |∂F/∂u|` for the pivot tests: the
+/// one assembly of the const-generic and the run-time-sized (`std`) tridiagonal Newton
+/// paths. Every slice holds `n = jd.len()` values. Cost: `16n` flops.
+#[inline(always)]
+pub(crate) fn jacobian_flat<T: Real>(
+    [md, mo]: [&[T]; 2],
+    [dd, doff]: [&[T]; 2],
+    [kd, ko]: [&[T]; 2],
+    b: T,
+    c: T,
+    jd: &mut [T],
+    jo: &mut [T],
+) -> T {
+    let mut scale = T::zero();
+    for i in 0..jd.len() {
+        jd[i] = md[i] + b * dd[i] + c * kd[i];
+        scale = scale.max(md[i].abs() + b * dd[i].abs() + c * kd[i].abs());
+        if i > 0 {
+            jo[i] = mo[i] + b * doff[i] + c * ko[i];
+            scale = scale.max(mo[i].abs() + b * doff[i].abs() + c * ko[i].abs());
+        }
+    }
+    scale
 }
 
 /// The state at step 0 with the acceleration from the equation of motion,
