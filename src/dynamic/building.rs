@@ -7,7 +7,7 @@
 use std::vec;
 use std::vec::Vec;
 
-use nalgebra::{DMatrix, DVectorView};
+use nalgebra::{DMatrix, DVectorView, SVectorView};
 
 use crate::hysteresis::{Bands, EnergyAccount, Law, check_building, storeys_flat};
 use crate::kinematics::{AemKinematics, Kinematics};
@@ -686,8 +686,17 @@ impl<T: Real, H: Copy> DynEnergyAccount<T, H> {
             for ((s, &a), &b) in sum.iter_mut().zip(a).zip(b) {
                 *s = a + b;
             }
-            let n = x.len();
-            DVectorView::from_slice(sum, n).dot(&DVectorView::from_slice(x, n))
+            // nalgebra sums fixed sizes 2, 3 and 4 in its own order (the const account's
+            // `dot`): the same views here give the same bits at every size.
+            fn fixed<T: Real, const K: usize>(a: &[T], b: &[T]) -> T {
+                SVectorView::<T, K>::from_slice(a).dot(&SVectorView::<T, K>::from_slice(b))
+            }
+            match x.len() {
+                2 => fixed::<T, 2>(sum, x),
+                3 => fixed::<T, 3>(sum, x),
+                4 => fixed::<T, 4>(sum, x),
+                n => DVectorView::from_slice(sum, n).dot(&DVectorView::from_slice(x, n)),
+            }
         };
         let works = [
             dot(&mut self.sum, &self.load, load, &self.du) * half,
