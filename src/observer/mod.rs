@@ -79,6 +79,7 @@
 mod fixed;
 mod kalman;
 // The one Kalman core: the correction and the Riccati equation with the cross covariance.
+mod flat;
 mod kalman_core;
 mod riccati;
 mod state_space;

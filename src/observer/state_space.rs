@@ -44,11 +44,14 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, input_kernel_operators, start_operators};
-use crate::linalg::lu::{Lu, row_scales};
+use super::flat::{identity_into, mul_into};
+use crate::kernel::{StartOps, Terms, input_kernel_operators, start_operators};
+use crate::kinematics::NewmarkKinematics;
+use crate::linalg::lu::{Lu, row_scales, solve_flat};
 use crate::linalg::{
     Mat, Rows, add_scaled, all_finite, identity, mul, put, rows_f64, scaled, transpose,
 };
+use crate::linalg::{add_scaled_flat, copy_flat};
 use crate::macros::mck_fn;
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
@@ -248,45 +251,165 @@ const fn newmark_blocks<const N: usize, const I: usize>(
         (Some(aw), Some((_, st))) => (aw, st),
         _ => return Err(Error::SingularMass),
     };
-    let kin = op.kin;
-    let zero_i = [[0.0; I]; N];
-    let id: Mat<N, N> = identity();
-    // The equation of motion: a = −M⁻¹K u − M⁻¹C v + M⁻¹B w.
-    let au = scaled(-1.0, &st.minv_k);
-    let av = scaled(-1.0, &st.minv_c);
-    // Predictor: v̂ = v + c_v a, û = u + h v̂ − c_u a.
-    let vh_u = scaled(kin.c_v, &au);
-    let vh_v = axpy(&id, kin.c_v, &av);
-    let vh_w = scaled(kin.c_v, &aw);
-    let uh_u = axpy(&axpy(&id, kin.h, &vh_u), -kin.c_u, &au);
-    let uh_v = axpy(&scaled(kin.h, &vh_v), -kin.c_u, &av);
-    let uh_w = axpy(&axpy(&zero_i, kin.h, &vh_w), -kin.c_u, &aw);
-    // q = M_eff⁻¹ (B w_n − C v̂ − K û): solves with the right-hand sides −C v̂ − K û, B.
-    let rhs_u = axpy(&scaled(-1.0, &mul(c, &vh_u)), -1.0, &mul(k, &uh_u));
-    let rhs_v = axpy(&scaled(-1.0, &mul(c, &vh_v)), -1.0, &mul(k, &uh_v));
-    let rhs_w = axpy(&scaled(-1.0, &mul(c, &vh_w)), -1.0, &mul(k, &uh_w));
-    let (qu, qv, qw, q1) = (
-        op.lu.solve(&rhs_u),
-        op.lu.solve(&rhs_v),
-        op.lu.solve(&rhs_w),
-        gb,
-    );
-    // Corrector: u_n = û + β h² q, v_n = v̂ + γ h q.
-    let (bh2, gh) = (kin.beta_h2, kin.gamma_h);
-    let blocks = NewmarkBlocks {
-        uu: axpy(&uh_u, bh2, &qu),
-        uv: axpy(&uh_v, bh2, &qv),
-        vu: axpy(&vh_u, gh, &qu),
-        vv: axpy(&vh_v, gh, &qv),
-        u0: axpy(&uh_w, bh2, &qw),
-        v0: axpy(&vh_w, gh, &qw),
-        u1: axpy(&zero_i, bh2, &q1),
-        v1: axpy(&zero_i, gh, &q1),
-        au,
-        av,
+    let z = [[0.0; N]; N];
+    let zi = [[0.0; I]; N];
+    let mut bl = NewmarkBlocks {
+        uu: z,
+        uv: z,
+        vu: z,
+        vv: z,
+        u0: zi,
+        v0: zi,
+        u1: zi,
+        v1: zi,
+        au: z,
+        av: z,
         aw,
     };
-    Ok(blocks)
+    let (mut t0, mut t1, mut t2, mut t3, mut t4) = (z, z, z, z, z);
+    let (mut w0, mut w1, mut w2) = (zi, zi, zi);
+    let (lu, perm) = op.lu.parts();
+    blocks_flat(
+        &Terms::of(m, c, k),
+        &BlockInputs {
+            minv_k: st.minv_k.as_flattened(),
+            minv_c: st.minv_c.as_flattened(),
+            aw: aw.as_flattened(),
+            gb: gb.as_flattened(),
+            lu,
+            perm,
+            kin: &op.kin,
+            inputs: I,
+        },
+        [
+            bl.uu.as_flattened_mut(),
+            bl.uv.as_flattened_mut(),
+            bl.vu.as_flattened_mut(),
+            bl.vv.as_flattened_mut(),
+            bl.au.as_flattened_mut(),
+            bl.av.as_flattened_mut(),
+        ],
+        [
+            bl.u0.as_flattened_mut(),
+            bl.v0.as_flattened_mut(),
+            bl.u1.as_flattened_mut(),
+            bl.v1.as_flattened_mut(),
+        ],
+        [
+            t0.as_flattened_mut(),
+            t1.as_flattened_mut(),
+            t2.as_flattened_mut(),
+            t3.as_flattened_mut(),
+            t4.as_flattened_mut(),
+        ],
+        [
+            w0.as_flattened_mut(),
+            w1.as_flattened_mut(),
+            w2.as_flattened_mut(),
+        ],
+    );
+    Ok(bl)
+}
+
+/// What the Newmark blocks are formed from (flat, row-major; `n = perm.len()`): the
+/// start-up operators `M⁻¹K`, `M⁻¹C`, `A_w = M⁻¹B`, `G B = M_eff⁻¹ B`, the factors of
+/// `M_eff` and the kinematic coefficients.
+pub(crate) struct BlockInputs<'a> {
+    pub(crate) minv_k: &'a [f64],
+    pub(crate) minv_c: &'a [f64],
+    pub(crate) aw: &'a [f64],
+    pub(crate) gb: &'a [f64],
+    pub(crate) lu: &'a [f64],
+    pub(crate) perm: &'a [usize],
+    pub(crate) kin: &'a NewmarkKinematics<f64>,
+    /// Inputs `I` (columns of `aw`, `gb`).
+    pub(crate) inputs: usize,
+}
+
+/// `dst = 0 + s·src` (the arrays' `scaled`, entry by entry).
+const fn set_scaled(dst: &mut [f64], s: f64, src: &[f64]) {
+    let mut i = 0;
+    while i < dst.len() {
+        dst[i] = 0.0;
+        i += 1;
+    }
+    add_scaled_flat(dst, s, src);
+}
+
+/// `dst = a + s·b`.
+const fn set_axpy(dst: &mut [f64], a: &[f64], s: f64, b: &[f64]) {
+    copy_flat(dst, a);
+    add_scaled_flat(dst, s, b);
+}
+
+/// The Newmark step's blocks (module docs) on flat slices: the one arithmetic of the
+/// const-generic [`StateSpace::from_rows_newmark`] and the run-time-sized
+/// [`DynStateSpace`](super::DynStateSpace). `sq = [uu, uv, vu, vv, au, av]` (`n×n`),
+/// `wi = [u0, v0, u1, v1]` (`n×I`) are written; `tn` (`n×n`) and `ti` (`n×I`) are
+/// scratch. Cost: about `8n³ + 6n²·I` flops.
+pub(crate) const fn blocks_flat(
+    t: &Terms<'_>,
+    x: &BlockInputs<'_>,
+    sq: [&mut [f64]; 6],
+    wi: [&mut [f64]; 4],
+    tn: [&mut [f64]; 5],
+    ti: [&mut [f64]; 3],
+) {
+    let (n, ni, kin) = (x.perm.len(), x.inputs, x.kin);
+    let [uu, uv, vu, vv, au, av] = sq;
+    let [u0, v0, u1, v1] = wi;
+    let [vh_u, vh_v, uh_u, uh_v, tmp] = tn;
+    let [vh_w, uh_w, tmp_i] = ti;
+    // The equation of motion: a = −M⁻¹K u − M⁻¹C v + M⁻¹B w.
+    set_scaled(au, -1.0, x.minv_k);
+    set_scaled(av, -1.0, x.minv_c);
+    // Predictor: v̂ = v + c_v a, û = u + h v̂ − c_u a.
+    set_scaled(vh_u, kin.c_v, au);
+    identity_into(vh_v, n);
+    add_scaled_flat(vh_v, kin.c_v, av);
+    set_scaled(vh_w, kin.c_v, x.aw);
+    identity_into(uh_u, n);
+    add_scaled_flat(uh_u, kin.h, vh_u);
+    add_scaled_flat(uh_u, -kin.c_u, au);
+    set_scaled(uh_v, kin.h, vh_v);
+    add_scaled_flat(uh_v, -kin.c_u, av);
+    set_scaled(uh_w, kin.h, vh_w);
+    add_scaled_flat(uh_w, -kin.c_u, x.aw);
+    // q = M_eff⁻¹ (B w_n − C v̂ − K û), corrector u_n = û + β h² q, v_n = v̂ + γ h q.
+    let (bh2, gh) = (kin.beta_h2, kin.gamma_h);
+    // u, v columns: the right-hand side into `tmp`, q into `uu` then the blocks.
+    rhs_q(t, vh_u, uh_u, n, n, x, [tmp, vu]);
+    set_axpy(uu, uh_u, bh2, vu);
+    copy_flat(tmp, vu);
+    set_axpy(vu, vh_u, gh, tmp);
+    rhs_q(t, vh_v, uh_v, n, n, x, [tmp, vv]);
+    set_axpy(uv, uh_v, bh2, vv);
+    copy_flat(tmp, vv);
+    set_axpy(vv, vh_v, gh, tmp);
+    // w columns.
+    rhs_q(t, vh_w, uh_w, n, ni, x, [tmp_i, u1]);
+    set_axpy(u0, uh_w, bh2, u1);
+    set_axpy(v0, vh_w, gh, u1);
+    set_scaled(u1, bh2, x.gb);
+    set_scaled(v1, gh, x.gb);
+}
+
+/// `q = M_eff⁻¹ ((0 − C v̂) − K û)` for `c` columns into `out[1]` (`out[0]` scratch).
+const fn rhs_q(
+    t: &Terms<'_>,
+    vh: &[f64],
+    uh: &[f64],
+    n: usize,
+    c: usize,
+    x: &BlockInputs<'_>,
+    out: [&mut [f64]; 2],
+) {
+    let [rhs, q] = out;
+    mul_into(q, t.c, false, vh, false, n, n, c);
+    set_scaled(rhs, -1.0, q);
+    mul_into(q, t.k, false, uh, false, n, n, c);
+    add_scaled_flat(rhs, -1.0, q);
+    solve_flat(x.lu, x.perm, rhs, c, q);
 }
 
 impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
