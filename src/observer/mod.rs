@@ -76,6 +76,8 @@
 //! above) the innovations' covariance, the mean window statistic (150.0 ± 0.2 over 158 000
 //! windows) and the false alarms at `α = 10⁻²` and `10⁻³` (inside their binomial bands).
 
+#[cfg(feature = "std")]
+mod dynamic;
 mod fixed;
 mod kalman;
 // The one Kalman core: the correction and the Riccati equation with the cross covariance.
@@ -84,6 +86,8 @@ mod kalman_core;
 mod riccati;
 mod state_space;
 
+#[cfg(feature = "std")]
+pub use dynamic::{DynEstimate, DynMeasurement, DynObserver, DynStateSpace, DynSteadyState};
 pub use fixed::{Estimate, Observer, Readout};
 pub(crate) use fixed::{check_counts, estimate_counters, mul2, next_counts};
 pub use kalman::{Kalman, KalmanState};

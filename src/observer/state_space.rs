@@ -51,7 +51,7 @@ use crate::linalg::lu::{Lu, row_scales, solve_flat};
 use crate::linalg::{
     Mat, Rows, add_scaled, all_finite, identity, mul, put, rows_f64, scaled, transpose,
 };
-use crate::linalg::{add_scaled_flat, copy_flat};
+use crate::linalg::{add_scaled_flat, all_finite_flat, copy_flat};
 use crate::macros::mck_fn;
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
@@ -981,27 +981,27 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         &self,
         outputs: &Outputs<N, I, O>,
     ) -> Result<Measurement<S, I, O>, Error> {
-        if !(all_finite(&outputs.u)
-            && all_finite(&outputs.v)
-            && all_finite(&outputs.a)
-            && all_finite(&outputs.w))
-        {
-            return Err(Error::NonFiniteInput);
-        }
-        let h = add_scaled(
-            &add_scaled(
-                &mul(&outputs.u, &self.dof_u),
-                1.0,
-                &mul(&outputs.v, &self.dof_v),
-            ),
-            1.0,
-            &mul(&outputs.a, &self.dof_a),
-        );
-        let d = add_scaled(&outputs.w, 1.0, &mul(&outputs.a, &self.dof_a_input));
-        if all_finite(&h) && all_finite(&d) {
-            Ok(Measurement { h, d })
-        } else {
-            Err(Error::OperatorOverflow)
+        let (mut h, mut d) = ([[0.0; S]; O], [[0.0; I]; O]);
+        let (mut th, mut td) = ([[0.0; S]; O], [[0.0; I]; O]);
+        match outputs_flat(
+            [
+                outputs.u.as_flattened(),
+                outputs.v.as_flattened(),
+                outputs.a.as_flattened(),
+                outputs.w.as_flattened(),
+            ],
+            [
+                self.dof_u.as_flattened(),
+                self.dof_v.as_flattened(),
+                self.dof_a.as_flattened(),
+                self.dof_a_input.as_flattened(),
+            ],
+            [N, S, I, O],
+            [h.as_flattened_mut(), d.as_flattened_mut()],
+            [th.as_flattened_mut(), td.as_flattened_mut()],
+        ) {
+            Ok(()) => Ok(Measurement { h, d }),
+            Err(e) => Err(e),
         }
     }
 
@@ -1019,8 +1019,15 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// [`StateSpace::feedthrough_noise`] to `R` ([module docs](super), "Noise that reaches
     /// the sensors", derives it and checks it by simulation).
     pub const fn input_noise(&self, qw: &[[f64; I]; I]) -> [[f64; S]; S] {
-        let g = add_scaled(&self.gamma0, 1.0, &self.gamma1);
-        mul(&mul(&g, qw), &transpose(&g))
+        let (mut q, mut g, mut gq) = ([[0.0; S]; S], [[0.0; I]; S], [[0.0; I]; S]);
+        input_noise_flat(
+            [self.gamma0.as_flattened(), self.gamma1.as_flattened()],
+            qw.as_flattened(),
+            [S, I],
+            q.as_flattened_mut(),
+            [g.as_flattened_mut(), gq.as_flattened_mut()],
+        );
+        q
     }
 
     /// The feedthrough companion of [`StateSpace::input_noise`]: the cross covariance
@@ -1101,4 +1108,57 @@ pub(crate) const fn bare_model<const S: usize, const O: usize>(
 /// singular to working precision).
 pub(crate) const fn lu_of<const N: usize>(a: &Mat<N, N>) -> Option<Lu<N>> {
     Lu::new(a, &row_scales(a))
+}
+
+/// `H = Y_u U + Y_v V + Y_a A_x`, `D = Y_w + Y_a A_w` on flat slices (`y = [Y_u, Y_v, Y_a,
+/// Y_w]`, `maps = [U, V, A_x, A_w]`, `dims = [N, S, I, O]`; `out = [H, D]`, `tmp` the same
+/// shapes): the one output build of [`StateSpace::outputs`] and the run-time-sized
+/// [`DynStateSpace::outputs`](super::DynStateSpace::outputs). Errors:
+/// [`Error::NonFiniteInput`] (a weight), [`Error::OperatorOverflow`].
+pub(crate) const fn outputs_flat(
+    y: [&[f64]; 4],
+    maps: [&[f64]; 4],
+    dims: [usize; 4],
+    out: [&mut [f64]; 2],
+    tmp: [&mut [f64]; 2],
+) -> Result<(), Error> {
+    let [yu, yv, ya, yw] = y;
+    let [mu, mv, ma, mw] = maps;
+    let [n, s, i, o] = dims;
+    let [h, d] = out;
+    let [th, td] = tmp;
+    if !(all_finite_flat(yu) && all_finite_flat(yv) && all_finite_flat(ya) && all_finite_flat(yw)) {
+        return Err(Error::NonFiniteInput);
+    }
+    mul_into(h, yu, false, mu, false, o, n, s);
+    mul_into(th, yv, false, mv, false, o, n, s);
+    add_scaled_flat(h, 1.0, th);
+    mul_into(th, ya, false, ma, false, o, n, s);
+    add_scaled_flat(h, 1.0, th);
+    copy_flat(d, yw);
+    mul_into(td, ya, false, mw, false, o, n, i);
+    add_scaled_flat(d, 1.0, td);
+    if all_finite_flat(h) && all_finite_flat(d) {
+        Ok(())
+    } else {
+        Err(Error::OperatorOverflow)
+    }
+}
+
+/// `Q = (Γ₀ + Γ₁) Q_w (Γ₀ + Γ₁)ᵀ` on flat slices (`gamma = [Γ₀, Γ₁]`, `dims = [S, I]`;
+/// `tmp`: two `S×I`): the one arithmetic of [`StateSpace::input_noise`] and the
+/// run-time-sized [`DynStateSpace::input_noise`](super::DynStateSpace::input_noise).
+pub(crate) const fn input_noise_flat(
+    gamma: [&[f64]; 2],
+    qw: &[f64],
+    dims: [usize; 2],
+    q: &mut [f64],
+    tmp: [&mut [f64]; 2],
+) {
+    let [s, i] = dims;
+    let [g, gq] = tmp;
+    copy_flat(g, gamma[0]);
+    add_scaled_flat(g, 1.0, gamma[1]);
+    mul_into(gq, g, false, qw, false, s, i, i);
+    mul_into(q, gq, false, g, true, s, i, s);
 }
