@@ -11,8 +11,9 @@
 //! storeys) are dispatched over [`SIZES`] (1 to 10, 12, 15, 20); `linear_response` with
 //! the AEM takes any other `n` on the run-time-sized `DynLinear` (bit-identical where both
 //! serve), other `n` elsewhere raise `UnsupportedSize`. Spectra take any number of periods: they are stepped in banks of
-//! [`CHUNK`] oscillators, the last bank padded with copies of the longest period. Observers
-//! take 1 to [`MAX_SENSORS`] sensors.
+//! [`CHUNK`] oscillators, the last bank padded with copies of the longest period. `observe`'s
+//! fixed-gain observer takes any `n` and any number of sensors (the run-time-sized
+//! `DynObserver` outside the compiled sizes); its Kalman filter 1 to [`MAX_SENSORS`] sensors.
 //!
 //! **Errors.** Every `aemstep::Error` variant is a Python exception of the same name,
 //! subclass of `AemstepError` (itself a `ValueError`), with the Rust `Display` as message;
@@ -26,7 +27,9 @@
 
 use aemstep::hysteresis::{EnergyAccount, HistoryModel, Law, ShearBuilding};
 use aemstep::nalgebra::{DMatrix, SMatrix, SVector};
-use aemstep::observer::{Kalman, Observer, Outputs, StateSpace, SteadyState};
+use aemstep::observer::{
+    DynObserver, DynStateSpace, DynSteadyState, Kalman, Observer, Outputs, StateSpace, SteadyState,
+};
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
 use aemstep::spectrum::{Bank, RotD, Scheme, Substeps};
 use aemstep::{
@@ -1506,11 +1509,44 @@ fn observe_n<const N: usize, const S: usize>(
         1 => observe_no::<N, S, 1>(job, stop),
         2 if N >= 2 => observe_no::<N, S, 2>(job, stop),
         3 if N >= 3 => observe_no::<N, S, 3>(job, stop),
-        o => Err(Fail::Size(format!(
-            "{o} sensors on {N} floors: this build takes 1 to {} sensors, at most one per floor",
-            MAX_SENSORS.min(N)
-        ))),
+        _ => observe_any(job, N, stop),
     }
+}
+
+/// The fixed-gain observer at a run-time size (`DynStateSpace`, `DynSteadyState`,
+/// `DynObserver`: the compiled path's arithmetic, so at a compiled size the same numbers),
+/// for sizes and sensor counts the compiled path does not take. The Kalman filter takes
+/// only the compiled sizes.
+fn observe_any(job: &ObserveJob, n: usize, stop: &AtomicBool) -> Res<ObserveOut> {
+    let o = job.sensors.len();
+    if job.kalman {
+        return Err(Fail::Size(format!(
+            "{n} floors, {o} sensors: kalman=True takes n in {SIZES:?} and 1 to {MAX_SENSORS} sensors; the fixed-gain observer (kalman=False) takes any n"
+        )));
+    }
+    let dm = |a: &[f64]| DMatrix::from_row_slice(n, n, a);
+    let (m, c, k) = (dm(&job.m), dm(&job.c), dm(&job.k));
+    let b = DMatrix::from_fn(n, 1, |i, _| -(0..n).map(|j| m[(i, j)]).sum::<f64>());
+    let model = DynStateSpace::aem(&m, &c, &k, &b, job.h)?;
+    let meas = model.absolute_accelerations(&job.sensors, 0)?;
+    // Process noise: white forces of standard deviation sigma_f on every floor.
+    let forces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(n, n), job.h)?;
+    let qf = DMatrix::identity(n, n) * (job.sigma_f * job.sigma_f);
+    let q = forces.input_noise(&qf)?;
+    let r = DMatrix::identity(o, o) * (job.sigma_y * job.sigma_y);
+    let gain = DynSteadyState::new(&model, &meas, &q, &r)?;
+    let obs = DynObserver::<f64>::new(&model, &meas, &gain.gain_matrix())?;
+    let steps = job.ag.len();
+    let mut x = buffer(steps, 2 * n)?;
+    let mut e = obs.start_at_rest(&[job.ag[0]]).map_err(at(0))?;
+    x.extend_from_slice(e.x());
+    for i in 1..steps {
+        stopped(stop, i)?;
+        obs.try_step(&mut e, &[job.ag[i]], &job.y[i * o..(i + 1) * o])
+            .map_err(at(i))?;
+        x.extend_from_slice(e.x());
+    }
+    Ok((x, gain.gain().to_vec()))
 }
 
 /// Estimate the state of a linear building from measured absolute floor accelerations:
@@ -1527,6 +1563,11 @@ fn observe_n<const N: usize, const S: usize>(
 /// Returns `(u, v, gain)`: estimated displacements (m) and velocities (m/s), `steps×n`,
 /// relative to the ground, and the steady-state gain (`2n×sensors`; empty for the
 /// Kalman filter). Raises `InvalidCovariance`, `RiccatiNotConverged`, …
+///
+/// Sizes: the fixed-gain observer takes any `n` and any number of sensors (outside the
+/// compiled sizes on the run-time-sized `DynObserver`, the same arithmetic: equal results
+/// where both serve); `kalman=True` takes `n` in the compiled sizes and 1 to 3 sensors
+/// (`UnsupportedSize` otherwise).
 #[pyfunction]
 #[pyo3(signature = (m, c, k, h, ag, measured, sensors, sigma_f, sigma_y, kalman=false))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
@@ -1589,9 +1630,11 @@ fn observe<'py>(
         ))
     };
     let (job, n) = prepare().map_err(|f| f.raise(py))?;
-    let (x, gain) = interruptible(py, work_units(job.ag.len(), n, 3), |stop| {
-        by_size!(n, observe_n(&job, stop))
-    })?;
+    let (x, gain) = interruptible(
+        py,
+        work_units(job.ag.len(), n, 3),
+        |stop| by_size!(n, observe_n(&job, stop) else observe_any(&job, n, stop)),
+    )?;
     let steps = job.ag.len();
     let (mut u, mut v) = (
         buffer(steps, n).map_err(|f| f.raise(py))?,
