@@ -31,6 +31,59 @@ use crate::kernel::{Buffers, Factored, StartBuffers, Terms, newmark_operators_fl
 use crate::linalg::all_finite_flat;
 use crate::{Error, Real};
 
+/// The heap storage of the kernel's flat operator build ([`newmark_operators_flat`]) at
+/// `n` degrees of freedom: ten `n×n` matrices, four scale vectors, two permutations.
+struct KernelHeap {
+    sq: [Vec<f64>; 10],
+    scales: [Vec<f64>; 4],
+    perms: [Vec<usize>; 2],
+}
+
+impl KernelHeap {
+    fn new(n: usize) -> Self {
+        Self {
+            sq: core::array::from_fn(|_| vec![0.0; n * n]),
+            scales: core::array::from_fn(|_| vec![0.0; n]),
+            perms: core::array::from_fn(|_| vec![0; n]),
+        }
+    }
+
+    /// The build's view: `M_eff` and its factors, `G`, `GC`, `GK`, and the start-up
+    /// factorization of `M` with `M⁻¹`, `M⁻¹C`, `M⁻¹K`.
+    fn buffers(&mut self) -> Buffers<'_> {
+        let [a, lu, g, gc, gk, ma, mlu, minv, minv_c, minv_k] = &mut self.sq;
+        let [scales, pivot_scales, ms, mps] = &mut self.scales;
+        let [perm, mperm] = &mut self.perms;
+        let eff = Factored {
+            a,
+            scales,
+            lu,
+            pivot_scales,
+            perm,
+        };
+        let f = Factored {
+            a: ma,
+            scales: ms,
+            lu: mlu,
+            pivot_scales: mps,
+            perm: mperm,
+        };
+        let start = StartBuffers {
+            f,
+            minv,
+            minv_c,
+            minv_k,
+        };
+        Buffers {
+            eff,
+            g,
+            gc,
+            gk,
+            start,
+        }
+    }
+}
+
 /// Row-major copy of a `nalgebra` matrix.
 fn rows(a: &DMatrix<f64>) -> Vec<f64> {
     a.transpose().as_slice().to_vec()
@@ -120,37 +173,10 @@ impl DynStateSpace {
             return Err(Error::NonFiniteInput);
         }
         let sq = || vec![0.0f64; n * n];
-        let (mut ident, mut meff, mut lu, mut g, mut gc, mut gk) =
-            (sq(), sq(), sq(), sq(), sq(), sq());
+        let mut ident = sq();
         identity_into(&mut ident, n);
-        let (mut ma, mut mlu, mut minv, mut minv_c, mut minv_k) = (sq(), sq(), sq(), sq(), sq());
-        let v = || vec![0.0f64; n];
-        let (mut sc, mut psc, mut msc, mut mpsc) = (v(), v(), v(), v());
-        let (mut perm, mut mperm) = (vec![0usize; n], vec![0usize; n]);
-        let mut kb = Buffers {
-            eff: Factored {
-                a: &mut meff,
-                scales: &mut sc,
-                lu: &mut lu,
-                pivot_scales: &mut psc,
-                perm: &mut perm,
-            },
-            g: &mut g,
-            gc: &mut gc,
-            gk: &mut gk,
-            start: StartBuffers {
-                f: Factored {
-                    a: &mut ma,
-                    scales: &mut msc,
-                    lu: &mut mlu,
-                    pivot_scales: &mut mpsc,
-                    perm: &mut mperm,
-                },
-                minv: &mut minv,
-                minv_c: &mut minv_c,
-                minv_k: &mut minv_k,
-            },
-        };
+        let mut heap = KernelHeap::new(n);
+        let mut kb = heap.buffers();
         let built = newmark_operators_flat(&t, &ident, h, 0.25, 0.5, f64::MAX, &mut kb)?;
         let wi = || vec![0.0f64; n * ni];
         let (mut gb, mut aw) = (wi(), wi());
@@ -555,8 +581,9 @@ impl<T: Real> DynEstimate<T> {
         self.missing
     }
 
-    /// The innovation `ν = y_n − H x̂⁻ − D w_n` of the last step (output units; non-finite
-    /// where the measurement was missing). Cost: none.
+    /// The innovation `ν = y_n − H x̂⁻ − D w_n` of the last step attempted (output units;
+    /// non-finite where the measurement was missing; work space, so a refused step may
+    /// have written it). Cost: none.
     pub fn innovation(&self) -> &[T] {
         &self.innov
     }
@@ -591,18 +618,29 @@ impl<T: Real> DynObserver<T> {
             model.time_step,
             T::MAX,
         )?;
-        let round = |a: &[f64]| a.iter().map(|&x| T::from_f64_rounded(x)).collect();
+        let round = |a: &Vec<f64>| a.iter().map(|&x| T::from_f64_rounded(x)).collect();
+        let [phi, gamma0, gamma1, h, d, gain] = [
+            &model.phi,
+            &model.gamma0,
+            &model.gamma1,
+            &meas.h,
+            &meas.d,
+            &gain,
+        ]
+        .map(round);
+        let (states, inputs, outputs) = (s, i, o);
+        let time_step = T::from_f64_rounded(model.time_step);
         Ok(Self {
-            states: s,
-            inputs: i,
-            outputs: o,
-            phi: round(&model.phi),
-            gamma0: round(&model.gamma0),
-            gamma1: round(&model.gamma1),
-            h: round(&meas.h),
-            d: round(&meas.d),
-            gain: round(&gain),
-            time_step: T::from_f64_rounded(model.time_step),
+            states,
+            inputs,
+            outputs,
+            phi,
+            gamma0,
+            gamma1,
+            h,
+            d,
+            gain,
+            time_step,
         })
     }
 

@@ -148,12 +148,7 @@ pub(crate) const fn cholesky_flat(m: &[f64], n: usize, l: &mut [f64]) -> bool {
     let tiny = n as f64 * f64::EPSILON * max_abs_flat(m);
     let mut j = 0;
     while j < n {
-        let mut s = m[j * n + j];
-        let mut k = 0;
-        while k < j {
-            s -= l[j * n + k] * l[j * n + k];
-            k += 1;
-        }
+        let s = minus_dot(m[j * n + j], l, j * n, j * n, j);
         if s.is_nan() || s <= tiny {
             return false;
         }
@@ -161,18 +156,22 @@ pub(crate) const fn cholesky_flat(m: &[f64], n: usize, l: &mut [f64]) -> bool {
         l[j * n + j] = d;
         let mut i = j + 1;
         while i < n {
-            let mut s = m[i * n + j];
-            let mut k = 0;
-            while k < j {
-                s -= l[i * n + k] * l[j * n + k];
-                k += 1;
-            }
-            l[i * n + j] = s / d;
+            l[i * n + j] = minus_dot(m[i * n + j], l, i * n, j * n, j) / d;
             i += 1;
         }
         j += 1;
     }
     true
+}
+
+/// `s − Σ_{k<len} l[a + k] l[b + k]`, subtracted term by term in `k` order.
+const fn minus_dot(mut s: f64, l: &[f64], a: usize, b: usize, len: usize) -> f64 {
+    let mut k = 0;
+    while k < len {
+        s -= l[a + k] * l[b + k];
+        k += 1;
+    }
+    s
 }
 
 /// `a` (`n×n`) is a covariance: finite, symmetric and positive semidefinite (a Cholesky

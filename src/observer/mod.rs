@@ -92,6 +92,7 @@ pub use fixed::{Estimate, Observer, Readout};
 pub(crate) use fixed::{check_counts, estimate_counters, mul2, next_counts};
 pub use kalman::{Kalman, KalmanState};
 // For the joint input–state estimators (`crate::estimation`).
+pub(crate) use flat::cholesky_flat;
 pub(crate) use kalman_core::{
     check_start_covariance, checked_cross_t, cross_is_valid, cross_riccati_start, gain_t,
     innovation_parts, innovation_t, is_zero, noise_fits, predict_t, short_form_t,
