@@ -606,28 +606,17 @@ impl<T: Real> DynObserver<T> {
             return Err(Error::StateSizeMismatch);
         }
         let gain = rows(gain);
-        check_parts_flat(
-            [
-                &model.phi,
-                &model.gamma0,
-                &model.gamma1,
-                &meas.h,
-                &meas.d,
-                &gain,
-            ],
-            model.time_step,
-            T::MAX,
-        )?;
-        let round = |a: &Vec<f64>| a.iter().map(|&x| T::from_f64_rounded(x)).collect();
-        let [phi, gamma0, gamma1, h, d, gain] = [
+        let parts = [
             &model.phi,
             &model.gamma0,
             &model.gamma1,
             &meas.h,
             &meas.d,
             &gain,
-        ]
-        .map(round);
+        ];
+        check_parts_flat(parts.map(|a| a.as_slice()), model.time_step, T::MAX)?;
+        let round = |a: &Vec<f64>| a.iter().map(|&x| T::from_f64_rounded(x)).collect();
+        let [phi, gamma0, gamma1, h, d, gain] = parts.map(round);
         let (states, inputs, outputs) = (s, i, o);
         let time_step = T::from_f64_rounded(model.time_step);
         Ok(Self {

@@ -367,9 +367,9 @@ pub(crate) const fn stein_flat(
     false
 }
 
-/// [`doubling`](super::riccati::doubling) on flat slices, in place on `(a, g, x)`:
-/// `Some((iterations, converged))`, `None` when `W` is singular or an iterate is not
-/// finite. Uses `m[0..5]` and the LU of `s`.
+/// The doubling algorithm (see [`doubling_solution`](super::riccati::doubling_solution))
+/// in place on `(a, g, x)`: `Some((iterations, converged))`, `None` when `W` is singular
+/// or an iterate is not finite. Uses `m[0..5]` and the LU of `s`.
 pub(crate) const fn doubling_flat(
     a: &mut [f64],
     g: &mut [f64],
@@ -421,16 +421,14 @@ pub(crate) const fn doubling_flat(
 /// [`doubling_solution`](super::riccati::doubling_solution) on flat slices: the
 /// a-priori covariance into `x` (plus `sym(q_cross)` when given) and the iterations;
 /// `None` if the doubling breaks down, does not converge or stops at a non-covariance.
-#[allow(clippy::too_many_arguments)]
 pub(crate) const fn doubling_solution_flat(
-    a: &mut [f64],
-    g: &mut [f64],
-    x: &mut [f64],
+    start: [&mut [f64]; 3],
     n: usize,
     max: u32,
     q_cross: Option<&[f64]>,
     s: &mut Scratch<'_>,
 ) -> Option<u32> {
+    let [a, g, x] = start;
     let (k, converged) = match doubling_flat(a, g, x, n, max, s) {
         Some(v) => v,
         None => return None,
@@ -669,7 +667,13 @@ pub(crate) const fn solve_from_start(
     let (cov, gain) = out;
     let [res, bound, delta, best_gain] = work;
     let qc = if q_cross { Some(q) } else { None };
-    let k = match doubling_solution_flat(a, g, p, n, RICCATI_MAX_ITERATIONS, qc, s) {
+    let k = match doubling_solution_flat(
+        [&mut *a, &mut *g, &mut *p],
+        n,
+        RICCATI_MAX_ITERATIONS,
+        qc,
+        s,
+    ) {
         Some(k) => k,
         None => return Err(Error::RiccatiNotConverged),
     };

@@ -198,9 +198,11 @@ pub(crate) const fn doubling_solution<const S: usize>(
         None => None,
     };
     match doubling_solution_flat(
-        a.as_flattened_mut(),
-        g.as_flattened_mut(),
-        x.as_flattened_mut(),
+        [
+            a.as_flattened_mut(),
+            g.as_flattened_mut(),
+            x.as_flattened_mut(),
+        ],
         S,
         max_iterations,
         q,
