@@ -20,6 +20,11 @@
 //! - [`Kalman`]: the full Kalman filter (covariance propagated in Joseph form), for the host
 //!   and small firmware models.
 //!
+//! - `DynStateSpace`, `DynSteadyState`, `DynObserver` (feature `std`): the AEM model, its
+//!   steady-state gain and the fixed-gain observer at sizes chosen at run time, on the same
+//!   flat-slice build and step rows as the const-generic types (bit-identical where both
+//!   serve; `tests/runtime_size_observer.rs`).
+//!
 //! Sizes are const generics: `N` degrees of freedom, `S` states (`S = 2N`, `3N` for
 //! generalized-α, or `2R` modal —
 //! a parameter of its own, checked at construction: [`Error::StateSizeMismatch`](crate::Error::StateSizeMismatch)),
