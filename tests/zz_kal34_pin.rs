@@ -53,9 +53,9 @@ fn run<T: Real, const N: usize, const S: usize, const O: usize>(
     let mut r = SMatrix::<f64, O, O>::identity() * 0.01;
     let kf = if cross {
         let fm = forces
-            .outputs(&Outputs::<N, N, O>::accelerations(core::array::from_fn(|s| {
-                core::array::from_fn(|j| if j == dofs[s] { 1.0 } else { 0.0 })
-            })))
+            .outputs(&Outputs::<N, N, O>::accelerations(core::array::from_fn(
+                |s| core::array::from_fn(|j| if j == dofs[s] { 1.0 } else { 0.0 }),
+            )))
             .unwrap();
         let n: [[f64; O]; S] = forces.input_cross_noise(&fm, &qw);
         let ft: [[f64; O]; O] = forces.feedthrough_noise(&fm, &qw);

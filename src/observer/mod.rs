@@ -88,6 +88,7 @@ mod kalman;
 // The one Kalman core: the correction and the Riccati equation with the cross covariance.
 mod flat;
 mod kalman_core;
+mod kalman_flat;
 mod riccati;
 mod state_space;
 
