@@ -14,8 +14,13 @@
 //! The number of sensors is run-time too (`1 ≤ O`): unlike the compiled path's short list
 //! of sensor counts, nothing here is unrolled for it.
 //!
-//! Not here yet: the time-varying Kalman filter ([`Kalman`](super::Kalman)) and the
-//! process–measurement cross covariance of [`SteadyState::from_parts_cross`](super::SteadyState::from_parts_cross).
+//! The time-varying Kalman filter is here too ([`DynKalman`]): the const-generic
+//! [`Kalman`](super::Kalman)'s step on flat column-major slices (`kalman_flat`), so the
+//! same numbers bit for bit.
+//!
+//! Not here yet: the process–measurement cross covariance of
+//! [`SteadyState::from_parts_cross`](super::SteadyState::from_parts_cross) and
+//! [`Kalman::with_cross`](super::Kalman::with_cross).
 
 use std::vec;
 use std::vec::Vec;
@@ -24,11 +29,13 @@ use nalgebra::DMatrix;
 
 use super::fixed::{check_parts_flat, correct_row, innovation_row, next_counts, predict_row};
 use super::flat::{
-    LuFlat, OutScratch, Scratch, Sensors, check_noise, identity_into, plain_start, solve_from_start,
+    LuFlat, OutScratch, Scratch, Sensors, check_noise, definite_lu_flat, identity_into,
+    is_covariance_flat, plain_start, solve_from_start,
 };
+use super::kalman_flat::{KalmanModel, KalmanWork, kalman_step_flat};
 use super::state_space::{BlockInputs, blocks_flat, input_noise_flat, outputs_flat};
 use crate::kernel::{Buffers, Factored, StartBuffers, Terms, newmark_operators_flat};
-use crate::linalg::all_finite_flat;
+use crate::linalg::{all_finite_flat, all_fit};
 use crate::{Error, Real};
 
 /// The heap storage of the kernel's flat operator build ([`newmark_operators_flat`]) at
@@ -725,6 +732,267 @@ impl<T: Real> DynObserver<T> {
         e.w.copy_from_slice(w);
         e.n = n;
         e.missing = missing;
+        Ok(())
+    }
+}
+
+/// A row-major `rows×cols` `f64` slice as a column-major `T` vector, each entry rounded
+/// once (as [`matrix_t`](crate::linalg::matrix_t) stores the const-generic filters).
+fn column_major<T: Real>(a: &[f64], rows: usize, cols: usize) -> Vec<T> {
+    (0..rows * cols)
+        .map(|k| T::from_f64_rounded(a[(k % rows) * cols + k / rows]))
+        .collect()
+}
+
+/// The full Kalman filter ([`Kalman`](super::Kalman)) at a run-time size (feature
+/// `std`): the estimate and its covariance propagated every step, Joseph form,
+///
+/// ```text
+/// x̂⁻ = Φ x̂ + Γ₀ w_{n−1} + Γ₁ w_n           P⁻ = Φ P Φᵀ + Q
+/// K = P⁻ Hᵀ (H P⁻ Hᵀ + R)⁻¹                 x̂ = x̂⁻ + K (y − H x̂⁻ − D w)
+/// P = (I − K H) P⁻ (I − K H)ᵀ + K R Kᵀ
+/// ```
+///
+/// The step is the const-generic filter's own code (`observer::kalman_flat`, called by
+/// [`Kalman`](super::Kalman) with its arrays): at every size both serve, estimates and
+/// covariances are bit-identical (`tests/runtime_size_observer.rs`). Any number of sensors
+/// `O ≥ 1`. Not here: the cross covariance of [`Kalman::with_cross`](super::Kalman::with_cross).
+///
+/// Cost of a step: about `3S³ + 3S²·O + 2S·O² + O³/6` multiply-adds, no allocation (the
+/// work space lives in the [`DynKalmanState`]). Size: `S² + 2S·I + O·(S + I) + O²` values
+/// of `T` on the heap.
+///
+/// ```
+/// use aemstep::nalgebra::DMatrix;
+/// use aemstep::observer::{DynKalman, DynStateSpace};
+/// let (m, k) = (DMatrix::identity(2, 2), DMatrix::from_row_slice(2, 2, &[2.0, -1.0, -1.0, 1.0]));
+/// let ss = DynStateSpace::aem(&m, &(&k * 0.01), &k, &DMatrix::from_element(2, 1, -1.0), 0.02)?;
+/// let meas = ss.absolute_accelerations(&[1], 0)?;
+/// let q = DMatrix::identity(4, 4) * 1e-6;
+/// let kf = DynKalman::<f64>::new(&ss, &meas, &q, &DMatrix::identity(1, 1))?;
+/// let mut s = kf.start(&[0.0; 4], &DMatrix::zeros(4, 4), &[0.0])?;
+/// kf.try_step(&mut s, &[0.1], &[0.05])?;
+/// kf.try_step(&mut s, &[0.1], &[f64::NAN])?; // a missing sample
+/// assert_eq!((s.steps(), s.missing()), (2, 1));
+/// # Ok::<(), aemstep::Error>(())
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct DynKalman<T> {
+    dims: [usize; 3],
+    /// Column-major `Φ`, `Γ₀`, `Γ₁`, `H`, `D`, `Q`, `R`.
+    parts: [Vec<T>; 7],
+}
+
+/// The state of a [`DynKalman`]: the estimate `x̂` (`S` values), its a-posteriori error
+/// covariance `P` (`S×S`), the last input, the step and missing-sample counts, and the
+/// step's work space (allocated once, by [`DynKalman::start`]).
+#[derive(Clone, Debug)]
+pub struct DynKalmanState<T> {
+    x: Vec<T>,
+    p: Vec<T>,
+    w: Vec<T>,
+    n: u64,
+    missing: u64,
+    /// The new `x̂`, `P`, then the flat step's work space (in [`KalmanWork`]'s order).
+    next: [Vec<T>; 2],
+    work: [Vec<T>; 11],
+}
+
+impl<T: Real> DynKalmanState<T> {
+    /// The estimate `x̂` (`S` values: `u` (m) then `v` (m/s) for a building). Cost: none.
+    pub fn x(&self) -> &[T] {
+        &self.x
+    }
+
+    /// The a-posteriori error covariance `P` (`S×S`, units of `x` squared). Cost: a copy.
+    pub fn covariance_matrix(&self) -> DMatrix<T> {
+        DMatrix::from_column_slice(self.x.len(), self.x.len(), &self.p)
+    }
+
+    /// The last input `w_{n−1}`. Cost: none.
+    pub fn last_input(&self) -> &[T] {
+        &self.w
+    }
+
+    /// Steps taken since the start. Cost: none.
+    pub fn steps(&self) -> u64 {
+        self.n
+    }
+
+    /// Steps whose measurement was missing (predicted, not corrected). Cost: none.
+    pub fn missing(&self) -> u64 {
+        self.missing
+    }
+
+    /// The innovation `ν = y_n − H x̂⁻ − D w_n` of the last step attempted (output units;
+    /// non-finite where the measurement was missing; work space, so a refused step may
+    /// have written it). Cost: none.
+    pub fn innovation(&self) -> &[T] {
+        &self.work[9]
+    }
+}
+
+impl<T: Real> DynKalman<T> {
+    /// The filter of `model` measuring `meas`, process noise `q` (`S×S`, symmetric
+    /// positive semidefinite), measurement noise `r` (`O×O`, symmetric positive
+    /// definite), in `f64`, rounded once to `T`: [`Kalman::new`](super::Kalman::new) at a
+    /// run-time size.
+    ///
+    /// Errors: [`Error::StateSizeMismatch`] (shapes), then as `Kalman::new`:
+    /// [`Error::InvalidCovariance`], [`Error::NonFiniteInput`],
+    /// [`Error::OperatorOverflow`]. Cost: `O(S³)` (the covariance checks).
+    pub fn new(
+        model: &DynStateSpace,
+        meas: &DynMeasurement,
+        q: &DMatrix<f64>,
+        r: &DMatrix<f64>,
+    ) -> Result<Self, Error> {
+        let (s, ni, o) = (model.states(), model.inputs, meas.outputs);
+        if o == 0 || q.shape() != (s, s) || r.shape() != (o, o) {
+            return Err(Error::StateSizeMismatch);
+        }
+        if meas.h.len() != o * s || meas.d.len() != o * ni {
+            return Err(Error::StateSizeMismatch);
+        }
+        let (q, r) = (rows(q), rows(r));
+        let sq = |n: usize| vec![0.0f64; n * n];
+        let (mut b, mut l) = (sq(s), sq(s));
+        let (mut lo, mut luo, mut permo, mut sco) = (sq(o), sq(o), vec![0usize; o], vec![0.0; o]);
+        let mut lu = LuFlat {
+            lu: &mut luo,
+            perm: &mut permo,
+            scales: &mut sco,
+        };
+        if !(is_covariance_flat(&q, s, &mut b, &mut l) && definite_lu_flat(&r, o, &mut lo, &mut lu))
+        {
+            return Err(Error::InvalidCovariance);
+        }
+        if !(all_finite_flat(&meas.h) && all_finite_flat(&meas.d)) {
+            return Err(Error::NonFiniteInput);
+        }
+        let parts = [
+            (&model.phi, s, s),
+            (&model.gamma0, s, ni),
+            (&model.gamma1, s, ni),
+            (&meas.h, o, s),
+            (&meas.d, o, ni),
+            (&q, s, s),
+            (&r, o, o),
+        ];
+        if !parts.iter().all(|(a, ..)| all_fit(a, T::MAX)) {
+            return Err(Error::OperatorOverflow);
+        }
+        Ok(Self {
+            dims: [s, ni, o],
+            parts: parts.map(|(a, rows, cols)| column_major(a, rows, cols)),
+        })
+    }
+
+    /// States `S`. Cost: none.
+    pub fn states(&self) -> usize {
+        self.dims[0]
+    }
+
+    /// The filter at `t = 0`: estimate `x0` (`S` values), its covariance `p0` (`S×S`,
+    /// symmetric positive semidefinite), input `w0` (`I` values).
+    ///
+    /// Errors: [`Error::StateSizeMismatch`] (lengths), [`Error::NonFiniteInput`],
+    /// [`Error::InvalidCovariance`]. Cost: `O(S³)`; allocates the state and its work space
+    /// (`5S² + 2S·O + 2O² + 5S + 2O + I` values).
+    pub fn start(&self, x0: &[T], p0: &DMatrix<T>, w0: &[T]) -> Result<DynKalmanState<T>, Error> {
+        let [s, ni, o] = self.dims;
+        if x0.len() != s || w0.len() != ni || p0.shape() != (s, s) {
+            return Err(Error::StateSizeMismatch);
+        }
+        if !x0.iter().chain(w0).all(|v| v.is_finite()) {
+            return Err(Error::NonFiniteInput);
+        }
+        let pr: Vec<f64> = p0.transpose().iter().map(|v| v.as_f64()).collect();
+        let (mut b, mut l) = (vec![0.0; s * s], vec![0.0; s * s]);
+        if !is_covariance_flat(&pr, s, &mut b, &mut l) {
+            return Err(Error::InvalidCovariance);
+        }
+        let z = |n: usize| vec![T::zero(); n];
+        Ok(DynKalmanState {
+            x: x0.to_vec(),
+            p: p0.as_slice().to_vec(),
+            w: w0.to_vec(),
+            n: 0,
+            missing: 0,
+            next: [z(s), z(s * s)],
+            work: [
+                z(s * s),
+                z(s * s),
+                z(s * s),
+                z(s * o),
+                z(o * s),
+                z(o * o),
+                z(o * o),
+                z(s),
+                z(s),
+                z(o),
+                z(o),
+            ],
+        })
+    }
+
+    /// One filter step ([`Kalman::try_step`](super::Kalman::try_step)) with input `w`
+    /// (`w_n`, `I` values) and measurement `y` (`O` values; a non-finite entry: missing,
+    /// predict only, counted).
+    ///
+    /// Errors, `st` unchanged (but its work space): [`Error::StateSizeMismatch`] (lengths,
+    /// or a state of another filter), [`Error::NonFiniteInput`] (`w`),
+    /// [`Error::InvalidCovariance`] (`H P⁻ Hᵀ + R` not positive definite to working
+    /// precision), [`Error::StepCountOverflow`], [`Error::NonFiniteState`]. No allocation;
+    /// cost in the type docs.
+    pub fn try_step(&self, st: &mut DynKalmanState<T>, w: &[T], y: &[T]) -> Result<(), Error> {
+        let [s, ni, o] = self.dims;
+        let sizes = [s * s, s * s, s * s, s * o, o * s, o * o, o * o, s, s, o, o];
+        let fits = st.work.iter().zip(sizes).all(|(v, n)| v.len() == n)
+            && (st.x.len(), st.p.len(), st.w.len()) == (s, s * s, ni)
+            && (st.next[0].len(), st.next[1].len()) == (s, s * s);
+        if !fits || w.len() != ni || y.len() != o {
+            return Err(Error::StateSizeMismatch);
+        }
+        if !w.iter().all(|v| v.is_finite()) {
+            return Err(Error::NonFiniteInput);
+        }
+        let [phi, gamma0, gamma1, h, d, q, r] = &self.parts;
+        let model = KalmanModel {
+            phi,
+            gamma: [gamma0, gamma1],
+            h,
+            d,
+            q,
+            r,
+            cross: None,
+            dims: self.dims,
+        };
+        let [pm, ikh, ss, so, xt, si, oo, xp, vs, innov, vo] = &mut st.work;
+        let mut wk = KalmanWork {
+            pm,
+            ikh,
+            ss,
+            so,
+            xt,
+            si,
+            oo,
+            xp,
+            vs,
+            innov,
+            vo,
+        };
+        let [xn, pn] = &mut st.next;
+        let present = kalman_step_flat(&model, &mut wk, (&st.x, &st.p, &st.w), (w, y), (xn, pn))?;
+        let (n, missing) =
+            next_counts(st.n, st.missing, present).ok_or(Error::StepCountOverflow)?;
+        if !xn.iter().chain(pn.iter()).all(|v| v.is_finite()) {
+            return Err(Error::NonFiniteState);
+        }
+        core::mem::swap(&mut st.x, xn);
+        core::mem::swap(&mut st.p, pn);
+        st.w.copy_from_slice(w);
+        (st.n, st.missing) = (n, missing);
         Ok(())
     }
 }

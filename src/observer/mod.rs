@@ -93,7 +93,10 @@ mod riccati;
 mod state_space;
 
 #[cfg(feature = "std")]
-pub use dynamic::{DynEstimate, DynMeasurement, DynObserver, DynStateSpace, DynSteadyState};
+pub use dynamic::{
+    DynEstimate, DynKalman, DynKalmanState, DynMeasurement, DynObserver, DynStateSpace,
+    DynSteadyState,
+};
 pub use fixed::{Estimate, Observer, Readout};
 pub(crate) use fixed::{check_counts, estimate_counters, mul2, next_counts};
 pub use kalman::{Kalman, KalmanState};
