@@ -1,4 +1,5 @@
-//! The run-time-sized observer (`DynStateSpace`, `DynSteadyState`, `DynObserver`) against
+//! The run-time-sized observer (`DynStateSpace`, `DynSteadyState`, `DynObserver`,
+//! `DynKalman`) against
 //! the const-generic one where both serve (bit for bit: model, gain, covariance, every
 //! estimate, with a missing sample in the record), against an independent dense reference
 //! written here from the equations at a size outside the compiled list, and the same
@@ -471,7 +472,8 @@ fn bad_input_gives_the_compiled_paths_errors() {
     );
 }
 
-/// The step time, run time vs compiled, at `N = 5` (`S = 10`, 2 sensors): release only,
+/// The step time, run time vs compiled, at `N = 5` (`S = 10`, 2 sensors), fixed-gain
+/// observer and full Kalman filter: release only,
 /// printed (`cargo test --release --features std --test runtime_size_observer -- --ignored --nocapture`).
 #[test]
 #[ignore]
@@ -525,6 +527,40 @@ fn step_time_run_time_vs_compiled() {
     let td = t.elapsed().as_secs_f64() / (reps * (ag.len() - 1)) as f64;
     println!(
         "step N = 5 (S = 10, O = 2): compiled {:.1} ns, run-time {:.1} ns ({:.2}×)",
+        tc * 1e9,
+        td * 1e9,
+        td / tc
+    );
+    // The full Kalman filter: Kalman vs DynKalman.
+    let kk = Kalman::<f64, 10, 1, 2>::new(&ss, &meas, &q, &r).unwrap();
+    let dq = DMatrix::<f64>::identity(10, 10) * 1e-8;
+    let dk = DynKalman::<f64>::new(&dss, &dmeas, &dq, &(DMatrix::identity(2, 2) * 0.01)).unwrap();
+    let reps = 200;
+    let t = Instant::now();
+    for _ in 0..reps {
+        let mut s = kk
+            .start(&SVector::zeros(), &SMatrix::zeros(), &SVector::from([0.0]))
+            .unwrap();
+        for i in 1..ag.len() {
+            let w = SVector::from([ag[i]]);
+            let _ = kk.try_step(&mut s, &w, &SVector::from_column_slice(&y[i]));
+        }
+        black_box(&s);
+    }
+    let tc = t.elapsed().as_secs_f64() / (reps * (ag.len() - 1)) as f64;
+    let t = Instant::now();
+    for _ in 0..reps {
+        let mut s = dk
+            .start(&[0.0; 10], &DMatrix::zeros(10, 10), &[0.0])
+            .unwrap();
+        for i in 1..ag.len() {
+            let _ = dk.try_step(&mut s, &[ag[i]], &y[i]);
+        }
+        black_box(&s);
+    }
+    let td = t.elapsed().as_secs_f64() / (reps * (ag.len() - 1)) as f64;
+    println!(
+        "Kalman step N = 5 (S = 10, O = 2): compiled {:.1} ns, run-time {:.1} ns ({:.2}×)",
         tc * 1e9,
         td * 1e9,
         td / tc

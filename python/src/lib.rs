@@ -12,8 +12,9 @@
 //! the AEM takes any other `n` on the run-time-sized `DynLinear` (bit-identical where both
 //! serve), other `n` elsewhere raise `UnsupportedSize`. Spectra take any number of periods: they are stepped in banks of
 //! [`CHUNK`] oscillators, the last bank padded with copies of the longest period. `observe`'s
-//! fixed-gain observer takes any `n` and any number of sensors (the run-time-sized
-//! `DynObserver` outside the compiled sizes); its Kalman filter 1 to [`MAX_SENSORS`] sensors.
+//! fixed-gain observer and Kalman filter take any `n` and any number of sensors (the
+//! run-time-sized `DynObserver` and `DynKalman` outside the compiled sizes and
+//! [`MAX_SENSORS`]).
 //!
 //! **Errors.** Every `aemstep::Error` variant is a Python exception of the same name,
 //! subclass of `AemstepError` (itself a `ValueError`), with the Rust `Display` as message;
@@ -28,7 +29,8 @@
 use aemstep::hysteresis::{EnergyAccount, HistoryModel, Law, ShearBuilding};
 use aemstep::nalgebra::{DMatrix, SMatrix, SVector};
 use aemstep::observer::{
-    DynObserver, DynStateSpace, DynSteadyState, Kalman, Observer, Outputs, StateSpace, SteadyState,
+    DynKalman, DynObserver, DynStateSpace, DynSteadyState, Kalman, Observer, Outputs, StateSpace,
+    SteadyState,
 };
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
 use aemstep::spectrum::{Bank, RotD, Scheme, Substeps};
@@ -54,7 +56,8 @@ pub const CHUNK: usize = 16;
 /// The most modes a truncated modal run keeps (besides all of them).
 pub const MAX_TRUNCATED_MODES: usize = 3;
 
-/// The largest number of sensors an observer takes.
+/// The largest number of sensors the compiled observers are built for (more, and sizes
+/// outside [`SIZES`], run on the run-time-sized `DynObserver` / `DynKalman`).
 pub const MAX_SENSORS: usize = 3;
 
 /// Rotation angles of RotD50/RotD100 (1° increments over 180°).
@@ -1513,17 +1516,11 @@ fn observe_n<const N: usize, const S: usize>(
     }
 }
 
-/// The fixed-gain observer at a run-time size (`DynStateSpace`, `DynSteadyState`,
-/// `DynObserver`: the compiled path's arithmetic, so at a compiled size the same numbers),
-/// for sizes and sensor counts the compiled path does not take. The Kalman filter takes
-/// only the compiled sizes.
+/// The observers at a run-time size (`DynStateSpace`, `DynSteadyState`, `DynObserver`,
+/// `DynKalman`: the compiled path's arithmetic, so at a compiled size the same numbers),
+/// for sizes and sensor counts the compiled path does not take.
 fn observe_any(job: &ObserveJob, n: usize, stop: &AtomicBool) -> Res<ObserveOut> {
     let o = job.sensors.len();
-    if job.kalman {
-        return Err(Fail::Size(format!(
-            "{n} floors, {o} sensors: kalman=True takes n in {SIZES:?} and 1 to {MAX_SENSORS} sensors; the fixed-gain observer (kalman=False) takes any n"
-        )));
-    }
     let dm = |a: &[f64]| DMatrix::from_row_slice(n, n, a);
     let (m, c, k) = (dm(&job.m), dm(&job.c), dm(&job.k));
     let b = DMatrix::from_fn(n, 1, |i, _| -(0..n).map(|j| m[(i, j)]).sum::<f64>());
@@ -1534,9 +1531,29 @@ fn observe_any(job: &ObserveJob, n: usize, stop: &AtomicBool) -> Res<ObserveOut>
     let qf = DMatrix::identity(n, n) * (job.sigma_f * job.sigma_f);
     let q = forces.input_noise(&qf)?;
     let r = DMatrix::identity(o, o) * (job.sigma_y * job.sigma_y);
+    let steps = job.ag.len();
+    if job.kalman {
+        let filter = DynKalman::<f64>::new(&model, &meas, &q, &r)?;
+        let mut x = buffer(steps, 2 * n)?;
+        let mut s = filter
+            .start(
+                &vec![0.0; 2 * n],
+                &DMatrix::zeros(2 * n, 2 * n),
+                &[job.ag[0]],
+            )
+            .map_err(at(0))?;
+        x.extend_from_slice(s.x());
+        for i in 1..steps {
+            stopped(stop, i)?;
+            filter
+                .try_step(&mut s, &[job.ag[i]], &job.y[i * o..(i + 1) * o])
+                .map_err(at(i))?;
+            x.extend_from_slice(s.x());
+        }
+        return Ok((x, vec![]));
+    }
     let gain = DynSteadyState::new(&model, &meas, &q, &r)?;
     let obs = DynObserver::<f64>::new(&model, &meas, &gain.gain_matrix())?;
-    let steps = job.ag.len();
     let mut x = buffer(steps, 2 * n)?;
     let mut e = obs.start_at_rest(&[job.ag[0]]).map_err(at(0))?;
     x.extend_from_slice(e.x());
@@ -1564,10 +1581,9 @@ fn observe_any(job: &ObserveJob, n: usize, stop: &AtomicBool) -> Res<ObserveOut>
 /// relative to the ground, and the steady-state gain (`2n×sensors`; empty for the
 /// Kalman filter). Raises `InvalidCovariance`, `RiccatiNotConverged`, …
 ///
-/// Sizes: the fixed-gain observer takes any `n` and any number of sensors (outside the
-/// compiled sizes on the run-time-sized `DynObserver`, the same arithmetic: equal results
-/// where both serve); `kalman=True` takes `n` in the compiled sizes and 1 to 3 sensors
-/// (`UnsupportedSize` otherwise).
+/// Sizes: both take any `n` and any number of sensors (outside the compiled sizes and 1–3
+/// sensors on the run-time-sized `DynObserver` / `DynKalman`, the same arithmetic: equal
+/// results where both serve).
 #[pyfunction]
 #[pyo3(signature = (m, c, k, h, ag, measured, sensors, sigma_f, sigma_y, kalman=false))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
