@@ -1,9 +1,8 @@
 //! The run-time-sized observer (`DynStateSpace`, `DynSteadyState`, `DynObserver`,
-//! `DynKalman`) against
-//! the const-generic one where both serve (bit for bit: model, gain, covariance, every
-//! estimate, with a missing sample in the record), against an independent dense reference
-//! written here from the equations at a size outside the compiled list, and the same
-//! errors for the same bad input.
+//! `DynKalman`) against the const-generic one where both serve (bit for bit: model, gain,
+//! covariance, every estimate, with a missing sample in the record), against an
+//! independent dense reference written here from the equations at a size outside the
+//! compiled list, and the same errors for the same bad input.
 #![cfg(feature = "std")]
 
 use aemstep::Error;
