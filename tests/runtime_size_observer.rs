@@ -615,7 +615,7 @@ fn kalman_same_at<const N: usize, const S: usize, const O: usize>(dofs: [usize; 
                 kf.try_step(&mut st, &w, &yv).unwrap();
                 dkf.try_step(&mut dst, &[t(ag[n])], yv.as_slice()).unwrap();
                 assert_eq!(
-                    bits(dst.x()),
+                    bits(dst.estimate().x()),
                     bits(st.estimate().x().as_slice()),
                     "x̂, N = {N}, sample {n}"
                 );
@@ -625,7 +625,7 @@ fn kalman_same_at<const N: usize, const S: usize, const O: usize>(dofs: [usize; 
                     "P, N = {N}, sample {n}"
                 );
             }
-            assert_eq!((dst.steps(), dst.missing()), (119, 1));
+            assert_eq!((dst.estimate().steps(), dst.estimate().missing()), (119, 1));
         }};
     }
     compare!(f64);
@@ -684,7 +684,7 @@ fn run_time_kalman_outside_the_list_matches_a_filter_written_from_the_equations(
         } else {
             (xp, pm)
         };
-        let xd = DMatrix::from_column_slice(s2, 1, st.x());
+        let xd = DMatrix::from_column_slice(s2, 1, st.estimate().x());
         wx = wx.max((&xd - &x).amax());
         sx = sx.max(x.amax());
         wp = wp.max(rel(&st.covariance_matrix(), &p));
@@ -697,7 +697,7 @@ fn run_time_kalman_outside_the_list_matches_a_filter_written_from_the_equations(
     // solve vs an explicit inverse of the 4×4 Σ carry it through a stable recursion
     // (measured 7.2e-14 for x̂, 4.5e-13 for P).
     assert!(wx / sx < 1e-12 && wp < 5e-12, "{} {wp}", wx / sx);
-    assert_eq!((st.steps(), st.missing()), (299, 1));
+    assert_eq!((st.estimate().steps(), st.estimate().missing()), (299, 1));
 }
 
 /// `DynKalman` refuses what `Kalman` refuses, with the same variant, and a refused step
@@ -734,7 +734,7 @@ fn run_time_kalman_gives_the_compiled_paths_errors() {
     );
     let mut st = kf.start(&[0.0; 6], &DMatrix::zeros(6, 6), &[0.0]).unwrap();
     kf.try_step(&mut st, &[0.1], &[0.2, 0.1]).unwrap();
-    let before = (st.x().to_vec(), st.covariance_matrix(), st.steps());
+    let before = (st.estimate().clone(), st.covariance_matrix());
     assert_eq!(
         kf.try_step(&mut st, &[f64::NAN], &[0.2, 0.1]),
         Err(Error::NonFiniteInput)
@@ -755,8 +755,5 @@ fn run_time_kalman_gives_the_compiled_paths_errors() {
         kf.try_step(&mut st4, &[0.1], &[0.2, 0.1]),
         Err(Error::StateSizeMismatch)
     );
-    assert_eq!(
-        before,
-        (st.x().to_vec(), st.covariance_matrix(), st.steps())
-    );
+    assert_eq!(before, (st.estimate().clone(), st.covariance_matrix()));
 }

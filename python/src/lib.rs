@@ -1542,13 +1542,13 @@ fn observe_any(job: &ObserveJob, n: usize, stop: &AtomicBool) -> Res<ObserveOut>
                 &[job.ag[0]],
             )
             .map_err(at(0))?;
-        x.extend_from_slice(s.x());
+        x.extend_from_slice(s.estimate().x());
         for i in 1..steps {
             stopped(stop, i)?;
             filter
                 .try_step(&mut s, &[job.ag[i]], &job.y[i * o..(i + 1) * o])
                 .map_err(at(i))?;
-            x.extend_from_slice(s.x());
+            x.extend_from_slice(s.estimate().x());
         }
         return Ok((x, vec![]));
     }

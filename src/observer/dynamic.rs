@@ -404,10 +404,7 @@ impl DynSteadyState {
         q: &DMatrix<f64>,
         r: &DMatrix<f64>,
     ) -> Result<Self, Error> {
-        let (n, o) = (model.states(), meas.outputs);
-        if q.shape() != (n, n) || r.shape() != (o, o) || meas.h.len() != o * n || o == 0 {
-            return Err(Error::StateSizeMismatch);
-        }
+        let [n, _, o] = noise_shapes(model, meas, q, r)?;
         let (q, r) = (rows(q), rows(r));
         let sn = Sensors {
             h: &meas.h,
@@ -736,6 +733,21 @@ impl<T: Real> DynObserver<T> {
     }
 }
 
+/// `[S, I, O]` of a filter of `model` measuring `meas` with noises `q` (`S×S`) and `r`
+/// (`O×O`). Errors: [`Error::StateSizeMismatch`] (no sensor, or a shape that differs).
+fn noise_shapes(
+    model: &DynStateSpace,
+    meas: &DynMeasurement,
+    q: &DMatrix<f64>,
+    r: &DMatrix<f64>,
+) -> Result<[usize; 3], Error> {
+    let (n, o) = (model.states(), meas.outputs);
+    if q.shape() != (n, n) || r.shape() != (o, o) || meas.h.len() != o * n || o == 0 {
+        return Err(Error::StateSizeMismatch);
+    }
+    Ok([n, model.inputs, o])
+}
+
 /// A row-major `rows×cols` `f64` slice as a column-major `T` vector, each entry rounded
 /// once (as [`matrix_t`](crate::linalg::matrix_t) stores the const-generic filters).
 fn column_major<T: Real>(a: &[f64], rows: usize, cols: usize) -> Vec<T> {
@@ -773,7 +785,7 @@ fn column_major<T: Real>(a: &[f64], rows: usize, cols: usize) -> Vec<T> {
 /// let mut s = kf.start(&[0.0; 4], &DMatrix::zeros(4, 4), &[0.0])?;
 /// kf.try_step(&mut s, &[0.1], &[0.05])?;
 /// kf.try_step(&mut s, &[0.1], &[f64::NAN])?; // a missing sample
-/// assert_eq!((s.steps(), s.missing()), (2, 1));
+/// assert_eq!((s.estimate().steps(), s.estimate().missing()), (2, 1));
 /// # Ok::<(), aemstep::Error>(())
 /// ```
 #[derive(Clone, Debug, PartialEq)]
@@ -783,52 +795,30 @@ pub struct DynKalman<T> {
     parts: [Vec<T>; 7],
 }
 
-/// The state of a [`DynKalman`]: the estimate `x̂` (`S` values), its a-posteriori error
-/// covariance `P` (`S×S`), the last input, the step and missing-sample counts, and the
-/// step's work space (allocated once, by [`DynKalman::start`]).
+/// The state of a [`DynKalman`]: the [`DynEstimate`] (`x̂`, the last input, the step and
+/// missing-sample counts, the innovation), its a-posteriori error covariance `P` (`S×S`),
+/// and the step's work space (allocated once, by [`DynKalman::start`]).
 #[derive(Clone, Debug)]
 pub struct DynKalmanState<T> {
-    x: Vec<T>,
+    estimate: DynEstimate<T>,
     p: Vec<T>,
-    w: Vec<T>,
-    n: u64,
-    missing: u64,
-    /// The new `x̂`, `P`, then the flat step's work space (in [`KalmanWork`]'s order).
-    next: [Vec<T>; 2],
-    work: [Vec<T>; 11],
+    /// The new `P`, then the flat step's work space (`KalmanWork`'s `S×S`, `S×O`, `O×S`,
+    /// `O×O` and vector parts not in the estimate).
+    p_next: Vec<T>,
+    work: [Vec<T>; 9],
 }
 
 impl<T: Real> DynKalmanState<T> {
-    /// The estimate `x̂` (`S` values: `u` (m) then `v` (m/s) for a building). Cost: none.
-    pub fn x(&self) -> &[T] {
-        &self.x
+    /// The estimate: `x̂` (`S` values: `u` (m) then `v` (m/s) for a building), the last
+    /// input, the counts and the last innovation. Cost: none.
+    pub fn estimate(&self) -> &DynEstimate<T> {
+        &self.estimate
     }
 
     /// The a-posteriori error covariance `P` (`S×S`, units of `x` squared). Cost: a copy.
     pub fn covariance_matrix(&self) -> DMatrix<T> {
-        DMatrix::from_column_slice(self.x.len(), self.x.len(), &self.p)
-    }
-
-    /// The last input `w_{n−1}`. Cost: none.
-    pub fn last_input(&self) -> &[T] {
-        &self.w
-    }
-
-    /// Steps taken since the start. Cost: none.
-    pub fn steps(&self) -> u64 {
-        self.n
-    }
-
-    /// Steps whose measurement was missing (predicted, not corrected). Cost: none.
-    pub fn missing(&self) -> u64 {
-        self.missing
-    }
-
-    /// The innovation `ν = y_n − H x̂⁻ − D w_n` of the last step attempted (output units;
-    /// non-finite where the measurement was missing; work space, so a refused step may
-    /// have written it). Cost: none.
-    pub fn innovation(&self) -> &[T] {
-        &self.work[9]
+        let s = self.estimate.x.len();
+        DMatrix::from_column_slice(s, s, &self.p)
     }
 }
 
@@ -846,12 +836,9 @@ impl<T: Real> DynKalman<T> {
         meas: &DynMeasurement,
         q: &DMatrix<f64>,
         r: &DMatrix<f64>,
-    ) -> Result<Self, Error> {
-        let (s, ni, o) = (model.states(), model.inputs, meas.outputs);
-        if o == 0 || q.shape() != (s, s) || r.shape() != (o, o) {
-            return Err(Error::StateSizeMismatch);
-        }
-        if meas.h.len() != o * s || meas.d.len() != o * ni {
+    ) -> Result<DynKalman<T>, Error> {
+        let [s, ni, o] = noise_shapes(model, meas, q, r)?;
+        if meas.d.len() != o * ni {
             return Err(Error::StateSizeMismatch);
         }
         let (q, r) = (rows(q), rows(r));
@@ -914,12 +901,17 @@ impl<T: Real> DynKalman<T> {
         }
         let z = |n: usize| vec![T::zero(); n];
         Ok(DynKalmanState {
-            x: x0.to_vec(),
+            estimate: DynEstimate {
+                x: x0.to_vec(),
+                w: w0.to_vec(),
+                n: 0,
+                missing: 0,
+                xp: z(s),
+                innov: z(o),
+                next: z(s),
+            },
             p: p0.as_slice().to_vec(),
-            w: w0.to_vec(),
-            n: 0,
-            missing: 0,
-            next: [z(s), z(s * s)],
+            p_next: z(s * s),
             work: [
                 z(s * s),
                 z(s * s),
@@ -929,8 +921,6 @@ impl<T: Real> DynKalman<T> {
                 z(o * o),
                 z(o * o),
                 z(s),
-                z(s),
-                z(o),
                 z(o),
             ],
         })
@@ -947,10 +937,11 @@ impl<T: Real> DynKalman<T> {
     /// cost in the type docs.
     pub fn try_step(&self, st: &mut DynKalmanState<T>, w: &[T], y: &[T]) -> Result<(), Error> {
         let [s, ni, o] = self.dims;
-        let sizes = [s * s, s * s, s * s, s * o, o * s, o * o, o * o, s, s, o, o];
+        let sizes = [s * s, s * s, s * s, s * o, o * s, o * o, o * o, s, o];
+        let e = &mut st.estimate;
         let fits = st.work.iter().zip(sizes).all(|(v, n)| v.len() == n)
-            && (st.x.len(), st.p.len(), st.w.len()) == (s, s * s, ni)
-            && (st.next[0].len(), st.next[1].len()) == (s, s * s);
+            && (e.x.len(), e.xp.len(), e.next.len(), e.w.len()) == (s, s, s, ni)
+            && (e.innov.len(), st.p.len(), st.p_next.len()) == (o, s * s, s * s);
         if !fits || w.len() != ni || y.len() != o {
             return Err(Error::StateSizeMismatch);
         }
@@ -968,7 +959,7 @@ impl<T: Real> DynKalman<T> {
             cross: None,
             dims: self.dims,
         };
-        let [pm, ikh, ss, so, xt, si, oo, xp, vs, innov, vo] = &mut st.work;
+        let [pm, ikh, ss, so, xt, si, oo, vs, vo] = &mut st.work;
         let mut wk = KalmanWork {
             pm,
             ikh,
@@ -977,22 +968,21 @@ impl<T: Real> DynKalman<T> {
             xt,
             si,
             oo,
-            xp,
+            xp: &mut e.xp,
             vs,
-            innov,
+            innov: &mut e.innov,
             vo,
         };
-        let [xn, pn] = &mut st.next;
-        let present = kalman_step_flat(&model, &mut wk, (&st.x, &st.p, &st.w), (w, y), (xn, pn))?;
-        let (n, missing) =
-            next_counts(st.n, st.missing, present).ok_or(Error::StepCountOverflow)?;
+        let (xn, pn) = (&mut e.next, &mut st.p_next);
+        let present = kalman_step_flat(&model, &mut wk, (&e.x, &st.p, &e.w), (w, y), (xn, pn))?;
+        let (n, missing) = next_counts(e.n, e.missing, present).ok_or(Error::StepCountOverflow)?;
         if !xn.iter().chain(pn.iter()).all(|v| v.is_finite()) {
             return Err(Error::NonFiniteState);
         }
-        core::mem::swap(&mut st.x, xn);
+        core::mem::swap(&mut e.x, xn);
         core::mem::swap(&mut st.p, pn);
-        st.w.copy_from_slice(w);
-        (st.n, st.missing) = (n, missing);
+        e.w.copy_from_slice(w);
+        (e.n, e.missing) = (n, missing);
         Ok(())
     }
 }

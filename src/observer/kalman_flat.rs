@@ -91,13 +91,13 @@ pub(crate) fn sym_flat<T: Real>(a: &mut [T], n: usize) {
 /// `a = a + b` element-wise.
 #[inline(always)]
 fn add_into<T: Real>(a: &mut [T], b: &[T]) {
-    a.iter_mut().zip(b).for_each(|(x, y)| *x = *x + *y);
+    a.iter_mut().zip(b).for_each(|(x, y)| *x += *y);
 }
 
 /// `a = a − b` element-wise.
 #[inline(always)]
 fn sub_into<T: Real>(a: &mut [T], b: &[T]) {
-    a.iter_mut().zip(b).for_each(|(x, y)| *x = *x - *y);
+    a.iter_mut().zip(b).for_each(|(x, y)| *x -= *y);
 }
 
 /// `Cholesky::new` in place on the column-major `n×n` `m` (lower triangle read and
@@ -122,7 +122,7 @@ pub(crate) fn cholesky_cm<T: Real>(m: &mut [T], n: usize) -> bool {
         };
         m[j + j * n] = denom;
         for i in j + 1..n {
-            m[i + j * n] = m[i + j * n] / denom;
+            m[i + j * n] /= denom;
         }
     }
     true
@@ -202,12 +202,12 @@ pub(crate) fn innovation_flat<T: Real>(
         add_into(si, tmp);
         for j in 0..o {
             for i in 0..o {
-                si[i + j * o] = si[i + j * o] + tmp[j + i * o];
+                si[i + j * o] += tmp[j + i * o];
             }
         }
         for j in 0..s {
             for i in 0..o {
-                xt[i + j * o] = xt[i + j * o] + n[j + i * s];
+                xt[i + j * o] += n[j + i * s];
             }
         }
     }
@@ -244,7 +244,7 @@ pub(crate) fn joseph_flat<T: Real>(
         sub_into(p, tmp);
         for j in 0..s {
             for i in 0..s {
-                p[i + j * s] = p[i + j * s] - tmp[j + i * s];
+                p[i + j * s] -= tmp[j + i * s];
             }
         }
     }
