@@ -31,6 +31,8 @@ const SKIP: &[(&str, &str)] = &[
     ("DynSteadyState", "std only"),
     ("DynObserver", "std only"),
     ("DynEstimate", "std only"),
+    ("DynKalman", "std only"),
+    ("DynKalmanState", "std only"),
     ("OnFailure", "std only"),
     ("Collapse", "std only"),
     ("Plan", "std only"),
