@@ -662,7 +662,7 @@ impl Factored<'_> {
     }
 
     /// `x = A⁻¹ B` (`B` row-major `n×c`) by the factors ([`solve_flat`]).
-    const fn solve(&self, b: &[f64], c: usize, x: &mut [f64]) {
+    pub(crate) const fn solve(&self, b: &[f64], c: usize, x: &mut [f64]) {
         solve_flat(self.lu, self.perm, b, c, x);
     }
 }

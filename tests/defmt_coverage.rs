@@ -26,6 +26,13 @@ const SKIP: &[(&str, &str)] = &[
     ("IdaDocDoctests", "cfg(doctest) marker"),
     // Feature `std` only (host: heap-held records and IDA results); `defmt` is for firmware.
     ("Record", "std only"),
+    ("DynStateSpace", "std only"),
+    ("DynMeasurement", "std only"),
+    ("DynSteadyState", "std only"),
+    ("DynObserver", "std only"),
+    ("DynEstimate", "std only"),
+    ("DynKalman", "std only"),
+    ("DynKalmanState", "std only"),
     ("OnFailure", "std only"),
     ("Collapse", "std only"),
     ("Plan", "std only"),

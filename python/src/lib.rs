@@ -10,10 +10,12 @@
 //! **Sizes.** The library's sizes are const generics. Structures (`n` degrees of freedom,
 //! storeys) are dispatched over [`SIZES`] (1 to 10, 12, 15, 20); `linear_response` with
 //! the AEM takes any other `n` on the run-time-sized `DynLinear`, `shear_building` on
-//! `DynShearBuilding` (bit-identical where both serve), other `n` elsewhere raise
+//! `DynShearBuilding` (bit-identical where both serve); other `n` elsewhere raise
 //! `UnsupportedSize`. Spectra take any number of periods: they are stepped in banks of
-//! [`CHUNK`] oscillators, the last bank padded with copies of the longest period. Observers
-//! take 1 to [`MAX_SENSORS`] sensors.
+//! [`CHUNK`] oscillators, the last bank padded with copies of the longest period.
+//! `observe`'s fixed-gain observer and Kalman filter take any `n` and any number of sensors
+//! (the run-time-sized `DynObserver` and `DynKalman` outside the compiled sizes and
+//! [`MAX_SENSORS`]).
 //!
 //! **Errors.** Every `aemstep::Error` variant is a Python exception of the same name,
 //! subclass of `AemstepError` (itself a `ValueError`), with the Rust `Display` as message;
@@ -27,7 +29,10 @@
 
 use aemstep::hysteresis::{EnergyAccount, HistoryModel, Law, ShearBuilding};
 use aemstep::nalgebra::{DMatrix, SMatrix, SVector};
-use aemstep::observer::{Kalman, Observer, Outputs, StateSpace, SteadyState};
+use aemstep::observer::{
+    DynKalman, DynObserver, DynStateSpace, DynSteadyState, Kalman, Observer, Outputs, StateSpace,
+    SteadyState,
+};
 use aemstep::spectrum::inelastic::{Outcome, Search, Yielding};
 use aemstep::spectrum::{Bank, RotD, Scheme, Substeps};
 use aemstep::{
@@ -52,7 +57,8 @@ pub const CHUNK: usize = 16;
 /// The most modes a truncated modal run keeps (besides all of them).
 pub const MAX_TRUNCATED_MODES: usize = 3;
 
-/// The largest number of sensors an observer takes.
+/// The largest number of sensors the compiled observers are built for (more, and sizes
+/// outside [`SIZES`], run on the run-time-sized `DynObserver` / `DynKalman`).
 pub const MAX_SENSORS: usize = 3;
 
 /// Rotation angles of RotD50/RotD100 (1° increments over 180°).
@@ -1609,11 +1615,58 @@ fn observe_n<const N: usize, const S: usize>(
         1 => observe_no::<N, S, 1>(job, stop),
         2 if N >= 2 => observe_no::<N, S, 2>(job, stop),
         3 if N >= 3 => observe_no::<N, S, 3>(job, stop),
-        o => Err(Fail::Size(format!(
-            "{o} sensors on {N} floors: this build takes 1 to {} sensors, at most one per floor",
-            MAX_SENSORS.min(N)
-        ))),
+        _ => observe_any(job, N, stop),
     }
+}
+
+/// The observers at a run-time size (`DynStateSpace`, `DynSteadyState`, `DynObserver`,
+/// `DynKalman`: the compiled path's arithmetic, so at a compiled size the same numbers),
+/// for sizes and sensor counts the compiled path does not take.
+fn observe_any(job: &ObserveJob, n: usize, stop: &AtomicBool) -> Res<ObserveOut> {
+    let o = job.sensors.len();
+    let dm = |a: &[f64]| DMatrix::from_row_slice(n, n, a);
+    let (m, c, k) = (dm(&job.m), dm(&job.c), dm(&job.k));
+    let b = DMatrix::from_fn(n, 1, |i, _| -(0..n).map(|j| m[(i, j)]).sum::<f64>());
+    let model = DynStateSpace::aem(&m, &c, &k, &b, job.h)?;
+    let meas = model.absolute_accelerations(&job.sensors, 0)?;
+    // Process noise: white forces of standard deviation sigma_f on every floor.
+    let forces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(n, n), job.h)?;
+    let qf = DMatrix::identity(n, n) * (job.sigma_f * job.sigma_f);
+    let q = forces.input_noise(&qf)?;
+    let r = DMatrix::identity(o, o) * (job.sigma_y * job.sigma_y);
+    let steps = job.ag.len();
+    if job.kalman {
+        let filter = DynKalman::<f64>::new(&model, &meas, &q, &r)?;
+        let mut x = buffer(steps, 2 * n)?;
+        let mut s = filter
+            .start(
+                &vec![0.0; 2 * n],
+                &DMatrix::zeros(2 * n, 2 * n),
+                &[job.ag[0]],
+            )
+            .map_err(at(0))?;
+        x.extend_from_slice(s.estimate().x());
+        for i in 1..steps {
+            stopped(stop, i)?;
+            filter
+                .try_step(&mut s, &[job.ag[i]], &job.y[i * o..(i + 1) * o])
+                .map_err(at(i))?;
+            x.extend_from_slice(s.estimate().x());
+        }
+        return Ok((x, vec![]));
+    }
+    let gain = DynSteadyState::new(&model, &meas, &q, &r)?;
+    let obs = DynObserver::<f64>::new(&model, &meas, &gain.gain_matrix())?;
+    let mut x = buffer(steps, 2 * n)?;
+    let mut e = obs.start_at_rest(&[job.ag[0]]).map_err(at(0))?;
+    x.extend_from_slice(e.x());
+    for i in 1..steps {
+        stopped(stop, i)?;
+        obs.try_step(&mut e, &[job.ag[i]], &job.y[i * o..(i + 1) * o])
+            .map_err(at(i))?;
+        x.extend_from_slice(e.x());
+    }
+    Ok((x, gain.gain().to_vec()))
 }
 
 /// Estimate the state of a linear building from measured absolute floor accelerations:
@@ -1630,6 +1683,10 @@ fn observe_n<const N: usize, const S: usize>(
 /// Returns `(u, v, gain)`: estimated displacements (m) and velocities (m/s), `steps×n`,
 /// relative to the ground, and the steady-state gain (`2n×sensors`; empty for the
 /// Kalman filter). Raises `InvalidCovariance`, `RiccatiNotConverged`, …
+///
+/// Sizes: both take any `n` and any number of sensors (outside the compiled sizes and 1–3
+/// sensors on the run-time-sized `DynObserver` / `DynKalman`, the same arithmetic: equal
+/// results where both serve).
 #[pyfunction]
 #[pyo3(signature = (m, c, k, h, ag, measured, sensors, sigma_f, sigma_y, kalman=false))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
@@ -1692,9 +1749,11 @@ fn observe<'py>(
         ))
     };
     let (job, n) = prepare().map_err(|f| f.raise(py))?;
-    let (x, gain) = interruptible(py, work_units(job.ag.len(), n, 3), |stop| {
-        by_size!(n, observe_n(&job, stop))
-    })?;
+    let (x, gain) = interruptible(
+        py,
+        work_units(job.ag.len(), n, 3),
+        |stop| by_size!(n, observe_n(&job, stop) else observe_any(&job, n, stop)),
+    )?;
     let steps = job.ag.len();
     let (mut u, mut v) = (
         buffer(steps, n).map_err(|f| f.raise(py))?,

@@ -95,9 +95,6 @@ def test_shapes_are_checked_before_anything_runs():
         aemstep.linear_response(np.eye(2), np.eye(2), np.eye(2), 0.01)
     with pytest.raises(ValueError, match="unknown scheme"):
         aemstep.linear_response(ONE, ONE, ONE, 0.01, p=np.zeros((3, 1)), scheme="rk4")
-    with pytest.raises(aemstep.UnsupportedSize):
-        aemstep.observe(np.eye(5), np.eye(5), np.eye(5), 0.01, np.zeros(3), np.zeros((3, 4)),
-                        [0, 1, 2, 3], sigma_f=1.0, sigma_y=1.0)
 
 
 def test_empty_and_degenerate_inputs_raise_typed_errors_never_crash():

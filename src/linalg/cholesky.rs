@@ -1,39 +1,16 @@
 //! Cholesky factorization `M = L Lᵀ` and the triangular solves with `L`, in `const fn`.
 
-use super::{Rows, max_abs, sqrt};
+use super::Rows;
 
 /// Cholesky factor `L` (lower, row-major) of a symmetric `m`; `None` unless every pivot
 /// exceeds `N ε max|m|` (positive definite and not singular to working precision).
 pub(crate) const fn cholesky<const N: usize>(m: &Rows<N>) -> Option<Rows<N>> {
-    let tiny = N as f64 * f64::EPSILON * max_abs(m);
     let mut l = [[0.0; N]; N];
-    let mut j = 0;
-    while j < N {
-        let mut s = m[j][j];
-        let mut k = 0;
-        while k < j {
-            s -= l[j][k] * l[j][k];
-            k += 1;
-        }
-        if s.is_nan() || s <= tiny {
-            return None;
-        }
-        let d = sqrt(s);
-        l[j][j] = d;
-        let mut i = j + 1;
-        while i < N {
-            let mut s = m[i][j];
-            let mut k = 0;
-            while k < j {
-                s -= l[i][k] * l[j][k];
-                k += 1;
-            }
-            l[i][j] = s / d;
-            i += 1;
-        }
-        j += 1;
+    if crate::observer::cholesky_flat(m.as_flattened(), N, l.as_flattened_mut()) {
+        Some(l)
+    } else {
+        None
     }
-    Some(l)
 }
 
 /// `L⁻¹ B` for lower-triangular `L` with a nonzero diagonal (forward substitution).

@@ -62,6 +62,11 @@ impl<const N: usize> Lu<N> {
         Self { lu, perm }
     }
 
+    /// The factors and the permutation, flat (for the flat-slice solves).
+    pub(crate) const fn parts(&self) -> (&[f64], &[usize]) {
+        (self.lu.as_flattened(), &self.perm)
+    }
+
     /// `A⁻¹` (the solve with the identity). Cost: `N³` multiply-adds.
     pub(crate) const fn inverse(&self) -> Mat<N, N> {
         self.solve(&identity())

@@ -5,7 +5,7 @@ use nalgebra::{SMatrix, SVector};
 
 use super::state_space::{Measurement, StateSpace};
 use crate::kinematics::check_time_step_as;
-use crate::linalg::{self, all_finite, finite_as, round_rows, rows_f64};
+use crate::linalg::{self, all_finite, all_finite_flat, all_fit, finite_as, round_rows, rows_f64};
 use crate::stepper::commit_if_finite;
 use crate::{Error, Real, StepState};
 
@@ -162,20 +162,43 @@ const fn check_parts<const N: usize, const S: usize, const I: usize, const O: us
     gain: &[[f64; O]; S],
     max: f64,
 ) -> Result<(), Error> {
-    if !(all_finite(gain) && all_finite(&meas.h) && all_finite(&meas.d)) {
+    check_parts_flat(
+        [
+            model.phi.as_flattened(),
+            model.gamma0.as_flattened(),
+            model.gamma1.as_flattened(),
+            meas.h.as_flattened(),
+            meas.d.as_flattened(),
+            gain.as_flattened(),
+        ],
+        model.time_step,
+        max,
+    )
+}
+
+/// [`check_parts`] on flat slices (`[Φ, Γ₀, Γ₁, H, D, L]`, time step `h`): the one check
+/// of [`Observer`] and [`DynObserver`](super::DynObserver). Errors:
+/// [`Error::NonFiniteInput`], [`Error::InvalidTimeStep`], [`Error::OperatorOverflow`].
+pub(crate) const fn check_parts_flat(
+    m: [&[f64]; 6],
+    time_step: f64,
+    max: f64,
+) -> Result<(), Error> {
+    let [phi, gamma0, gamma1, h, d, gain] = m;
+    if !(all_finite_flat(gain) && all_finite_flat(h) && all_finite_flat(d)) {
         return Err(Error::NonFiniteInput);
     }
     // The time step too must fit `T` (an f32 observer of a model with h = 1e147 had an
     // infinite time step; found by fuzzing).
-    if let Err(e) = check_time_step_as(model.time_step, max) {
+    if let Err(e) = check_time_step_as(time_step, max) {
         return Err(e);
     }
-    if !(finite_as(&model.phi, max)
-        && finite_as(&model.gamma0, max)
-        && finite_as(&model.gamma1, max)
-        && finite_as(&meas.h, max)
-        && finite_as(&meas.d, max)
-        && finite_as(gain, max))
+    if !(all_fit(phi, max)
+        && all_fit(gamma0, max)
+        && all_fit(gamma1, max)
+        && all_fit(h, max)
+        && all_fit(d, max)
+        && all_fit(gain, max))
     {
         return Err(Error::OperatorOverflow);
     }
@@ -263,40 +286,27 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Observer<T, S, I, 
         w: &SVector<T, I>,
         y: &SVector<T, O>,
     ) -> SVector<T, O> {
-        // Sums start from −0 (`−0 + x = x` exactly, so the compiler drops the add) and the
-        // prediction is built in place (no zeroed temporary).
-        let neg_zero = -T::zero();
+        // The prediction is built in place (no zeroed temporary); the rows' arithmetic is
+        // the run-time-sized observer's ([`predict_row`], [`innovation_row`], [`correct_row`]).
         let xp: [T; S] = core::array::from_fn(|i| {
-            let mut s = neg_zero;
-            for j in 0..I {
-                s += self.gamma0[i][j] * e.w[j];
-                s += self.gamma1[i][j] * w[j];
-            }
-            for j in 0..S {
-                s += self.phi[i][j] * e.x[j];
-            }
-            s
+            predict_row(
+                &self.phi[i],
+                &self.gamma0[i],
+                &self.gamma1[i],
+                e.x.as_slice(),
+                e.w.as_slice(),
+                w.as_slice(),
+            )
         });
         let mut innov = [T::zero(); O];
         let mut measured = true;
         for o in 0..O {
-            let mut s = y[o];
-            for j in 0..I {
-                s -= self.d[o][j] * w[j];
-            }
-            for j in 0..S {
-                s -= self.h[o][j] * xp[j];
-            }
-            innov[o] = s;
+            innov[o] = innovation_row(y[o], &self.d[o], &self.h[o], w.as_slice(), &xp);
             measured &= y[o].is_finite();
         }
         if measured {
             for i in 0..S {
-                let mut s = xp[i];
-                for o in 0..O {
-                    s += self.gain[i][o] * innov[o];
-                }
-                e.x[i] = s;
+                e.x[i] = correct_row(xp[i], &self.gain[i], &innov);
             }
         } else {
             e.x = xp.into();
@@ -411,6 +421,55 @@ impl<T: Real, const S: usize, const I: usize, const P: usize> Readout<T, S, I, P
     pub fn read(&self, x: &SVector<T, S>, w: &SVector<T, I>) -> SVector<T, P> {
         mul2(&self.h, &self.d, x, w)
     }
+}
+
+/// Row `i` of the fixed-gain observer's prediction, `Σ_j Γ₀[i][j] w_{n−1}[j] + Γ₁[i][j]
+/// w_n[j]` then `+ Σ_j Φ[i][j] x[j]`, summed from `−0` (`−0 + x = x` exactly, so the
+/// compiler drops the add): the one row of [`Observer`] and the run-time-sized
+/// [`DynObserver`](super::DynObserver). Cost: `S + 2I` multiply-adds.
+#[inline(always)]
+pub(crate) fn predict_row<T: Real>(
+    phi: &[T],
+    gamma0: &[T],
+    gamma1: &[T],
+    x: &[T],
+    w_prev: &[T],
+    w: &[T],
+) -> T {
+    let mut s = -T::zero();
+    for ((g0, g1), (wp, wn)) in gamma0.iter().zip(gamma1).zip(w_prev.iter().zip(w)) {
+        s += *g0 * *wp;
+        s += *g1 * *wn;
+    }
+    for (p, xj) in phi.iter().zip(x) {
+        s += *p * *xj;
+    }
+    s
+}
+
+/// Innovation `o`: `y_o − Σ_j D[o][j] w[j] − Σ_j H[o][j] x̂⁻[j]` (the observers' one row).
+/// Cost: `I + S` multiply-adds.
+#[inline(always)]
+pub(crate) fn innovation_row<T: Real>(y: T, d: &[T], h: &[T], w: &[T], xp: &[T]) -> T {
+    let mut s = y;
+    for (dj, wj) in d.iter().zip(w) {
+        s -= *dj * *wj;
+    }
+    for (hj, xj) in h.iter().zip(xp) {
+        s -= *hj * *xj;
+    }
+    s
+}
+
+/// Corrected state `i`: `x̂⁻[i] + Σ_o L[i][o] ν[o]` (the observers' one row). Cost: `O`
+/// multiply-adds.
+#[inline(always)]
+pub(crate) fn correct_row<T: Real>(xp: T, gain: &[T], innov: &[T]) -> T {
+    let mut s = xp;
+    for (l, v) in gain.iter().zip(innov) {
+        s += *l * *v;
+    }
+    s
 }
 
 /// `M₁ x + M₂ w` row by row (`M₁` `R×S`, `M₂` `R×I`; from `+0`, `M₁`'s terms first): the

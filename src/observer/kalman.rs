@@ -5,8 +5,8 @@ use nalgebra::{SMatrix, SVector};
 
 use super::fixed::{Estimate, initial_estimate, next_counts};
 use super::kalman_core::is_covariance;
-use super::kalman_core::{check_start_covariance, checked_cross_t, gain_t, innovation_t, joseph_t};
-use super::kalman_core::{noise_fits, predict_t};
+use super::kalman_core::{check_start_covariance, checked_cross_t, noise_fits, predict_t};
+use super::kalman_flat::{KalmanModel, KalmanWork, kalman_step_flat};
 use super::state_space::{Measurement, StateSpace};
 use crate::linalg::{Mat, all_finite, finite_as, matrix_t, rows_f64};
 use crate::{Error, Real};
@@ -150,6 +150,20 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         Ok(KalmanState { estimate, p: *p0 })
     }
 
+    /// The model as the flat step's slices.
+    fn flat(&self) -> KalmanModel<'_, T> {
+        KalmanModel {
+            phi: self.phi.as_slice(),
+            gamma: [self.gamma0.as_slice(), self.gamma1.as_slice()],
+            h: self.h.as_slice(),
+            d: self.d.as_slice(),
+            q: self.q.as_slice(),
+            r: self.r.as_slice(),
+            cross: self.cross.as_ref().map(|n| n.as_slice()),
+            dims: [S, I, O],
+        }
+    }
+
     /// The a-priori covariance of the next step, `P⁻ = Φ P Φᵀ + Q` (what converges to
     /// the Riccati solution). Cost: `2S³`.
     pub fn predicted_covariance(&self, s: &KalmanState<T, S, I>) -> SMatrix<T, S, S> {
@@ -188,25 +202,36 @@ impl<T: Real, const S: usize, const I: usize, const O: usize> Kalman<T, S, I, O>
         if !w.iter().all(|v| v.is_finite()) {
             return Err(Error::NonFiniteInput);
         }
-        let e = &s.estimate;
-        let xp = self.phi * e.x + self.gamma0 * e.w + self.gamma1 * w;
-        let pm = self.predicted_covariance(s);
+        let z = SMatrix::<T, S, S>::zeros;
+        let (mut pm, mut ikh, mut ss) = (z(), z(), z());
+        let mut so = SMatrix::<T, S, O>::zeros();
+        let mut xt = SMatrix::<T, O, S>::zeros();
+        let (mut si, mut oo) = (SMatrix::<T, O, O>::zeros(), SMatrix::<T, O, O>::zeros());
+        let (mut xp, mut vs) = (SVector::<T, S>::zeros(), SVector::<T, S>::zeros());
+        let (mut innov, mut vo) = (SVector::<T, O>::zeros(), SVector::<T, O>::zeros());
+        let mut wk = KalmanWork {
+            pm: pm.as_mut_slice(),
+            ikh: ikh.as_mut_slice(),
+            ss: ss.as_mut_slice(),
+            so: so.as_mut_slice(),
+            xt: xt.as_mut_slice(),
+            si: si.as_mut_slice(),
+            oo: oo.as_mut_slice(),
+            xp: xp.as_mut_slice(),
+            vs: vs.as_mut_slice(),
+            innov: innov.as_mut_slice(),
+            vo: vo.as_mut_slice(),
+        };
         let mut next = *s;
-        let cross = self.cross.as_ref();
-        // Xᵀ = H P⁻ (+ Nᵀ), Σ = H P⁻ Hᵀ + R (+ H N + Nᵀ Hᵀ): the one Kalman core.
-        let (xt, si) = innovation_t(&pm, &self.h, &self.r, cross);
-        let innov = y - self.h * xp - self.d * w;
-        let present = y.iter().all(|v| v.is_finite());
-        if present {
-            let chol = si.cholesky().ok_or(Error::InvalidCovariance)?;
-            // Kᵀ = Σ⁻¹ Xᵀ.
-            let k = gain_t(&chol, &xt);
-            next.estimate.x = xp + k * innov;
-            next.p = joseph_t(&pm, &k, &self.h, &self.r, cross);
-        } else {
-            next.estimate.x = xp;
-            next.p = pm;
-        }
+        let e = &s.estimate;
+        // The one Kalman step (shared with `DynKalman`).
+        let present = kalman_step_flat(
+            &self.flat(),
+            &mut wk,
+            (e.x.as_slice(), s.p.as_slice(), e.w.as_slice()),
+            (w.as_slice(), y.as_slice()),
+            (next.estimate.x.as_mut_slice(), next.p.as_mut_slice()),
+        )?;
         next.estimate.w = *w;
         (next.estimate.n, next.estimate.missing) =
             next_counts(s.estimate.n, s.estimate.missing, present)

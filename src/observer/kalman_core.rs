@@ -42,6 +42,7 @@
 
 use nalgebra::{Cholesky, SMatrix};
 
+use super::kalman_flat::{cholesky_solve_cm, innovation_flat, predict_cov};
 use super::state_space::lu_of;
 use crate::linalg::cholesky::cholesky;
 use crate::linalg::lu::Lu;
@@ -190,69 +191,53 @@ pub(crate) const fn cross_riccati_start<const S: usize, const O: usize>(
 }
 
 /// The innovation's parts in the filter's scalar type (as [`innovation_parts`]):
-/// `Xᵀ = H P⁻ (+ Nᵀ)` and `Σ` symmetrized, `(Σ + Σᵀ)/2`. Without `n` exactly the operations
-/// the time-varying filters have always done. Cost: `S²·O + S·O²` multiply-adds (`S·O²`
-/// more with `n`).
+/// `Xᵀ = H P⁻ (+ Nᵀ)` and `Σ` symmetrized, `(Σ + Σᵀ)/2`: [`innovation_flat`] on the
+/// arrays (the operations the time-varying filters have always done). Cost: `S²·O + S·O²`
+/// multiply-adds (`S·O²` more with `n`).
 pub(crate) fn innovation_t<T: Real, const S: usize, const O: usize>(
     pm: &SMatrix<T, S, S>,
     h: &SMatrix<T, O, S>,
     r: &SMatrix<T, O, O>,
     n: Option<&SMatrix<T, S, O>>,
 ) -> (SMatrix<T, O, S>, SMatrix<T, O, O>) {
-    let hp = h * pm;
-    let si = hp * h.transpose() + r;
-    match n {
-        None => (hp, (si + si.transpose()) * T::from_f64_rounded(0.5)),
-        Some(n) => {
-            let hn = h * n;
-            let si = si + hn + hn.transpose();
-            (
-                hp + n.transpose(),
-                (si + si.transpose()) * T::from_f64_rounded(0.5),
-            )
-        }
-    }
+    let mut xt = SMatrix::<T, O, S>::zeros();
+    let (mut si, mut tmp) = (SMatrix::<T, O, O>::zeros(), SMatrix::<T, O, O>::zeros());
+    innovation_flat(
+        [xt.as_mut_slice(), si.as_mut_slice(), tmp.as_mut_slice()],
+        [pm.as_slice(), h.as_slice(), r.as_slice()],
+        n.map(|n| n.as_slice()),
+        [S, O],
+    );
+    (xt, si)
 }
 
-/// The gain `K = Xᵀᵀ Σ⁻¹` from the factored `Σ` and `Xᵀ` of [`innovation_t`].
-/// Cost: `S·O²` multiply-adds.
+/// The gain `K = Xᵀᵀ Σ⁻¹` from the factored `Σ` and `Xᵀ` of [`innovation_t`]
+/// ([`cholesky_solve_cm`] on the factor). Cost: `S·O²` multiply-adds.
 pub(crate) fn gain_t<T: Real, const S: usize, const O: usize>(
     chol: &Cholesky<T, nalgebra::Const<O>>,
     xt: &SMatrix<T, O, S>,
 ) -> SMatrix<T, S, O> {
-    chol.solve(xt).transpose()
+    let mut kt = *xt;
+    cholesky_solve_cm(chol.l_dirty().as_slice(), kt.as_mut_slice(), O, S);
+    kt.transpose()
 }
 
-/// The a-posteriori covariance in Joseph form, `(I − K H) P⁻ (I − K H)ᵀ + K R Kᵀ` and,
-/// with `n`, `− (I − K H) N Kᵀ − K Nᵀ (I − K H)ᵀ` ([module docs](self)), symmetrized.
-/// Cost: about `2S³ + 2S²·O + S·O²` multiply-adds (`2S²·O` more with `n`).
-pub(crate) fn joseph_t<T: Real, const S: usize, const O: usize>(
-    pm: &SMatrix<T, S, S>,
-    k: &SMatrix<T, S, O>,
-    h: &SMatrix<T, O, S>,
-    r: &SMatrix<T, O, O>,
-    n: Option<&SMatrix<T, S, O>>,
-) -> SMatrix<T, S, S> {
-    let ikh = SMatrix::<T, S, S>::identity() - k * h;
-    let p = ikh * pm * ikh.transpose() + k * r * k.transpose();
-    match n {
-        None => sym(&p),
-        Some(n) => {
-            let c = ikh * n * k.transpose();
-            sym(&(p - c - c.transpose()))
-        }
-    }
-}
-
-/// The a-priori covariance `P⁻ = Φ P Φᵀ + Q`, symmetrized: the prediction of the
-/// time-varying filters whose state noise enters alone (the Kalman filter, the dual
-/// filter's state stage). Cost: `2S³` multiply-adds.
+/// The a-priori covariance `P⁻ = Φ P Φᵀ + Q`, symmetrized ([`predict_cov`] on the
+/// arrays): the prediction of the time-varying filters whose state noise enters alone
+/// (the Kalman filter, the dual filter's state stage). Cost: `2S³` multiply-adds.
 pub(crate) fn predict_t<T: Real, const S: usize>(
     phi: &SMatrix<T, S, S>,
     p: &SMatrix<T, S, S>,
     q: &SMatrix<T, S, S>,
 ) -> SMatrix<T, S, S> {
-    sym(&(phi * p * phi.transpose() + q))
+    let (mut pm, mut tmp) = (SMatrix::<T, S, S>::zeros(), SMatrix::<T, S, S>::zeros());
+    predict_cov(
+        pm.as_mut_slice(),
+        [phi.as_slice(), p.as_slice(), q.as_slice()],
+        tmp.as_mut_slice(),
+        S,
+    );
+    pm
 }
 
 /// The a-posteriori covariance in the short form, `P⁻ − K Xᵀ` (`Xᵀ = H P⁻` of

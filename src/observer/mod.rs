@@ -20,6 +20,11 @@
 //! - [`Kalman`]: the full Kalman filter (covariance propagated in Joseph form), for the host
 //!   and small firmware models.
 //!
+//! - `DynStateSpace`, `DynSteadyState`, `DynObserver` (feature `std`): the AEM model, its
+//!   steady-state gain and the fixed-gain observer at sizes chosen at run time, on the same
+//!   flat-slice build and step rows as the const-generic types (bit-identical where both
+//!   serve; `tests/runtime_size_observer.rs`).
+//!
 //! Sizes are const generics: `N` degrees of freedom, `S` states (`S = 2N`, `3N` for
 //! generalized-α, or `2R` modal —
 //! a parameter of its own, checked at construction: [`Error::StateSizeMismatch`](crate::Error::StateSizeMismatch)),
@@ -76,17 +81,27 @@
 //! above) the innovations' covariance, the mean window statistic (150.0 ± 0.2 over 158 000
 //! windows) and the false alarms at `α = 10⁻²` and `10⁻³` (inside their binomial bands).
 
+#[cfg(feature = "std")]
+mod dynamic;
 mod fixed;
 mod kalman;
 // The one Kalman core: the correction and the Riccati equation with the cross covariance.
+mod flat;
 mod kalman_core;
+mod kalman_flat;
 mod riccati;
 mod state_space;
 
+#[cfg(feature = "std")]
+pub use dynamic::{
+    DynEstimate, DynKalman, DynKalmanState, DynMeasurement, DynObserver, DynStateSpace,
+    DynSteadyState,
+};
 pub use fixed::{Estimate, Observer, Readout};
 pub(crate) use fixed::{check_counts, estimate_counters, mul2, next_counts};
 pub use kalman::{Kalman, KalmanState};
 // For the joint input–state estimators (`crate::estimation`).
+pub(crate) use flat::cholesky_flat;
 pub(crate) use kalman_core::{
     check_start_covariance, checked_cross_t, cross_is_valid, cross_riccati_start, gain_t,
     innovation_parts, innovation_t, is_zero, noise_fits, predict_t, short_form_t,

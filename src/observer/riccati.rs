@@ -24,15 +24,16 @@
 
 use nalgebra::SMatrix;
 
+use super::flat::{
+    LuFlat, OutScratch, Scratch, Sensors, abs_into, balance_flat, check_noise,
+    doubling_solution_flat, inf_norm_flat, plain_start, solve_from_start, stein_flat,
+};
 use super::kalman_core::{
-    cross_is_valid, cross_riccati_start, definite_lu, innovation_parts, is_covariance, is_zero,
-    symmetrize,
+    cross_is_valid, cross_riccati_start, definite_lu, innovation_parts, is_zero, symmetrize,
 };
-use super::state_space::{Measurement, StateSpace, lu_of};
+use super::state_space::{Measurement, StateSpace};
 use crate::Error;
-use crate::linalg::{
-    Mat, add_scaled, all_finite, identity, max_abs, mul, rows_f64, sqrt, transpose,
-};
+use crate::linalg::{Mat, all_finite, mul, rows_f64, transpose};
 
 /// Iteration budget of the doubling algorithm: iterate `k` covers `2^k` steps of the
 /// Riccati difference equation, so 64 cover any convergent case.
@@ -71,34 +72,100 @@ pub struct SteadyState<const S: usize, const O: usize> {
     pub cross: [[f64; O]; S],
 }
 
-/// `L = P Hᵀ (H P Hᵀ + R)⁻¹` for a covariance `P` (a solve with the `O×O` innovation
-/// covariance), or with a cross covariance `n`, `(P Hᵀ + N) Σ⁻¹` (the core's
-/// [`innovation_parts`]). `None` if `Σ` is singular.
-pub(crate) const fn gain_of<const S: usize, const O: usize>(
-    p: &Mat<S, S>,
-    h: &Mat<O, S>,
-    r: &Mat<O, O>,
-    n: Option<&Mat<S, O>>,
-) -> Option<Mat<S, O>> {
-    let (hp, si) = innovation_parts(p, h, r, n);
-    let lu = match lu_of(&symmetrize(&si)) {
-        Some(lu) => lu,
-        None => return None,
-    };
-    // Lᵀ = (H P Hᵀ + R)⁻¹ H P (both symmetric).
-    Some(transpose(&lu.solve(&hp)))
-}
-
-/// Newton refinements of the doubling's solution at most ([`SteadyState::from_parts`]).
-const RICCATI_REFINEMENTS: u32 = 3;
-
-/// A residual at or below this many units (of [`RICCATI_RESIDUAL_UNITS`]'s `(2S + 5) ε`)
-/// is not refined: rounding in evaluating it is about one unit.
-const RICCATI_RESIDUAL_REFINE: f64 = 4.0;
-
 /// The doubling has converged once `‖A_k‖∞ ≤ 2^-26` (`√ε`): the updates of `X` still to
 /// come are quadratic in it.
 pub(crate) const A_SMALL: f64 = 1.4901161193847656e-8;
+
+/// Stack scratch of the flat core ([`flat`](super::flat)) for `S` states: eight `S×S`
+/// matrices, a vector and an LU. Size: `9 S² + 3 S` values.
+pub(crate) struct SquareStack<const S: usize> {
+    m: [Mat<S, S>; 8],
+    d: [f64; S],
+    lu: Mat<S, S>,
+    perm: [usize; S],
+    scales: [f64; S],
+}
+
+impl<const S: usize> SquareStack<S> {
+    /// Zeroed scratch.
+    pub(crate) const fn new() -> Self {
+        Self {
+            m: [[[0.0; S]; S]; 8],
+            d: [0.0; S],
+            lu: [[0.0; S]; S],
+            perm: [0; S],
+            scales: [0.0; S],
+        }
+    }
+
+    /// The flat core's view of it.
+    pub(crate) const fn scratch(&mut self) -> Scratch<'_> {
+        let [m0, m1, m2, m3, m4, m5, m6, m7] = &mut self.m;
+        Scratch {
+            m: [
+                m0.as_flattened_mut(),
+                m1.as_flattened_mut(),
+                m2.as_flattened_mut(),
+                m3.as_flattened_mut(),
+                m4.as_flattened_mut(),
+                m5.as_flattened_mut(),
+                m6.as_flattened_mut(),
+                m7.as_flattened_mut(),
+            ],
+            d: &mut self.d,
+            lu: LuFlat {
+                lu: self.lu.as_flattened_mut(),
+                perm: &mut self.perm,
+                scales: &mut self.scales,
+            },
+        }
+    }
+}
+
+/// Stack scratch of the flat core's output side for `S` states and `O` outputs.
+struct OutStack<const S: usize, const O: usize> {
+    on: [Mat<O, S>; 2],
+    oo: [Mat<O, O>; 3],
+    no: [Mat<S, O>; 2],
+    lu: Mat<O, O>,
+    perm: [usize; O],
+    scales: [f64; O],
+}
+
+impl<const S: usize, const O: usize> OutStack<S, O> {
+    /// Zeroed scratch.
+    const fn new() -> Self {
+        Self {
+            on: [[[0.0; S]; O]; 2],
+            oo: [[[0.0; O]; O]; 3],
+            no: [[[0.0; O]; S]; 2],
+            lu: [[0.0; O]; O],
+            perm: [0; O],
+            scales: [0.0; O],
+        }
+    }
+
+    /// The flat core's view of it.
+    const fn scratch(&mut self) -> OutScratch<'_> {
+        let [on0, on1] = &mut self.on;
+        let [oo0, oo1, oo2] = &mut self.oo;
+        let [no0, no1] = &mut self.no;
+        OutScratch {
+            on: [on0.as_flattened_mut(), on1.as_flattened_mut()],
+            oo: [
+                oo0.as_flattened_mut(),
+                oo1.as_flattened_mut(),
+                oo2.as_flattened_mut(),
+            ],
+            no: [no0.as_flattened_mut(), no1.as_flattened_mut()],
+            lu: LuFlat {
+                lu: self.lu.as_flattened_mut(),
+                perm: &mut self.perm,
+                scales: &mut self.scales,
+            },
+        }
+    }
+}
 
 /// The a-priori covariance the doubling algorithm solves for from `start = (A₀, G₀, X₀)`
 /// within `max_iterations`, and the iterations taken; `None` if it breaks down, does not
@@ -107,193 +174,55 @@ pub(crate) const A_SMALL: f64 = 1.4901161193847656e-8;
 /// stopped at a `P` with diagonal entries of −4e10: found by fuzzing). With the cross
 /// term's start ([`cross_riccati_start`](super::kalman_core::cross_riccati_start)) the
 /// doubling solves for `Y` and the a-priori covariance is `Y + Q`: pass `q_cross = Some(Q)`.
-/// Shared by [`SteadyState`] and the joint filter's steady state. Cost: [`doubling`]'s,
-/// plus `N³/6` flops for the check.
-pub(crate) const fn doubling_solution<const S: usize>(
-    start: (Mat<S, S>, Mat<S, S>, Mat<S, S>),
-    max_iterations: u32,
-    q_cross: Option<&Mat<S, S>>,
-) -> Option<(Mat<S, S>, u32)> {
-    let (x, k, converged) = match doubling(start.0, start.1, start.2, max_iterations) {
-        Some(v) => v,
-        None => return None,
-    };
-    if !(converged && is_covariance(&x, false)) {
-        return None;
-    }
-    let x = match q_cross {
-        None => x,
-        Some(q) => symmetrize(&add_scaled(&x, 1.0, &symmetrize(q))),
-    };
-    Some((x, k))
-}
-
-/// The doubling algorithm for the filter Riccati equation `X = Aᵀ X A − …` in the form
-/// `A₀ = Aᵀ`, `G₀ = G`, `X₀ = X`: `W = I + G X`, `X ← X + Aᵀ X W⁻¹ A`,
-/// `G ← G + A W⁻¹ G Aᵀ`, `A ← A W⁻¹ A`, at most `max` times. Returns `(X, iterations,
-/// converged)`, or `None` when `W` is singular or an iterate is not finite (each caller
-/// names that failure its own way: no steady state of a Kalman filter, an unidentifiable
-/// input of the joint filter).
+/// Shared by [`SteadyState`] and the joint filter's steady state; the flat core's
+/// `doubling_solution_flat` on stack arrays.
 ///
+/// The doubling (Chu, Fan, Lin 2005) for `X = Aᵀ X A − …` from `A₀ = Aᵀ`, `G₀ = G`,
+/// `X₀ = X`: `W = I + G X`, `X ← X + Aᵀ X W⁻¹ A`, `G ← G + A W⁻¹ G Aᵀ`, `A ← A W⁻¹ A`.
 /// Converged when X no longer moves (the update is below rounding of X) and A_k, which the
 /// updates of X are quadratic in (`A_k ≈ (Φ − K H)ᵀ^(2^k)`), has become small: with a
 /// closed-loop mode near the unit circle X can stand still for a few iterations while its
 /// slow part has not yet accumulated (P stopped at iteration 2 with errors of 6e-14
 /// relative, and its gain's observer had a spectral radius of 1.000008; found by fuzzing).
-/// Below 2^-26 the remaining updates are below ε ‖X‖.
-pub(crate) const fn doubling<const S: usize>(
-    mut a: Mat<S, S>,
-    mut g: Mat<S, S>,
-    mut x: Mat<S, S>,
-    max: u32,
-) -> Option<(Mat<S, S>, u32, bool)> {
-    let id: Mat<S, S> = identity();
-    let mut k = 0;
-    while k < max {
-        k += 1;
-        let w = add_scaled(&id, 1.0, &mul(&g, &x));
-        let lu = match lu_of(&w) {
-            Some(lu) => lu,
-            None => return None,
-        };
-        let wa = lu.solve(&a);
-        let wg = lu.solve(&g);
-        let x1 = symmetrize(&add_scaled(&x, 1.0, &mul(&transpose(&a), &mul(&x, &wa))));
-        let g1 = symmetrize(&add_scaled(&g, 1.0, &mul(&a, &mul(&wg, &transpose(&a)))));
-        let a1 = mul(&a, &wa);
-        if !(all_finite(&x1) && all_finite(&g1) && all_finite(&a1)) {
-            return None;
-        }
-        let diff = max_abs(&add_scaled(&x1, -1.0, &x));
-        x = x1;
-        g = g1;
-        a = a1;
-        if diff <= 4.0 * f64::EPSILON * max_abs(&x) && inf_norm(&a) <= A_SMALL {
-            return Some((x, k, true));
-        }
+/// Below 2^-26 the remaining updates are below ε ‖X‖. Cost: about `10 S³` flops an
+/// iteration, plus `S³/6` for the check.
+pub(crate) const fn doubling_solution<const S: usize>(
+    start: (Mat<S, S>, Mat<S, S>, Mat<S, S>),
+    max_iterations: u32,
+    q_cross: Option<&Mat<S, S>>,
+) -> Option<(Mat<S, S>, u32)> {
+    let (mut a, mut g, mut x) = start;
+    let mut st = SquareStack::<S>::new();
+    let q = match q_cross {
+        Some(q) => Some(q.as_flattened()),
+        None => None,
+    };
+    match doubling_solution_flat(
+        [
+            a.as_flattened_mut(),
+            g.as_flattened_mut(),
+            x.as_flattened_mut(),
+        ],
+        S,
+        max_iterations,
+        q,
+        &mut st.scratch(),
+    ) {
+        Some(k) => Some((x, k)),
+        None => None,
     }
-    Some((x, k, false))
 }
 
 /// `|a|` entry by entry.
 pub(crate) const fn abs_of<const R: usize, const C: usize>(a: &Mat<R, C>) -> Mat<R, C> {
     let mut b = *a;
-    let mut i = 0;
-    while i < R {
-        let mut j = 0;
-        while j < C {
-            b[i][j] = a[i][j].abs();
-            j += 1;
-        }
-        i += 1;
-    }
+    abs_into(b.as_flattened_mut(), a.as_flattened());
     b
-}
-
-/// The Riccati equation's residual in Joseph form, `A P Aᵀ + K R Kᵀ + Q − P` with the
-/// predictor gain `K = Φ L` and the closed loop `A = Φ − K H` (the a-priori error
-/// dynamics), the size of its terms `B = |A||P||A|ᵀ + |K||R||K|ᵀ + |Q| + |P|`, and `A`.
-/// With a cross covariance `n` the a-priori error `e⁻` and the measurement noise are
-/// correlated (`E e⁻ rᵀ = N`): the residual gains `− A N Kᵀ − K Nᵀ Aᵀ` and the size
-/// `2 |A||N||K|ᵀ`.
-///
-/// The Joseph form is the Riccati equation where `L` is its gain, and it is stationary in
-/// `L`: an error `δL` changes it by `δK S δKᵀ` only (second order), so the residual is not
-/// spoiled by the conditioning of `S = H P Hᵀ + R` as the textbook form
-/// `Φ P Φᵀ − Φ P Hᵀ S⁻¹ H P Φᵀ + Q − P` is. Cost: about `6 S³ + 4 S² O` flops.
-const fn joseph_residual<const S: usize, const O: usize>(
-    phi: &Mat<S, S>,
-    h: &Mat<O, S>,
-    q: &Mat<S, S>,
-    r: &Mat<O, O>,
-    p: &Mat<S, S>,
-    l: &Mat<S, O>,
-    n: Option<&Mat<S, O>>,
-) -> (Mat<S, S>, Mat<S, S>, Mat<S, S>) {
-    let k = mul(phi, l);
-    let a = add_scaled(phi, -1.0, &mul(&k, h));
-    let kt = transpose(&k);
-    let at = transpose(&a);
-    let mut res = add_scaled(
-        &add_scaled(
-            &add_scaled(&mul(&a, &mul(p, &at)), 1.0, &mul(&k, &mul(r, &kt))),
-            1.0,
-            q,
-        ),
-        -1.0,
-        p,
-    );
-    let (aa, ka) = (abs_of(&a), abs_of(&k));
-    let mut bound = add_scaled(
-        &add_scaled(
-            &add_scaled(
-                &mul(&aa, &mul(&abs_of(p), &transpose(&aa))),
-                1.0,
-                &mul(&ka, &mul(&abs_of(r), &transpose(&ka))),
-            ),
-            1.0,
-            &abs_of(q),
-        ),
-        1.0,
-        &abs_of(p),
-    );
-    if let Some(n) = n {
-        let ank = mul(&a, &mul(n, &kt));
-        res = add_scaled(&res, -1.0, &add_scaled(&ank, 1.0, &transpose(&ank)));
-        let sz = mul(&aa, &mul(&abs_of(n), &transpose(&ka)));
-        bound = add_scaled(&bound, 1.0, &add_scaled(&sz, 1.0, &transpose(&sz)));
-    }
-    (res, bound, a)
-}
-
-/// The largest `|res_ij| / ((2S + 5) ε max(√(B_ii B_jj), B_ij))` (`∞` if any entry is not
-/// finite, or nonzero where its scale is zero).
-const fn residual_units<const S: usize>(res: &Mat<S, S>, bound: &Mat<S, S>) -> f64 {
-    let unit = (2 * S + 5) as f64 * f64::EPSILON;
-    let mut worst = 0.0f64;
-    let mut i = 0;
-    while i < S {
-        let mut j = 0;
-        while j < S {
-            let x = res[i][j].abs();
-            let b = bound[i][j];
-            if !(x.is_finite() && b.is_finite()) {
-                return f64::INFINITY;
-            }
-            let mut scale = sqrt(bound[i][i]) * sqrt(bound[j][j]);
-            if b > scale {
-                scale = b;
-            }
-            if x > 0.0 {
-                let u = x / (unit * scale);
-                if u > worst || u.is_nan() {
-                    worst = u;
-                }
-            }
-            j += 1;
-        }
-        i += 1;
-    }
-    worst
 }
 
 /// `max_i Σ_j |a_ij|` (NaN if an entry is NaN).
 pub(crate) const fn inf_norm<const N: usize>(a: &Mat<N, N>) -> f64 {
-    let mut m = 0.0f64;
-    let mut i = 0;
-    while i < N {
-        let mut s = 0.0;
-        let mut j = 0;
-        while j < N {
-            s += a[i][j].abs();
-            j += 1;
-        }
-        if s > m || s.is_nan() {
-            m = s;
-        }
-        i += 1;
-    }
-    m
+    inf_norm_flat(a.as_flattened(), N)
 }
 
 /// `a` balanced: `D⁻¹ a D` and `D` (its diagonal), `D` powers of two (exact, the same
@@ -304,55 +233,7 @@ pub(crate) const fn inf_norm<const N: usize>(a: &Mat<N, N>) -> f64 {
 pub(crate) const fn balance<const N: usize>(a: &Mat<N, N>) -> (Mat<N, N>, [f64; N]) {
     let mut b = *a;
     let mut d = [1.0f64; N];
-    let mut sweep = 0;
-    while sweep < 64 {
-        let mut changed = false;
-        let mut i = 0;
-        while i < N {
-            let (mut c, mut r) = (0.0f64, 0.0f64);
-            let mut j = 0;
-            while j < N {
-                if j != i {
-                    c += b[j][i].abs();
-                    r += b[i][j].abs();
-                }
-                j += 1;
-            }
-            if c > 0.0 && r > 0.0 && c.is_finite() && r.is_finite() {
-                let s = c + r;
-                let mut f = 1.0f64;
-                let mut steps = 0;
-                while c < 0.5 * r && steps < 2100 {
-                    f *= 2.0;
-                    c *= 2.0;
-                    r *= 0.5;
-                    steps += 1;
-                }
-                while c >= 2.0 * r && steps < 2100 {
-                    f *= 0.5;
-                    c *= 0.5;
-                    r *= 2.0;
-                    steps += 1;
-                }
-                let di = d[i] * f;
-                if c + r < 0.95 * s && f.is_normal() && di.is_normal() {
-                    let mut j = 0;
-                    while j < N {
-                        b[j][i] *= f;
-                        b[i][j] /= f;
-                        j += 1;
-                    }
-                    d[i] = di;
-                    changed = true;
-                }
-            }
-            i += 1;
-        }
-        if !changed {
-            break;
-        }
-        sweep += 1;
-    }
+    balance_flat(b.as_flattened_mut(), &mut d, N);
     (b, d)
 }
 
@@ -364,41 +245,19 @@ pub(crate) const fn balance<const N: usize>(a: &Mat<N, N>) -> (Mat<N, N>, [f64; 
 /// spectral radius ≥ 1, within rounding of the squarings of 1, or a power that is not
 /// finite. Cost: `3 S³` flops a squaring, about `log₂(1/(1 − ρ))` of them.
 pub(crate) const fn stein<const N: usize>(a: &Mat<N, N>, w: &Mat<N, N>) -> Option<Mat<N, N>> {
-    let (mut b, d) = balance(a);
-    // W in the balanced coordinates, D⁻¹ W D⁻¹ (exact: powers of two).
-    let mut x = *w;
-    let mut i = 0;
-    while i < N {
-        let mut j = 0;
-        while j < N {
-            x[i][j] = w[i][j] / d[i] / d[j];
-            j += 1;
-        }
-        i += 1;
+    let mut x = [[0.0; N]; N];
+    let mut st = SquareStack::<N>::new();
+    if stein_flat(
+        a.as_flattened(),
+        w.as_flattened(),
+        N,
+        x.as_flattened_mut(),
+        &mut st.scratch(),
+    ) {
+        Some(x)
+    } else {
+        None
     }
-    let mut k = 0;
-    while k < 64 {
-        let n = inf_norm(&b);
-        if !n.is_finite() || !all_finite(&x) {
-            return None;
-        }
-        if n <= A_SMALL {
-            let mut i = 0;
-            while i < N {
-                let mut j = 0;
-                while j < N {
-                    x[i][j] = x[i][j] * d[i] * d[j];
-                    j += 1;
-                }
-                i += 1;
-            }
-            return if all_finite(&x) { Some(x) } else { None };
-        }
-        x = add_scaled(&x, 1.0, &mul(&b, &mul(&x, &transpose(&b))));
-        b = mul(&b, &b);
-        k += 1;
-    }
-    None
 }
 
 impl<const S: usize, const O: usize> SteadyState<S, O> {
@@ -473,17 +332,6 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         r: &[[f64; O]; O],
         n: Option<&[[f64; O]; S]>,
     ) -> Result<Self, Error> {
-        if !is_covariance(q, false) {
-            return Err(Error::InvalidCovariance);
-        }
-        let lu_r = match definite_lu(r) {
-            Some(lu) => lu,
-            None => return Err(Error::InvalidCovariance),
-        };
-        let h = &meas.h;
-        if !all_finite(h) {
-            return Err(Error::NonFiniteInput);
-        }
         let cross: Mat<S, O> = match n {
             Some(n) => *n,
             None => [[0.0; O]; S],
@@ -493,11 +341,34 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
             Some(m) if is_zero(m) => None,
             other => other,
         };
-        let start = match n {
-            None => (
-                transpose(&model.phi),
-                symmetrize(&mul(&transpose(h), &lu_r.solve(h))),
-                symmetrize(q),
+        let sn = Sensors {
+            h: meas.h.as_flattened(),
+            r: r.as_flattened(),
+            cross: match n {
+                Some(m) => Some(m.as_flattened()),
+                None => None,
+            },
+            o: O,
+        };
+        let (mut sq, mut out) = (SquareStack::<S>::new(), OutStack::<S, O>::new());
+        let (mut s, mut t) = (sq.scratch(), out.scratch());
+        if let Err(e) = check_noise(q.as_flattened(), S, &sn, &mut s, &mut t) {
+            return Err(e);
+        }
+        let h = &meas.h;
+        let (mut a, mut g, mut x) = ([[0.0; S]; S], [[0.0; S]; S], [[0.0; S]; S]);
+        match n {
+            None => plain_start(
+                model.phi.as_flattened(),
+                q.as_flattened(),
+                S,
+                &sn,
+                [
+                    a.as_flattened_mut(),
+                    g.as_flattened_mut(),
+                    x.as_flattened_mut(),
+                ],
+                &mut t,
             ),
             Some(n) => {
                 if !cross_is_valid(q, r, n) {
@@ -517,66 +388,47 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
                 if !(all_finite(&qy) && all_finite(&sy) && all_finite(&pi)) {
                     return Err(Error::OperatorOverflow);
                 }
-                cross_riccati_start(phi, h, &qy, &sy, &pi)
+                (a, g, x) = cross_riccati_start(phi, h, &qy, &sy, &pi);
             }
-        };
-        let q_cross = match n {
-            None => None,
-            Some(_) => Some(q),
-        };
-        let (x, k) = match doubling_solution(start, RICCATI_MAX_ITERATIONS, q_cross) {
-            Some(v) => v,
-            None => return Err(Error::RiccatiNotConverged),
-        };
+        }
         // The solution verified, not trusted: an iterate that stops moving is not
         // necessarily the stabilizing solution to working accuracy (found by fuzzing). Its
-        // closed loop is certified stable and its residual measured; one above
-        // `RICCATI_RESIDUAL_REFINE` units is refined by Newton's method for the Riccati
-        // equation (Hewer's iteration: the closed loop's Stein equation for the correction,
-        // solved by doubling), at most `RICCATI_REFINEMENTS` times, keeping the best
-        // iterate. Every iterate's gain is computed from its own `P`.
-        let mut p = x;
-        let mut best: Option<(Mat<S, S>, Mat<S, O>, f64)> = None;
-        let mut step = 0;
-        while step <= RICCATI_REFINEMENTS {
-            let gain = match gain_of(&p, h, r, n) {
-                Some(l) => l,
-                None => break,
-            };
-            if !all_finite(&gain) {
-                if best.is_none() && step == 0 {
-                    return Err(Error::OperatorOverflow);
-                }
-                break;
-            }
-            let (res, bound, a_cl) = joseph_residual(&model.phi, h, q, r, &p, &gain, n);
-            let units = residual_units(&res, &bound);
-            // Hewer's step needs a stabilizing gain: its Stein solve is the certificate.
-            let delta = match stein(&a_cl, &res) {
-                Some(d) => d,
-                None => break,
-            };
-            let better = match &best {
-                Some((_, _, u)) => units < *u,
-                None => units <= f64::INFINITY,
-            };
-            if better && is_covariance(&p, false) {
-                best = Some((p, gain, units));
-            }
-            if units <= RICCATI_RESIDUAL_REFINE {
-                break;
-            }
-            p = symmetrize(&add_scaled(&p, 1.0, &delta));
-            step += 1;
-        }
-        match best {
-            Some((p, gain, units)) if units <= RICCATI_RESIDUAL_UNITS => Ok(Self {
-                covariance: p,
+        // closed loop is certified stable and its residual measured; one above 4 units is
+        // refined by Newton's method for the Riccati equation (Hewer's iteration: the
+        // closed loop's Stein equation for the correction, solved by doubling), at most 3
+        // times, keeping the best iterate. Every iterate's gain is computed from its own
+        // `P`. (The flat core's `solve_from_start`, shared with `DynSteadyState`.)
+        let (mut covariance, mut gain) = ([[0.0; S]; S], [[0.0; O]; S]);
+        let (mut res, mut bound, mut delta, mut best) =
+            ([[0.0; S]; S], [[0.0; S]; S], [[0.0; S]; S], [[0.0; O]; S]);
+        match solve_from_start(
+            model.phi.as_flattened(),
+            q.as_flattened(),
+            S,
+            &sn,
+            n.is_some(),
+            [
+                a.as_flattened_mut(),
+                g.as_flattened_mut(),
+                x.as_flattened_mut(),
+            ],
+            (covariance.as_flattened_mut(), gain.as_flattened_mut()),
+            [
+                res.as_flattened_mut(),
+                bound.as_flattened_mut(),
+                delta.as_flattened_mut(),
+                best.as_flattened_mut(),
+            ],
+            &mut s,
+            &mut t,
+        ) {
+            Ok(k) => Ok(Self {
+                covariance,
                 gain,
                 iterations: k,
                 cross,
             }),
-            _ => Err(Error::RiccatiNotConverged),
+            Err(e) => Err(e),
         }
     }
 

@@ -44,11 +44,14 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::kernel::{StartOps, input_kernel_operators, start_operators};
-use crate::linalg::lu::{Lu, row_scales};
+use super::flat::{identity_into, mul_into};
+use crate::kernel::{StartOps, Terms, input_kernel_operators, start_operators};
+use crate::kinematics::NewmarkKinematics;
+use crate::linalg::lu::{Lu, row_scales, solve_flat};
 use crate::linalg::{
     Mat, Rows, add_scaled, all_finite, identity, mul, put, rows_f64, scaled, transpose,
 };
+use crate::linalg::{add_scaled_flat, all_finite_flat, copy_flat};
 use crate::macros::mck_fn;
 use crate::modal::{Damping, lowest_modes, modal_operators};
 use crate::schemes::alpha_operators;
@@ -248,45 +251,165 @@ const fn newmark_blocks<const N: usize, const I: usize>(
         (Some(aw), Some((_, st))) => (aw, st),
         _ => return Err(Error::SingularMass),
     };
-    let kin = op.kin;
-    let zero_i = [[0.0; I]; N];
-    let id: Mat<N, N> = identity();
-    // The equation of motion: a = −M⁻¹K u − M⁻¹C v + M⁻¹B w.
-    let au = scaled(-1.0, &st.minv_k);
-    let av = scaled(-1.0, &st.minv_c);
-    // Predictor: v̂ = v + c_v a, û = u + h v̂ − c_u a.
-    let vh_u = scaled(kin.c_v, &au);
-    let vh_v = axpy(&id, kin.c_v, &av);
-    let vh_w = scaled(kin.c_v, &aw);
-    let uh_u = axpy(&axpy(&id, kin.h, &vh_u), -kin.c_u, &au);
-    let uh_v = axpy(&scaled(kin.h, &vh_v), -kin.c_u, &av);
-    let uh_w = axpy(&axpy(&zero_i, kin.h, &vh_w), -kin.c_u, &aw);
-    // q = M_eff⁻¹ (B w_n − C v̂ − K û): solves with the right-hand sides −C v̂ − K û, B.
-    let rhs_u = axpy(&scaled(-1.0, &mul(c, &vh_u)), -1.0, &mul(k, &uh_u));
-    let rhs_v = axpy(&scaled(-1.0, &mul(c, &vh_v)), -1.0, &mul(k, &uh_v));
-    let rhs_w = axpy(&scaled(-1.0, &mul(c, &vh_w)), -1.0, &mul(k, &uh_w));
-    let (qu, qv, qw, q1) = (
-        op.lu.solve(&rhs_u),
-        op.lu.solve(&rhs_v),
-        op.lu.solve(&rhs_w),
-        gb,
-    );
-    // Corrector: u_n = û + β h² q, v_n = v̂ + γ h q.
-    let (bh2, gh) = (kin.beta_h2, kin.gamma_h);
-    let blocks = NewmarkBlocks {
-        uu: axpy(&uh_u, bh2, &qu),
-        uv: axpy(&uh_v, bh2, &qv),
-        vu: axpy(&vh_u, gh, &qu),
-        vv: axpy(&vh_v, gh, &qv),
-        u0: axpy(&uh_w, bh2, &qw),
-        v0: axpy(&vh_w, gh, &qw),
-        u1: axpy(&zero_i, bh2, &q1),
-        v1: axpy(&zero_i, gh, &q1),
-        au,
-        av,
+    let z = [[0.0; N]; N];
+    let zi = [[0.0; I]; N];
+    let mut bl = NewmarkBlocks {
+        uu: z,
+        uv: z,
+        vu: z,
+        vv: z,
+        u0: zi,
+        v0: zi,
+        u1: zi,
+        v1: zi,
+        au: z,
+        av: z,
         aw,
     };
-    Ok(blocks)
+    let (mut t0, mut t1, mut t2, mut t3, mut t4) = (z, z, z, z, z);
+    let (mut w0, mut w1, mut w2) = (zi, zi, zi);
+    let (lu, perm) = op.lu.parts();
+    blocks_flat(
+        &Terms::of(m, c, k),
+        &BlockInputs {
+            minv_k: st.minv_k.as_flattened(),
+            minv_c: st.minv_c.as_flattened(),
+            aw: aw.as_flattened(),
+            gb: gb.as_flattened(),
+            lu,
+            perm,
+            kin: &op.kin,
+            inputs: I,
+        },
+        [
+            bl.uu.as_flattened_mut(),
+            bl.uv.as_flattened_mut(),
+            bl.vu.as_flattened_mut(),
+            bl.vv.as_flattened_mut(),
+            bl.au.as_flattened_mut(),
+            bl.av.as_flattened_mut(),
+        ],
+        [
+            bl.u0.as_flattened_mut(),
+            bl.v0.as_flattened_mut(),
+            bl.u1.as_flattened_mut(),
+            bl.v1.as_flattened_mut(),
+        ],
+        [
+            t0.as_flattened_mut(),
+            t1.as_flattened_mut(),
+            t2.as_flattened_mut(),
+            t3.as_flattened_mut(),
+            t4.as_flattened_mut(),
+        ],
+        [
+            w0.as_flattened_mut(),
+            w1.as_flattened_mut(),
+            w2.as_flattened_mut(),
+        ],
+    );
+    Ok(bl)
+}
+
+/// What the Newmark blocks are formed from (flat, row-major; `n = perm.len()`): the
+/// start-up operators `M⁻¹K`, `M⁻¹C`, `A_w = M⁻¹B`, `G B = M_eff⁻¹ B`, the factors of
+/// `M_eff` and the kinematic coefficients.
+pub(crate) struct BlockInputs<'a> {
+    pub(crate) minv_k: &'a [f64],
+    pub(crate) minv_c: &'a [f64],
+    pub(crate) aw: &'a [f64],
+    pub(crate) gb: &'a [f64],
+    pub(crate) lu: &'a [f64],
+    pub(crate) perm: &'a [usize],
+    pub(crate) kin: &'a NewmarkKinematics<f64>,
+    /// Inputs `I` (columns of `aw`, `gb`).
+    pub(crate) inputs: usize,
+}
+
+/// `dst = 0 + s·src` (the arrays' `scaled`, entry by entry).
+const fn set_scaled(dst: &mut [f64], s: f64, src: &[f64]) {
+    let mut i = 0;
+    while i < dst.len() {
+        dst[i] = 0.0;
+        i += 1;
+    }
+    add_scaled_flat(dst, s, src);
+}
+
+/// `dst = a + s·b`.
+const fn set_axpy(dst: &mut [f64], a: &[f64], s: f64, b: &[f64]) {
+    copy_flat(dst, a);
+    add_scaled_flat(dst, s, b);
+}
+
+/// The Newmark step's blocks (module docs) on flat slices: the one arithmetic of the
+/// const-generic [`StateSpace::from_rows_newmark`] and the run-time-sized
+/// [`DynStateSpace`](super::DynStateSpace). `sq = [uu, uv, vu, vv, au, av]` (`n×n`),
+/// `wi = [u0, v0, u1, v1]` (`n×I`) are written; `tn` (`n×n`) and `ti` (`n×I`) are
+/// scratch. Cost: about `8n³ + 6n²·I` flops.
+pub(crate) const fn blocks_flat(
+    t: &Terms<'_>,
+    x: &BlockInputs<'_>,
+    sq: [&mut [f64]; 6],
+    wi: [&mut [f64]; 4],
+    tn: [&mut [f64]; 5],
+    ti: [&mut [f64]; 3],
+) {
+    let (n, ni, kin) = (x.perm.len(), x.inputs, x.kin);
+    let [uu, uv, vu, vv, au, av] = sq;
+    let [u0, v0, u1, v1] = wi;
+    let [vh_u, vh_v, uh_u, uh_v, tmp] = tn;
+    let [vh_w, uh_w, tmp_i] = ti;
+    // The equation of motion: a = −M⁻¹K u − M⁻¹C v + M⁻¹B w.
+    set_scaled(au, -1.0, x.minv_k);
+    set_scaled(av, -1.0, x.minv_c);
+    // Predictor: v̂ = v + c_v a, û = u + h v̂ − c_u a.
+    set_scaled(vh_u, kin.c_v, au);
+    identity_into(vh_v, n);
+    add_scaled_flat(vh_v, kin.c_v, av);
+    set_scaled(vh_w, kin.c_v, x.aw);
+    identity_into(uh_u, n);
+    add_scaled_flat(uh_u, kin.h, vh_u);
+    add_scaled_flat(uh_u, -kin.c_u, au);
+    set_scaled(uh_v, kin.h, vh_v);
+    add_scaled_flat(uh_v, -kin.c_u, av);
+    set_scaled(uh_w, kin.h, vh_w);
+    add_scaled_flat(uh_w, -kin.c_u, x.aw);
+    // q = M_eff⁻¹ (B w_n − C v̂ − K û), corrector u_n = û + β h² q, v_n = v̂ + γ h q.
+    let (bh2, gh) = (kin.beta_h2, kin.gamma_h);
+    // u, v columns: the right-hand side into `tmp`, q into `uu` then the blocks.
+    rhs_q(t, vh_u, uh_u, n, n, x, [tmp, vu]);
+    set_axpy(uu, uh_u, bh2, vu);
+    copy_flat(tmp, vu);
+    set_axpy(vu, vh_u, gh, tmp);
+    rhs_q(t, vh_v, uh_v, n, n, x, [tmp, vv]);
+    set_axpy(uv, uh_v, bh2, vv);
+    copy_flat(tmp, vv);
+    set_axpy(vv, vh_v, gh, tmp);
+    // w columns.
+    rhs_q(t, vh_w, uh_w, n, ni, x, [tmp_i, u1]);
+    set_axpy(u0, uh_w, bh2, u1);
+    set_axpy(v0, vh_w, gh, u1);
+    set_scaled(u1, bh2, x.gb);
+    set_scaled(v1, gh, x.gb);
+}
+
+/// `q = M_eff⁻¹ ((0 − C v̂) − K û)` for `c` columns into `out[1]` (`out[0]` scratch).
+const fn rhs_q(
+    t: &Terms<'_>,
+    vh: &[f64],
+    uh: &[f64],
+    n: usize,
+    c: usize,
+    x: &BlockInputs<'_>,
+    out: [&mut [f64]; 2],
+) {
+    let [rhs, q] = out;
+    mul_into(q, t.c, false, vh, false, n, n, c);
+    set_scaled(rhs, -1.0, q);
+    mul_into(q, t.k, false, uh, false, n, n, c);
+    add_scaled_flat(rhs, -1.0, q);
+    solve_flat(x.lu, x.perm, rhs, c, q);
 }
 
 impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
@@ -858,27 +981,27 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
         &self,
         outputs: &Outputs<N, I, O>,
     ) -> Result<Measurement<S, I, O>, Error> {
-        if !(all_finite(&outputs.u)
-            && all_finite(&outputs.v)
-            && all_finite(&outputs.a)
-            && all_finite(&outputs.w))
-        {
-            return Err(Error::NonFiniteInput);
-        }
-        let h = add_scaled(
-            &add_scaled(
-                &mul(&outputs.u, &self.dof_u),
-                1.0,
-                &mul(&outputs.v, &self.dof_v),
-            ),
-            1.0,
-            &mul(&outputs.a, &self.dof_a),
-        );
-        let d = add_scaled(&outputs.w, 1.0, &mul(&outputs.a, &self.dof_a_input));
-        if all_finite(&h) && all_finite(&d) {
-            Ok(Measurement { h, d })
-        } else {
-            Err(Error::OperatorOverflow)
+        let (mut h, mut d) = ([[0.0; S]; O], [[0.0; I]; O]);
+        let (mut th, mut td) = ([[0.0; S]; O], [[0.0; I]; O]);
+        match outputs_flat(
+            [
+                outputs.u.as_flattened(),
+                outputs.v.as_flattened(),
+                outputs.a.as_flattened(),
+                outputs.w.as_flattened(),
+            ],
+            [
+                self.dof_u.as_flattened(),
+                self.dof_v.as_flattened(),
+                self.dof_a.as_flattened(),
+                self.dof_a_input.as_flattened(),
+            ],
+            [N, S, I, O],
+            [h.as_flattened_mut(), d.as_flattened_mut()],
+            [th.as_flattened_mut(), td.as_flattened_mut()],
+        ) {
+            Ok(()) => Ok(Measurement { h, d }),
+            Err(e) => Err(e),
         }
     }
 
@@ -896,8 +1019,15 @@ impl<const N: usize, const S: usize, const I: usize> StateSpace<N, S, I> {
     /// [`StateSpace::feedthrough_noise`] to `R` ([module docs](super), "Noise that reaches
     /// the sensors", derives it and checks it by simulation).
     pub const fn input_noise(&self, qw: &[[f64; I]; I]) -> [[f64; S]; S] {
-        let g = add_scaled(&self.gamma0, 1.0, &self.gamma1);
-        mul(&mul(&g, qw), &transpose(&g))
+        let (mut q, mut g, mut gq) = ([[0.0; S]; S], [[0.0; I]; S], [[0.0; I]; S]);
+        input_noise_flat(
+            [self.gamma0.as_flattened(), self.gamma1.as_flattened()],
+            qw.as_flattened(),
+            [S, I],
+            q.as_flattened_mut(),
+            [g.as_flattened_mut(), gq.as_flattened_mut()],
+        );
+        q
     }
 
     /// The feedthrough companion of [`StateSpace::input_noise`]: the cross covariance
@@ -978,4 +1108,57 @@ pub(crate) const fn bare_model<const S: usize, const O: usize>(
 /// singular to working precision).
 pub(crate) const fn lu_of<const N: usize>(a: &Mat<N, N>) -> Option<Lu<N>> {
     Lu::new(a, &row_scales(a))
+}
+
+/// `H = Y_u U + Y_v V + Y_a A_x`, `D = Y_w + Y_a A_w` on flat slices (`y = [Y_u, Y_v, Y_a,
+/// Y_w]`, `maps = [U, V, A_x, A_w]`, `dims = [N, S, I, O]`; `out = [H, D]`, `tmp` the same
+/// shapes): the one output build of [`StateSpace::outputs`] and the run-time-sized
+/// [`DynStateSpace::outputs`](super::DynStateSpace::outputs). Errors:
+/// [`Error::NonFiniteInput`] (a weight), [`Error::OperatorOverflow`].
+pub(crate) const fn outputs_flat(
+    y: [&[f64]; 4],
+    maps: [&[f64]; 4],
+    dims: [usize; 4],
+    out: [&mut [f64]; 2],
+    tmp: [&mut [f64]; 2],
+) -> Result<(), Error> {
+    let [yu, yv, ya, yw] = y;
+    let [mu, mv, ma, mw] = maps;
+    let [n, s, i, o] = dims;
+    let [h, d] = out;
+    let [th, td] = tmp;
+    if !(all_finite_flat(yu) && all_finite_flat(yv) && all_finite_flat(ya) && all_finite_flat(yw)) {
+        return Err(Error::NonFiniteInput);
+    }
+    mul_into(h, yu, false, mu, false, o, n, s);
+    mul_into(th, yv, false, mv, false, o, n, s);
+    add_scaled_flat(h, 1.0, th);
+    mul_into(th, ya, false, ma, false, o, n, s);
+    add_scaled_flat(h, 1.0, th);
+    copy_flat(d, yw);
+    mul_into(td, ya, false, mw, false, o, n, i);
+    add_scaled_flat(d, 1.0, td);
+    if all_finite_flat(h) && all_finite_flat(d) {
+        Ok(())
+    } else {
+        Err(Error::OperatorOverflow)
+    }
+}
+
+/// `Q = (Γ₀ + Γ₁) Q_w (Γ₀ + Γ₁)ᵀ` on flat slices (`gamma = [Γ₀, Γ₁]`, `dims = [S, I]`;
+/// `tmp`: two `S×I`): the one arithmetic of [`StateSpace::input_noise`] and the
+/// run-time-sized [`DynStateSpace::input_noise`](super::DynStateSpace::input_noise).
+pub(crate) const fn input_noise_flat(
+    gamma: [&[f64]; 2],
+    qw: &[f64],
+    dims: [usize; 2],
+    q: &mut [f64],
+    tmp: [&mut [f64]; 2],
+) {
+    let [s, i] = dims;
+    let [g, gq] = tmp;
+    copy_flat(g, gamma[0]);
+    add_scaled_flat(g, 1.0, gamma[1]);
+    mul_into(gq, g, false, qw, false, s, i, i);
+    mul_into(q, gq, false, g, true, s, i, s);
 }

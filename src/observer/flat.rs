@@ -1,0 +1,724 @@
+//! The observers' build-time arithmetic on flat row-major `f64` slices with explicit
+//! dimensions: the one implementation behind the const-generic [`SteadyState`](super::SteadyState)
+//! (which calls it with its stack arrays, `as_flattened`) and the run-time-sized
+//! [`DynSteadyState`](super::DynSteadyState) (feature `std`, heap buffers). Same checks in
+//! the same order, the same arithmetic, so both give bit-identical gains at every size both
+//! serve (`tests/runtime_size_observer.rs`).
+//!
+//! Every function is `const fn` (a `static` observer's gain is still computed by the
+//! compiler) and allocation-free: temporaries are scratch slices the caller owns. A matrix
+//! `a` of `r×c` is `a[i * c + j]`, row `i`, column `j`.
+
+use crate::Error;
+use crate::linalg::lu::{factor, row_scales_flat, solve_flat};
+use crate::linalg::{add_scaled_flat, all_finite_flat, copy_flat, max_abs_flat, sqrt};
+
+use super::riccati::{A_SMALL, RICCATI_MAX_ITERATIONS, RICCATI_RESIDUAL_UNITS};
+
+/// Newton refinements of the doubling's solution at most ([`refine`]).
+const RICCATI_REFINEMENTS: u32 = 3;
+
+/// A residual at or below this many units (of [`RICCATI_RESIDUAL_UNITS`]'s `(2S + 5) ε`)
+/// is not refined: rounding in evaluating it is about one unit.
+const RICCATI_RESIDUAL_REFINE: f64 = 4.0;
+
+/// `r = op(a) · op(b)` (`rows×cols`, inner dimension `inner`), `op(a) = aᵀ` when `at`
+/// (`a` stored `inner×rows`), `op(b) = bᵀ` when `bt` (`b` stored `cols×inner`): each entry
+/// summed from `+0` over `k` ascending, the order of the array product
+/// [`linalg::mul`](crate::linalg::mul) of the transposed copies. Cost: `rows·inner·cols`
+/// multiply-adds.
+#[allow(clippy::too_many_arguments)]
+pub(crate) const fn mul_into(
+    r: &mut [f64],
+    a: &[f64],
+    at: bool,
+    b: &[f64],
+    bt: bool,
+    rows: usize,
+    inner: usize,
+    cols: usize,
+) {
+    let (ars, acs) = if at { (1, rows) } else { (inner, 1) };
+    let (bks, bjs) = if bt { (1, inner) } else { (cols, 1) };
+    let mut i = 0;
+    while i < rows {
+        let mut j = 0;
+        while j < cols {
+            let mut s = 0.0;
+            let (mut ai, mut bi, mut k) = (i * ars, j * bjs, 0);
+            while k < inner {
+                s += a[ai] * b[bi];
+                ai += acs;
+                bi += bks;
+                k += 1;
+            }
+            r[i * cols + j] = s;
+            j += 1;
+        }
+        i += 1;
+    }
+}
+
+/// `dst += s · srcᵀ` (`dst` `rows×cols`, `src` `cols×rows`), entry by entry as
+/// [`add_scaled_flat`] does with a transposed copy.
+pub(crate) const fn add_transposed(dst: &mut [f64], s: f64, src: &[f64], rows: usize, cols: usize) {
+    let mut i = 0;
+    while i < rows {
+        let mut j = 0;
+        while j < cols {
+            dst[i * cols + j] += s * src[j * rows + i];
+            j += 1;
+        }
+        i += 1;
+    }
+}
+
+/// `dst = srcᵀ` (`src` `rows×cols`).
+pub(crate) const fn transpose_into(dst: &mut [f64], src: &[f64], rows: usize, cols: usize) {
+    let mut i = 0;
+    while i < rows {
+        let mut j = 0;
+        while j < cols {
+            dst[j * rows + i] = src[i * cols + j];
+            j += 1;
+        }
+        i += 1;
+    }
+}
+
+/// `dst = |src|` entry by entry.
+pub(crate) const fn abs_into(dst: &mut [f64], src: &[f64]) {
+    let mut i = 0;
+    while i < src.len() {
+        dst[i] = src[i].abs();
+        i += 1;
+    }
+}
+
+/// `dst = I` (`n×n`).
+pub(crate) const fn identity_into(dst: &mut [f64], n: usize) {
+    let mut i = 0;
+    while i < n * n {
+        dst[i] = if i % (n + 1) == 0 { 1.0 } else { 0.0 };
+        i += 1;
+    }
+}
+
+/// `a ← (a + aᵀ)/2` in place (`n×n`).
+pub(crate) const fn symmetrize_flat(a: &mut [f64], n: usize) {
+    let mut i = 0;
+    while i < n {
+        let mut j = 0;
+        while j < i {
+            let m = 0.5 * (a[i * n + j] + a[j * n + i]);
+            a[i * n + j] = m;
+            a[j * n + i] = m;
+            j += 1;
+        }
+        i += 1;
+    }
+}
+
+/// `|a_ij − a_ji| ≤ rel · max|a|` for every pair (`n×n`; not a finiteness check).
+pub(crate) const fn is_symmetric_flat(a: &[f64], n: usize, rel: f64) -> bool {
+    let tol = rel * max_abs_flat(a);
+    let mut i = 0;
+    while i < n {
+        let mut j = 0;
+        while j < i {
+            if (a[i * n + j] - a[j * n + i]).abs() > tol {
+                return false;
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    true
+}
+
+/// `a` symmetric to `64 ε max|a|` and all finite.
+pub(crate) const fn symmetric_flat(a: &[f64], n: usize) -> bool {
+    all_finite_flat(a) && is_symmetric_flat(a, n, 64.0 * f64::EPSILON)
+}
+
+/// The Cholesky factor `L` (lower, into `l`, `n×n`; the strict upper part is not written)
+/// of a symmetric `m`; `false` unless every pivot exceeds `n ε max|m|`. The one
+/// factorization behind [`cholesky`](crate::linalg::cholesky::cholesky). Cost: `n³/6`.
+pub(crate) const fn cholesky_flat(m: &[f64], n: usize, l: &mut [f64]) -> bool {
+    let tiny = n as f64 * f64::EPSILON * max_abs_flat(m);
+    let mut j = 0;
+    while j < n {
+        let s = minus_dot(m[j * n + j], l, j * n, j * n, j);
+        if s.is_nan() || s <= tiny {
+            return false;
+        }
+        let d = sqrt(s);
+        l[j * n + j] = d;
+        let mut i = j + 1;
+        while i < n {
+            l[i * n + j] = minus_dot(m[i * n + j], l, i * n, j * n, j) / d;
+            i += 1;
+        }
+        j += 1;
+    }
+    true
+}
+
+/// `s − Σ_{k<len} l[a + k] l[b + k]`, subtracted term by term in `k` order.
+const fn minus_dot(mut s: f64, l: &[f64], a: usize, b: usize, len: usize) -> f64 {
+    let mut k = 0;
+    while k < len {
+        s -= l[a + k] * l[b + k];
+        k += 1;
+    }
+    s
+}
+
+/// `a` (`n×n`) is a covariance: finite, symmetric and positive semidefinite (a Cholesky
+/// factorization of `a + δI`, `δ = 16 n ε max|a|`), as
+/// [`is_covariance`](super::kalman_core::is_covariance) judges it; `b`, `l`: `n²` scratch.
+pub(crate) const fn is_covariance_flat(a: &[f64], n: usize, b: &mut [f64], l: &mut [f64]) -> bool {
+    if !symmetric_flat(a, n) {
+        return false;
+    }
+    let delta = 16.0 * n as f64 * f64::EPSILON * max_abs_flat(a) + f64::MIN_POSITIVE;
+    copy_flat(b, a);
+    let mut i = 0;
+    while i < n {
+        b[i * n + i] += delta;
+        i += 1;
+    }
+    cholesky_flat(b, n, l)
+}
+
+/// An LU factorization of `n×n` `f64`: factors, permutation and row scales (slices of
+/// `n²`, `n`, `n`).
+pub(crate) struct LuFlat<'a> {
+    /// `L` and `U`, row-major.
+    pub(crate) lu: &'a mut [f64],
+    /// The row permutation.
+    pub(crate) perm: &'a mut [usize],
+    /// The row scales (permuted).
+    pub(crate) scales: &'a mut [f64],
+}
+
+impl LuFlat<'_> {
+    /// Factorize `a` with its own row scales (as [`lu_of`](super::state_space::lu_of));
+    /// `false` if singular to working precision.
+    pub(crate) const fn factor_of(&mut self, a: &[f64], n: usize) -> bool {
+        copy_flat(self.lu, a);
+        row_scales_flat(a, self.scales);
+        factor(self.lu, n, self.scales, self.perm)
+    }
+
+    /// `x = A⁻¹ b` for `b` of `c` columns.
+    pub(crate) const fn solve(&self, b: &[f64], c: usize, x: &mut [f64]) {
+        solve_flat(self.lu, self.perm, b, c, x);
+    }
+}
+
+/// [`definite_lu`](super::kalman_core::definite_lu) on flat slices: `a` finite, symmetric,
+/// with a Cholesky factorization (`l`: `n²` scratch) and an LU (into `lu`).
+pub(crate) const fn definite_lu_flat(
+    a: &[f64],
+    n: usize,
+    l: &mut [f64],
+    lu: &mut LuFlat<'_>,
+) -> bool {
+    symmetric_flat(a, n) && cholesky_flat(a, n, l) && lu.factor_of(a, n)
+}
+
+/// `max_i Σ_j |a_ij|` (`n×n`; NaN if an entry is NaN).
+pub(crate) const fn inf_norm_flat(a: &[f64], n: usize) -> f64 {
+    let mut m = 0.0f64;
+    let mut i = 0;
+    while i < n {
+        let mut s = 0.0;
+        let mut j = 0;
+        while j < n {
+            s += a[i * n + j].abs();
+            j += 1;
+        }
+        if s > m || s.is_nan() {
+            m = s;
+        }
+        i += 1;
+    }
+    m
+}
+
+/// [`balance`](super::riccati::balance) in place: `b ← D⁻¹ b D`, `d` the diagonal of `D`
+/// (powers of two, as LAPACK's `gebal`).
+pub(crate) const fn balance_flat(b: &mut [f64], d: &mut [f64], n: usize) {
+    let mut i = 0;
+    while i < n {
+        d[i] = 1.0;
+        i += 1;
+    }
+    let mut sweep = 0;
+    while sweep < 64 {
+        let mut changed = false;
+        let mut i = 0;
+        while i < n {
+            let (mut c, mut r) = (0.0f64, 0.0f64);
+            let mut j = 0;
+            while j < n {
+                if j != i {
+                    c += b[j * n + i].abs();
+                    r += b[i * n + j].abs();
+                }
+                j += 1;
+            }
+            if c > 0.0 && r > 0.0 && c.is_finite() && r.is_finite() {
+                let s = c + r;
+                let mut f = 1.0f64;
+                let mut steps = 0;
+                while c < 0.5 * r && steps < 2100 {
+                    f *= 2.0;
+                    c *= 2.0;
+                    r *= 0.5;
+                    steps += 1;
+                }
+                while c >= 2.0 * r && steps < 2100 {
+                    f *= 0.5;
+                    c *= 0.5;
+                    r *= 2.0;
+                    steps += 1;
+                }
+                let di = d[i] * f;
+                if c + r < 0.95 * s && f.is_normal() && di.is_normal() {
+                    let mut j = 0;
+                    while j < n {
+                        b[j * n + i] *= f;
+                        b[i * n + j] /= f;
+                        j += 1;
+                    }
+                    d[i] = di;
+                    changed = true;
+                }
+            }
+            i += 1;
+        }
+        if !changed {
+            break;
+        }
+        sweep += 1;
+    }
+}
+
+/// `n×n` scratch of the Riccati solve: eight matrices, a vector and an LU.
+pub(crate) struct Scratch<'a> {
+    /// Scratch matrices (`n²` each).
+    pub(crate) m: [&'a mut [f64]; 8],
+    /// Scratch vector (`n`).
+    pub(crate) d: &'a mut [f64],
+    /// An `n×n` factorization.
+    pub(crate) lu: LuFlat<'a>,
+}
+
+/// [`stein`](super::riccati::stein) on flat slices: `x = A x Aᵀ + W` by doubling in
+/// balanced coordinates into `x`; `false` if `A` is not certified stable. Uses
+/// `m[0..3]` and `d` of `s`.
+pub(crate) const fn stein_flat(
+    a: &[f64],
+    w: &[f64],
+    n: usize,
+    x: &mut [f64],
+    s: &mut Scratch<'_>,
+) -> bool {
+    let [b, t1, t2, ..] = &mut s.m;
+    let d = &mut *s.d;
+    copy_flat(b, a);
+    balance_flat(b, d, n);
+    let mut i = 0;
+    while i < n {
+        let mut j = 0;
+        while j < n {
+            x[i * n + j] = w[i * n + j] / d[i] / d[j];
+            j += 1;
+        }
+        i += 1;
+    }
+    let mut k = 0;
+    while k < 64 {
+        let nrm = inf_norm_flat(b, n);
+        if !nrm.is_finite() || !all_finite_flat(x) {
+            return false;
+        }
+        if nrm <= A_SMALL {
+            let mut i = 0;
+            while i < n {
+                let mut j = 0;
+                while j < n {
+                    x[i * n + j] = x[i * n + j] * d[i] * d[j];
+                    j += 1;
+                }
+                i += 1;
+            }
+            return all_finite_flat(x);
+        }
+        mul_into(t1, x, false, b, true, n, n, n);
+        mul_into(t2, b, false, t1, false, n, n, n);
+        add_scaled_flat(x, 1.0, t2);
+        mul_into(t1, b, false, b, false, n, n, n);
+        copy_flat(b, t1);
+        k += 1;
+    }
+    false
+}
+
+/// The doubling algorithm (see [`doubling_solution`](super::riccati::doubling_solution))
+/// in place on `(a, g, x)`: `Some((iterations, converged))`, `None` when `W` is singular
+/// or an iterate is not finite. Uses `m[0..5]` and the LU of `s`.
+pub(crate) const fn doubling_flat(
+    a: &mut [f64],
+    g: &mut [f64],
+    x: &mut [f64],
+    n: usize,
+    max: u32,
+    s: &mut Scratch<'_>,
+) -> Option<(u32, bool)> {
+    let [w, wa, wg, t1, t2, ..] = &mut s.m;
+    let mut k = 0;
+    while k < max {
+        k += 1;
+        mul_into(t1, g, false, x, false, n, n, n);
+        identity_into(w, n);
+        add_scaled_flat(w, 1.0, t1);
+        if !s.lu.factor_of(w, n) {
+            return None;
+        }
+        s.lu.solve(a, n, wa);
+        s.lu.solve(g, n, wg);
+        // X₁ = sym(X + Aᵀ (X W⁻¹A)) into w.
+        mul_into(t1, x, false, wa, false, n, n, n);
+        mul_into(t2, a, true, t1, false, n, n, n);
+        copy_flat(w, x);
+        add_scaled_flat(w, 1.0, t2);
+        symmetrize_flat(w, n);
+        // G₁ = sym(G + A (W⁻¹G Aᵀ)) in place.
+        mul_into(t1, wg, false, a, true, n, n, n);
+        mul_into(t2, a, false, t1, false, n, n, n);
+        add_scaled_flat(g, 1.0, t2);
+        symmetrize_flat(g, n);
+        // A₁ = A W⁻¹A into t1.
+        mul_into(t1, a, false, wa, false, n, n, n);
+        if !(all_finite_flat(w) && all_finite_flat(g) && all_finite_flat(t1)) {
+            return None;
+        }
+        copy_flat(t2, w);
+        add_scaled_flat(t2, -1.0, x);
+        let diff = max_abs_flat(t2);
+        copy_flat(x, w);
+        copy_flat(a, t1);
+        if diff <= 4.0 * f64::EPSILON * max_abs_flat(x) && inf_norm_flat(a, n) <= A_SMALL {
+            return Some((k, true));
+        }
+    }
+    Some((k, false))
+}
+
+/// [`doubling_solution`](super::riccati::doubling_solution) on flat slices: the
+/// a-priori covariance into `x` (plus `sym(q_cross)` when given) and the iterations;
+/// `None` if the doubling breaks down, does not converge or stops at a non-covariance.
+pub(crate) const fn doubling_solution_flat(
+    start: [&mut [f64]; 3],
+    n: usize,
+    max: u32,
+    q_cross: Option<&[f64]>,
+    s: &mut Scratch<'_>,
+) -> Option<u32> {
+    let [a, g, x] = start;
+    let (k, converged) = match doubling_flat(a, g, x, n, max, s) {
+        Some(v) => v,
+        None => return None,
+    };
+    let [b, l, t, ..] = &mut s.m;
+    if !(converged && is_covariance_flat(x, n, b, l)) {
+        return None;
+    }
+    if let Some(q) = q_cross {
+        copy_flat(t, q);
+        symmetrize_flat(t, n);
+        add_scaled_flat(x, 1.0, t);
+        symmetrize_flat(x, n);
+    }
+    Some(k)
+}
+
+/// The measurement side of the Riccati solve: `H` (`o×n`), `R` (`o×o`) and the cross
+/// covariance `N` (`n×o`, `None` when absent or zero).
+#[derive(Clone, Copy)]
+pub(crate) struct Sensors<'a> {
+    /// `H`, `o×n`.
+    pub(crate) h: &'a [f64],
+    /// `R`, `o×o`.
+    pub(crate) r: &'a [f64],
+    /// `N`, `n×o`.
+    pub(crate) cross: Option<&'a [f64]>,
+    /// Outputs `o`.
+    pub(crate) o: usize,
+}
+
+/// Scratch of the output side (`o×n`, `o×o` matrices and an `o×o` LU).
+pub(crate) struct OutScratch<'a> {
+    /// `o×n` scratch (two).
+    pub(crate) on: [&'a mut [f64]; 2],
+    /// `o×o` scratch (three).
+    pub(crate) oo: [&'a mut [f64]; 3],
+    /// `n×o` scratch (two).
+    pub(crate) no: [&'a mut [f64]; 2],
+    /// An `o×o` factorization.
+    pub(crate) lu: LuFlat<'a>,
+}
+
+/// [`gain_of`](super::riccati::gain_of) on flat slices: `L = (P Hᵀ + N) Σ⁻¹` into `gain`
+/// (`n×o`); `false` if `Σ` is singular. Uses `on`, `oo` and the LU of `t`.
+pub(crate) const fn gain_of_flat(
+    p: &[f64],
+    n: usize,
+    sn: &Sensors<'_>,
+    gain: &mut [f64],
+    t: &mut OutScratch<'_>,
+) -> bool {
+    let o = sn.o;
+    let [hp, sol] = &mut t.on;
+    let [si, hh, hn] = &mut t.oo;
+    // The innovation's parts (`innovation_parts`): H P (+ Nᵀ), R + H P Hᵀ (+ H N + Nᵀ Hᵀ).
+    mul_into(hp, sn.h, false, p, false, o, n, n);
+    mul_into(hh, hp, false, sn.h, true, o, n, o);
+    copy_flat(si, sn.r);
+    add_scaled_flat(si, 1.0, hh);
+    if let Some(nx) = sn.cross {
+        mul_into(hn, sn.h, false, nx, false, o, n, o);
+        add_transposed(hp, 1.0, nx, o, n);
+        copy_flat(hh, hn);
+        add_transposed(hh, 1.0, hn, o, o);
+        add_scaled_flat(si, 1.0, hh);
+    }
+    symmetrize_flat(si, o);
+    if !t.lu.factor_of(si, o) {
+        return false;
+    }
+    t.lu.solve(hp, n, sol);
+    transpose_into(gain, sol, o, n);
+    true
+}
+
+/// The Riccati equation's Joseph-form residual `A P Aᵀ + K R Kᵀ + Q − P` (into `res`),
+/// the size of its terms (into `bound`) and the closed loop `A = Φ − Φ L H` (into `acl`),
+/// as [`joseph_residual`](super::riccati) forms them. Uses `m[0..4]` of `s` and `t`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) const fn joseph_residual_flat(
+    phi: &[f64],
+    q: &[f64],
+    p: &[f64],
+    l: &[f64],
+    n: usize,
+    sn: &Sensors<'_>,
+    out: [&mut [f64]; 3],
+    s: &mut Scratch<'_>,
+    t: &mut OutScratch<'_>,
+) {
+    let o = sn.o;
+    let [res, bound, acl] = out;
+    let [t1, t2, t3, t4, ..] = &mut s.m;
+    let [k, ka] = &mut t.no;
+    let [rk, _] = &mut t.on;
+    let [ra, ..] = &mut t.oo;
+    mul_into(k, phi, false, l, false, n, n, o);
+    mul_into(t1, k, false, sn.h, false, n, o, n);
+    copy_flat(acl, phi);
+    add_scaled_flat(acl, -1.0, t1);
+    // res = A (P Aᵀ) + K (R Kᵀ) + Q − P.
+    mul_into(t1, p, false, acl, true, n, n, n);
+    mul_into(res, acl, false, t1, false, n, n, n);
+    mul_into(rk, sn.r, false, k, true, o, o, n);
+    mul_into(t1, k, false, rk, false, n, o, n);
+    add_scaled_flat(res, 1.0, t1);
+    add_scaled_flat(res, 1.0, q);
+    add_scaled_flat(res, -1.0, p);
+    // bound = |A| (|P| |A|ᵀ) + |K| (|R| |K|ᵀ) + |Q| + |P|.
+    abs_into(t3, acl);
+    abs_into(ka, k);
+    abs_into(t2, p);
+    mul_into(t1, t2, false, t3, true, n, n, n);
+    mul_into(bound, t3, false, t1, false, n, n, n);
+    abs_into(ra, sn.r);
+    mul_into(rk, ra, false, ka, true, o, o, n);
+    mul_into(t1, ka, false, rk, false, n, o, n);
+    add_scaled_flat(bound, 1.0, t1);
+    abs_into(t1, q);
+    add_scaled_flat(bound, 1.0, t1);
+    add_scaled_flat(bound, 1.0, t2);
+    if let Some(nx) = sn.cross {
+        // − A N Kᵀ − K Nᵀ Aᵀ, and 2 |A||N||K|ᵀ in the size.
+        mul_into(t1, nx, false, k, true, n, o, n);
+        mul_into(t2, acl, false, t1, false, n, n, n);
+        copy_flat(t4, t2);
+        add_transposed(t4, 1.0, t2, n, n);
+        add_scaled_flat(res, -1.0, t4);
+        // |N| into the n×o scratch `k` (K is no longer needed).
+        abs_into(k, nx);
+        mul_into(t1, k, false, ka, true, n, o, n);
+        mul_into(t2, t3, false, t1, false, n, n, n);
+        copy_flat(t4, t2);
+        add_transposed(t4, 1.0, t2, n, n);
+        add_scaled_flat(bound, 1.0, t4);
+    }
+}
+
+/// The largest `|res_ij| / ((2S + 5) ε max(√(B_ii B_jj), B_ij))` (`∞` if any entry is not
+/// finite, or nonzero where its scale is zero; `n×n`).
+pub(crate) const fn residual_units_flat(res: &[f64], bound: &[f64], n: usize) -> f64 {
+    let unit = (2 * n + 5) as f64 * f64::EPSILON;
+    let mut worst = 0.0f64;
+    let mut i = 0;
+    while i < n {
+        let mut j = 0;
+        while j < n {
+            let x = res[i * n + j].abs();
+            let b = bound[i * n + j];
+            if !(x.is_finite() && b.is_finite()) {
+                return f64::INFINITY;
+            }
+            let mut scale = sqrt(bound[i * n + i]) * sqrt(bound[j * n + j]);
+            if b > scale {
+                scale = b;
+            }
+            if x > 0.0 {
+                let u = x / (unit * scale);
+                if u > worst || u.is_nan() {
+                    worst = u;
+                }
+            }
+            j += 1;
+        }
+        i += 1;
+    }
+    worst
+}
+
+/// The noise checks of the Riccati solve, in [`SteadyState`](super::SteadyState)'s
+/// order: `q` a covariance, `r` positive definite ([`Error::InvalidCovariance`]), `H`
+/// finite ([`Error::NonFiniteInput`]). On success the LU of `r` is in `t.lu`.
+pub(crate) const fn check_noise(
+    q: &[f64],
+    n: usize,
+    sn: &Sensors<'_>,
+    s: &mut Scratch<'_>,
+    t: &mut OutScratch<'_>,
+) -> Result<(), Error> {
+    let [b, l, ..] = &mut s.m;
+    if !is_covariance_flat(q, n, b, l) {
+        return Err(Error::InvalidCovariance);
+    }
+    let [lo, ..] = &mut t.oo;
+    if !definite_lu_flat(sn.r, sn.o, lo, &mut t.lu) {
+        return Err(Error::InvalidCovariance);
+    }
+    if !all_finite_flat(sn.h) {
+        return Err(Error::NonFiniteInput);
+    }
+    Ok(())
+}
+
+/// The doubling's start without a cross covariance, `A₀ = Φᵀ`, `G₀ = sym(Hᵀ R⁻¹ H)`,
+/// `X₀ = sym(Q)` into `(a, g, x)`, with the LU of `R` from [`check_noise`] in `t.lu`.
+#[allow(clippy::too_many_arguments)]
+pub(crate) const fn plain_start(
+    phi: &[f64],
+    q: &[f64],
+    n: usize,
+    sn: &Sensors<'_>,
+    start: [&mut [f64]; 3],
+    t: &mut OutScratch<'_>,
+) {
+    let [a, g, x] = start;
+    transpose_into(a, phi, n, n);
+    let [rh, _] = &mut t.on;
+    t.lu.solve(sn.h, n, rh);
+    mul_into(g, sn.h, true, rh, false, n, sn.o, n);
+    symmetrize_flat(g, n);
+    copy_flat(x, q);
+    symmetrize_flat(x, n);
+}
+
+/// The solution `(P, L)` of the steady-state Kalman filter, written into `cov` and `gain`
+/// (`n×n`, `n×o`), from the doubling's start in `(a, g, x)`: the doubling solution, then
+/// the verification and up to three Newton (Hewer) refinements of
+/// [`SteadyState::from_parts`](super::SteadyState::from_parts), keeping the best iterate.
+/// Returns the doubling iterations. Errors: [`Error::RiccatiNotConverged`],
+/// [`Error::OperatorOverflow`].
+#[allow(clippy::too_many_arguments)]
+pub(crate) const fn solve_from_start(
+    phi: &[f64],
+    q: &[f64],
+    n: usize,
+    sn: &Sensors<'_>,
+    q_cross: bool,
+    start: [&mut [f64]; 3],
+    out: (&mut [f64], &mut [f64]),
+    work: [&mut [f64]; 4],
+    s: &mut Scratch<'_>,
+    t: &mut OutScratch<'_>,
+) -> Result<u32, Error> {
+    let [a, g, p] = start;
+    let (cov, gain) = out;
+    let [res, bound, delta, best_gain] = work;
+    let qc = if q_cross { Some(q) } else { None };
+    let k = match doubling_solution_flat(
+        [&mut *a, &mut *g, &mut *p],
+        n,
+        RICCATI_MAX_ITERATIONS,
+        qc,
+        s,
+    ) {
+        Some(k) => k,
+        None => return Err(Error::RiccatiNotConverged),
+    };
+    // `a` and `g` are free from here: `a` holds the closed loop.
+    let acl = a;
+    let (mut has_best, mut best_units) = (false, f64::INFINITY);
+    let mut step = 0;
+    while step <= RICCATI_REFINEMENTS {
+        if !gain_of_flat(p, n, sn, gain, t) {
+            break;
+        }
+        if !all_finite_flat(gain) {
+            if !has_best && step == 0 {
+                return Err(Error::OperatorOverflow);
+            }
+            break;
+        }
+        joseph_residual_flat(phi, q, p, gain, n, sn, [res, bound, acl], s, t);
+        let units = residual_units_flat(res, bound, n);
+        if !stein_flat(acl, res, n, delta, s) {
+            break;
+        }
+        let better = if has_best {
+            units < best_units
+        } else {
+            units <= f64::INFINITY
+        };
+        let [b, l, ..] = &mut s.m;
+        if better && is_covariance_flat(p, n, b, l) {
+            copy_flat(cov, p);
+            copy_flat(best_gain, gain);
+            best_units = units;
+            has_best = true;
+        }
+        if units <= RICCATI_RESIDUAL_REFINE {
+            break;
+        }
+        add_scaled_flat(p, 1.0, delta);
+        symmetrize_flat(p, n);
+        step += 1;
+    }
+    if has_best && best_units <= RICCATI_RESIDUAL_UNITS {
+        copy_flat(gain, best_gain);
+        Ok(k)
+    } else {
+        Err(Error::RiccatiNotConverged)
+    }
+}
