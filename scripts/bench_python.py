@@ -209,8 +209,8 @@ def aem_ida_stripes(recs_h, scales, masses, params, c, threads=2):
     peaks = np.zeros((len(recs_h), len(scales)))
     order = np.argsort(scales)
     for r, cur in enumerate(curves):
-        assert not np.any(cur["collapsed"]), "a run failed"
-        peaks[r, order] = np.asarray(cur["drift"])  # curves come sorted by intensity
+        assert not np.any(cur.collapsed), "a run failed"
+        peaks[r, order] = np.asarray(cur.drift)  # curves come sorted by intensity
     return peaks
 
 
