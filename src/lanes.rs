@@ -298,28 +298,14 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         p: &[[T; L]; N],
         active: [bool; L],
     ) -> LaneReports<T, L> {
-        // `inline(always)`: the closure's body must be inlined into the AVX-compiled
-        // caller of the dispatch, else it is one out-of-line SSE2 function called from it
-        // and the lanes never run 4 wide (measured: the whole step was SSE2 code).
-        crate::linalg::wide(
-            #[inline(always)]
-            || self.step_here(building, state, history, p, active),
-        )
-    }
-
-    /// [`LaneStepper::step`] compiled into its caller (inside the dispatch of
-    /// [`LaneStepper::step`] or [`LaneStepper::run`]).
-    #[inline(always)]
-    fn step_here<Lw: LaneLaw<T>>(
-        &self,
-        building: &ShearBuilding<T, Lw, N>,
-        state: &mut LaneState<T, N, L>,
-        history: &mut LaneHistory<Lw::History, N, L>,
-        p: &[[T; L]; N],
-        active: [bool; L],
-    ) -> LaneReports<T, L> {
         if let Some(band) = building.band() {
-            return self.banded(building, band, state, history, p, active);
+            // `inline(always)`: the closure's body must be inlined into the AVX-compiled
+            // caller of the dispatch, else it is one out-of-line SSE2 function called from
+            // it and the lanes never run 4 wide (measured: the whole step was SSE2 code).
+            return crate::linalg::wide(
+                #[inline(always)]
+                || self.banded(building, band, state, history, p, active),
+            );
         }
         // A dense-damping building: each active lane by the single step.
         core::array::from_fn(|l| {
@@ -616,35 +602,26 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
             }
         }
         let last = steps.iter().copied().max().unwrap_or(0);
-        // The whole stepping loop in one dispatch (`inline(always)`: see `step`), the
-        // loads and the observer compiled with it.
-        crate::linalg::wide(
-            #[inline(always)]
-            || {
-                for n in 1..=last {
-                    let active: [bool; L] =
-                        core::array::from_fn(|l| outcome[l].is_ok() && n <= steps[l]);
-                    if !active.iter().any(|&a| a) {
-                        break;
-                    }
-                    let ag: [T; L] =
-                        core::array::from_fn(|l| if active[l] { ground(l, n) } else { T::zero() });
-                    let p = Self::ground_loads(building, &ag);
-                    let reports = self.step_here(building, &mut state, &mut history, &p, active);
-                    for (l, report) in reports.iter().enumerate() {
-                        if let Some(Err(error)) = report {
-                            outcome[l] = Err(Failure {
-                                step: n,
-                                error: *error,
-                            });
-                        }
-                    }
-                    let stepped: [bool; L] =
-                        core::array::from_fn(|l| matches!(reports[l], Some(Ok(_))));
-                    observe(&state, &stepped);
+        for n in 1..=last {
+            let active: [bool; L] = core::array::from_fn(|l| outcome[l].is_ok() && n <= steps[l]);
+            if !active.iter().any(|&a| a) {
+                break;
+            }
+            let ag: [T; L] =
+                core::array::from_fn(|l| if active[l] { ground(l, n) } else { T::zero() });
+            let p = Self::ground_loads(building, &ag);
+            let reports = self.step(building, &mut state, &mut history, &p, active);
+            for (l, report) in reports.iter().enumerate() {
+                if let Some(Err(error)) = report {
+                    outcome[l] = Err(Failure {
+                        step: n,
+                        error: *error,
+                    });
                 }
-            },
-        );
+            }
+            let stepped: [bool; L] = core::array::from_fn(|l| matches!(reports[l], Some(Ok(_))));
+            observe(&state, &stepped);
+        }
         outcome
     }
 }
