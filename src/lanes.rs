@@ -299,7 +299,13 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         active: [bool; L],
     ) -> LaneReports<T, L> {
         if let Some(band) = building.band() {
-            return crate::linalg::wide(|| self.banded(building, band, state, history, p, active));
+            // `inline(always)`: the closure's body must be inlined into the AVX-compiled
+            // caller of the dispatch, else it is one out-of-line SSE2 function called from
+            // it and the lanes never run 4 wide (measured: the whole step was SSE2 code).
+            return crate::linalg::wide(
+                #[inline(always)]
+                || self.banded(building, band, state, history, p, active),
+            );
         }
         // A dense-damping building: each active lane by the single step.
         core::array::from_fn(|l| {
@@ -469,6 +475,13 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                     }
                 })
             };
+            // The lanes that finish here: their outcome as the single step's, and those
+            // that converged to a finite state committed together (masked copies).
+            let state_finite = {
+                let (fu, fv, fq) = (finite(&w.u, 0), finite(&w.v, 0), finite(&w.q, 0));
+                core::array::from_fn::<bool, L, _>(|l| fu[l] && fv[l] && fq[l])
+            };
+            let mut commit = [false; L];
             for l in 0..L {
                 if !running[l] {
                     continue;
@@ -476,16 +489,24 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                 let converged = residual[l] <= tol || (iterations > 0 && correction[l] <= tol);
                 if iterations >= budget || (!fixed && converged) {
                     running[l] = false;
-                    out[l] = Some(self.commit(state, history, &w, l, converged).map(|()| {
-                        NewtonReport {
+                    out[l] = Some(if !state_finite[l] {
+                        Err(Error::NonFiniteState)
+                    } else if !converged {
+                        Err(Error::NotConverged)
+                    } else {
+                        commit[l] = true;
+                        Ok(NewtonReport {
                             iterations,
                             residual: residual[l],
                             correction: correction[l],
                             converged,
                             branch_changes: branch_changes[l],
-                        }
-                    }));
+                        })
+                    });
                 }
+            }
+            if commit.iter().any(|&x| x) {
+                Self::commit(state, history, &w, &commit);
             }
             if !running.iter().any(|&x| x) {
                 break;
@@ -511,32 +532,27 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         out
     }
 
-    /// Commit lane `l`'s last iterate (state `(w.u, w.v, w.q)`, trial history) when it is
-    /// finite and `converged`; else the single step's error, nothing written.
+    /// Commit the last iterate (state `(w.u, w.v, w.q)`, trial history) of every lane in
+    /// `commit` (each converged to a finite state), as masked copies over all lanes.
+    #[inline(always)]
     fn commit<H: Copy>(
-        &self,
         state: &mut LaneState<T, N, L>,
         history: &mut LaneHistory<H, N, L>,
         w: &Work<T, H, N, L>,
-        l: usize,
-        converged: bool,
-    ) -> Result<(), Error> {
-        let finite =
-            (0..N).all(|i| w.u[i][l].is_finite() && w.v[i][l].is_finite() && w.q[i][l].is_finite());
-        if !finite {
-            return Err(Error::NonFiniteState);
-        }
-        if !converged {
-            return Err(Error::NotConverged);
-        }
+        commit: &[bool; L],
+    ) {
         for i in 0..N {
-            state.u[i][l] = w.u[i][l];
-            state.v[i][l] = w.v[i][l];
-            state.a[i][l] = w.q[i][l];
-            history[i][l] = w.history[i][l];
+            for l in 0..L {
+                let c = commit[l];
+                state.u[i][l] = if c { w.u[i][l] } else { state.u[i][l] };
+                state.v[i][l] = if c { w.v[i][l] } else { state.v[i][l] };
+                state.a[i][l] = if c { w.q[i][l] } else { state.a[i][l] };
+                history[i][l] = if c { w.history[i][l] } else { history[i][l] };
+            }
         }
-        state.n[l] = state.n[l].wrapping_add(1);
-        Ok(())
+        for l in 0..L {
+            state.n[l] = state.n[l].wrapping_add(u64::from(commit[l]));
+        }
     }
 
     /// `L` analyses of the building from rest under ground accelerations

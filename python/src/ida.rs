@@ -14,7 +14,7 @@
 //!
 //! **Many runs at once.** The runs go [`LANES`] at a time through `aemstep::ida::batched`,
 //! one a SIMD lane of `aemstep::lanes::LaneStepper` (stripes: a stripe's records side by
-//! side; hunt-and-fill: four records' traces side by side), every law of the package. Each
+//! side; hunt-and-fill: [`LANES`] records' traces side by side), every law of the package. Each
 //! lane is bit for bit the single run of `shear_building`, so the curves are those of the
 //! serial one-run-at-a-time IDA, bit for bit, on any thread count; a run that fails does
 //! not stop the others of its batch, and the collapse and abort rules are the library's.
@@ -33,11 +33,13 @@ use pyo3::types::{PyDict, PyList};
 use crate::laws::{self, WithLaws};
 use crate::{Fail, Res, SIZES, out1, out2, read1, read2, rows, shape, square};
 
-/// Analyses stepped together by [`LaneStepper`], one a lane: `f64 × 4` fills one AVX
-/// register (two SSE2 ones). Measured on the 880-analysis IDA of `scripts/bench_python.py`
-/// (1 thread, load 3.3 to 4.1 on 2 cores): 1.60 s with 4 lanes, 1.74 s with 2, 1.68 s
-/// with 8; 4 lanes a batch still leaves 220 batches to share between threads.
-const LANES: usize = 4;
+/// Analyses stepped together by [`LaneStepper`], one a lane: `f64 × 8`, two AVX registers
+/// (four SSE2 ones), whose two independent chains hide the latency of the Newton solve's
+/// divisions. The width `xtask/benches/lanes.rs` measures fastest a lane step (see
+/// `docs/performance.md`, lanes); 8 lanes a batch leaves 110 batches of the 880-analysis IDA
+/// to share between threads. (4 lanes measured fastest before the lanes' step ran AVX code
+/// at all: it was compiled as SSE2, outside the dispatch.)
+const LANES: usize = 8;
 
 /// The intensities to run: fixed stripes, or a hunt-and-fill trace.
 enum Plan {

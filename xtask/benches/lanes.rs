@@ -16,7 +16,10 @@
 //!
 //! After criterion, each case is timed again ([`REPEATS`] times, fastest kept: on a shared
 //! machine the fastest run is the least disturbed) and printed as `LANES …` lines with the
-//! load averages before and after.
+//! load averages before and after; the step cases also by their time on a CPU (the thread's
+//! scheduler statistics: what they cost when other processes hold the cores). A last line
+//! states what bounds a lane step: the Newton iterations a step of the 880 single analyses
+//! take, on average and as the slowest lane of each batch of 4 or 8 (the lane step's count).
 //!
 //! Run: `cargo bench -p xtask --bench lanes` (about three minutes on an idle machine);
 //! `-- --skip-criterion` times only the summary lines.
@@ -29,6 +32,7 @@ mod ida;
 use std::hint::black_box;
 use std::time::Instant;
 
+use aemstep::hysteresis::HistoryModel;
 use aemstep::ida::{Batching, Collapse, OnFailure, Plan, batched, stripes};
 use aemstep::lanes::LaneStepper;
 use criterion::{Criterion, Throughput};
@@ -37,6 +41,8 @@ use criterion::{Criterion, Throughput};
 const STEPS: u64 = 4000;
 /// Timed repetitions of the summary (fastest kept).
 const REPEATS: usize = 3;
+/// Repetitions of a step case timed on the CPU (mean kept).
+const CPU_REPEATS: usize = 40;
 
 fn loadavg() -> String {
     std::fs::read_to_string("/proc/loadavg").map_or_else(|_| "?".into(), |s| s.trim().into())
@@ -80,6 +86,26 @@ fn records() -> Vec<Vec<f64>> {
         out.push(x.iter().map(|a| a * pga / peak).collect());
     }
     out
+}
+
+/// This thread's time on a CPU so far (s; `/proc/thread-self/schedstat`, NaN elsewhere):
+/// on a machine shared with other processes, what a single-threaded case costs without the
+/// time it waited for a core.
+fn thread_cpu() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(f64::NAN, |ns| ns * 1e-9)
+}
+
+/// The mean on-CPU time ([`thread_cpu`]) of [`CPU_REPEATS`] runs of `f` on this thread (s;
+/// many runs: the kernel brings the figure up to date at its ticks, a few milliseconds).
+fn mean_cpu(mut f: impl FnMut()) -> f64 {
+    let t = thread_cpu();
+    for _ in 0..CPU_REPEATS {
+        f();
+    }
+    (thread_cpu() - t) / CPU_REPEATS as f64
 }
 
 /// The fastest of [`REPEATS`] runs of `f` (s).
@@ -167,6 +193,24 @@ fn main() {
         per(t8, 8)
     );
 
+    let c1 = mean_cpu(one);
+    let c2 = mean_cpu(|| {
+        black_box(ida::peak_drifts(&building, &l2, &jobs[..2]));
+    });
+    let c4 = mean_cpu(|| {
+        black_box(ida::peak_drifts(&building, &l4, &jobs[..4]));
+    });
+    let c8 = mean_cpu(|| {
+        black_box(ida::peak_drifts(&building, &l8, &jobs));
+    });
+    println!(
+        "LANES step on-CPU (mean) ns/analysis-step: single {:.1} L2 {:.1} L4 {:.1} L8 {:.1}",
+        per(c1, 1),
+        per(c2, 2),
+        per(c4, 4),
+        per(c8, 8)
+    );
+
     // The 880-analysis IDA.
     let mut recs = records();
     let mut scales: Vec<f64> = (1..=20).map(|k| k as f64 / 10.0).collect();
@@ -241,5 +285,64 @@ fn main() {
     println!(
         "LANES IDA{n} s: single t1 {s1:.3} t2 {s2:.3}; lanes4 t1 {a1:.3} t2 {a2:.3}; lanes8 t1 {b1:.3} t2 {b2:.3}"
     );
+    // What bounds a lane step: the Newton iterations of the slowest lane. Each run's
+    // iteration count at every step (single analyses), then per step the largest of each
+    // batch of `L` runs as `ida::batched` groups them (a stripe's records side by side).
+    let iterations: Vec<Vec<u32>> = scales
+        .iter()
+        .flat_map(|&im| recs.iter().map(move |r| (r, im)))
+        .map(|(r, im)| newton_iterations(&building, &single, r, im))
+        .collect();
+    let total: u64 = iterations.iter().flatten().map(|&k| u64::from(k)).sum();
+    let steps_all: usize = iterations.iter().map(Vec::len).sum();
+    let lane_max = |l: usize| {
+        let mut sum = 0u64;
+        let mut lane_steps = 0usize;
+        for batch in iterations.chunks(l) {
+            let longest = batch.iter().map(Vec::len).max().unwrap_or(0);
+            for n in 0..longest {
+                sum += u64::from(
+                    batch
+                        .iter()
+                        .filter_map(|k| k.get(n))
+                        .max()
+                        .copied()
+                        .unwrap_or(0),
+                );
+            }
+            lane_steps += longest * l;
+        }
+        sum as f64 / lane_steps as f64 * l as f64
+    };
+    println!(
+        "LANES iterations a step: mean {:.3}; slowest of the batch L4 {:.3} L8 {:.3}",
+        total as f64 / steps_all as f64,
+        lane_max(4),
+        lane_max(8)
+    );
     println!("LOADAVG after {}", loadavg());
+}
+
+/// The Newton iterations of every step of one whole run (as `ida::peak_drift` steps it).
+fn newton_iterations(
+    building: &ida::Building,
+    single: &aemstep::Nonlinear<f64, { ida::N }>,
+    r: &[f64],
+    im: f64,
+) -> Vec<u32> {
+    let zero = aemstep::nalgebra::SVector::<f64, { ida::N }>::zeros();
+    let virgin = building.initial_history();
+    let p0 = building.ground_load(ida::ground(r, im, 0));
+    let Ok((mut s, mut h)) = single.start_with_history(building, &zero, &zero, &p0, &virgin) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for n in 1..=ida::steps(r.len()) {
+        let p = building.ground_load(ida::ground(r, im, n));
+        match single.try_step_with_history(building, &mut s, &mut h, &p) {
+            Ok(report) => out.push(report.iterations),
+            Err(_) => break,
+        }
+    }
+    out
 }
