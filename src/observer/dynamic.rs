@@ -27,7 +27,7 @@ use std::vec::Vec;
 
 use nalgebra::DMatrix;
 
-use super::fixed::{check_parts_flat, correct_row, innovation_row, next_counts, predict_row};
+use super::fixed::{check_parts_flat, next_counts};
 use super::flat::{
     LuFlat, OutScratch, Scratch, Sensors, check_noise, definite_lu_flat, identity_into,
     is_covariance_flat, plain_start, solve_from_start,
@@ -985,4 +985,53 @@ impl<T: Real> DynKalman<T> {
         (e.n, e.missing) = (n, missing);
         Ok(())
     }
+}
+
+/// Row `i` of the fixed-gain observer's prediction, `Σ_j Γ₀[i][j] w_{n−1}[j] + Γ₁[i][j]
+/// w_n[j]` then `+ Σ_j Φ[i][j] x[j]`, summed from `−0` (`−0 + x = x` exactly, so the
+/// compiler drops the add): the one row of [`DynObserver`], the same sums in the
+/// same order as [`Observer`](super::Observer)'s step on its arrays. Cost: `S + 2I` multiply-adds.
+#[inline(always)]
+pub(crate) fn predict_row<T: Real>(
+    phi: &[T],
+    gamma0: &[T],
+    gamma1: &[T],
+    x: &[T],
+    w_prev: &[T],
+    w: &[T],
+) -> T {
+    let mut s = -T::zero();
+    for ((g0, g1), (wp, wn)) in gamma0.iter().zip(gamma1).zip(w_prev.iter().zip(w)) {
+        s += *g0 * *wp;
+        s += *g1 * *wn;
+    }
+    for (p, xj) in phi.iter().zip(x) {
+        s += *p * *xj;
+    }
+    s
+}
+
+/// Innovation `o`: `y_o − Σ_j D[o][j] w[j] − Σ_j H[o][j] x̂⁻[j]` (the observers' one row).
+/// Cost: `I + S` multiply-adds.
+#[inline(always)]
+pub(crate) fn innovation_row<T: Real>(y: T, d: &[T], h: &[T], w: &[T], xp: &[T]) -> T {
+    let mut s = y;
+    for (dj, wj) in d.iter().zip(w) {
+        s -= *dj * *wj;
+    }
+    for (hj, xj) in h.iter().zip(xp) {
+        s -= *hj * *xj;
+    }
+    s
+}
+
+/// Corrected state `i`: `x̂⁻[i] + Σ_o L[i][o] ν[o]` (the observers' one row). Cost: `O`
+/// multiply-adds.
+#[inline(always)]
+pub(crate) fn correct_row<T: Real>(xp: T, gain: &[T], innov: &[T]) -> T {
+    let mut s = xp;
+    for (l, v) in gain.iter().zip(innov) {
+        s += *l * *v;
+    }
+    s
 }
