@@ -1,0 +1,153 @@
+//! Host benchmark of the observers' step, compiled (const-generic) against run-time-sized
+//! (issue 34): the fixed-gain `Observer<f64, 10, 1, 2>` against `DynObserver<f64>` and the
+//! full `Kalman<f64, 10, 1, 2>` against `DynKalman<f64>`, at N = 5 (S = 10 states, 2
+//! accelerometers, one ground input), over 999 steps of a noisy record, repeated; the mean
+//! time a step is printed (host timings).
+//!
+//! Run: `cargo bench -p xtask --bench observer` (a few seconds).
+
+use aemstep::nalgebra::{DMatrix, SMatrix, SVector};
+use aemstep::observer::{
+    DynKalman, DynObserver, DynStateSpace, Kalman, Observer, Outputs, StateSpace, SteadyState,
+};
+
+const H: f64 = 0.02;
+
+/// A shear building of `n` storeys: floor masses 1e5 kg, storey stiffness 2e8 N/m,
+/// damping `C = 0.2 M + 1e-3 K` (about 2–5 % in the lower modes).
+fn building(n: usize) -> (DMatrix<f64>, DMatrix<f64>, DMatrix<f64>) {
+    let m = DMatrix::<f64>::identity(n, n) * 1.0e5;
+    let k = DMatrix::from_fn(n, n, |i, j| {
+        let ks = 2.0e8;
+        match (i.abs_diff(j), i + 1 == n) {
+            (0, true) => ks,
+            (0, false) => 2.0 * ks,
+            (1, _) => -ks,
+            _ => 0.0,
+        }
+    });
+    let c = &m * 0.2 + &k * 1.0e-3;
+    (m, c, k)
+}
+
+/// The ground-acceleration input `B = −M ι`.
+fn ground(m: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = m.nrows();
+    DMatrix::from_fn(n, 1, |i, _| -(0..n).map(|j| m[(i, j)]).sum::<f64>())
+}
+
+/// A record of `steps` samples: ground acceleration (m/s²) and `o` measured absolute
+/// accelerations, with sample 7 of sensor 0 missing (NaN).
+fn record(steps: usize, o: usize) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let ag = (0..steps)
+        .map(|n| {
+            let t = n as f64 * 0.02;
+            (7.0 * t).sin() * (-0.2 * t).exp() + 0.3 * (19.0 * t).cos()
+        })
+        .collect();
+    let y = (0..steps)
+        .map(|n| {
+            (0..o)
+                .map(|s| {
+                    if n == 7 && s == 0 {
+                        f64::NAN
+                    } else {
+                        0.5 * ((3.0 + s as f64) * n as f64 * 0.02).sin()
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    (ag, y)
+}
+
+/// The step times, printed.
+fn main() {
+    use std::hint::black_box;
+    use std::time::Instant;
+    const N: usize = 5;
+    let (m, c, k) = building(N);
+    let b = ground(&m);
+    let sm = |a: &DMatrix<f64>| SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)]);
+    let bs = SMatrix::<f64, N, 1>::from_fn(|i, _| b[(i, 0)]);
+    let ss = StateSpace::<N, 10, 1>::aem(&sm(&m), &sm(&c), &sm(&k), &bs, H).unwrap();
+    let meas = ss
+        .outputs(&Outputs::absolute_accelerations(
+            Outputs::<N, 1, 2>::select([1, 4]),
+            0,
+        ))
+        .unwrap();
+    let q = SMatrix::<f64, 10, 10>::identity() * 1e-8;
+    let r = SMatrix::<f64, 2, 2>::identity() * 0.01;
+    let kf = SteadyState::new(&ss, &meas, &q, &r).unwrap();
+    let obs = Observer::<f64, 10, 1, 2>::new(&ss, &meas, &kf.gain_matrix()).unwrap();
+    let dss = DynStateSpace::aem(&m, &c, &k, &b, H).unwrap();
+    let dmeas = dss.absolute_accelerations(&[1, 4], 0).unwrap();
+    let dobs =
+        DynObserver::<f64>::new(&dss, &dmeas, &DMatrix::from_fn(10, 2, |i, j| kf.gain[i][j]))
+            .unwrap();
+    let (ag, y) = record(1000, 2);
+    let reps = 2000;
+    let t = Instant::now();
+    for _ in 0..reps {
+        let mut e = obs.start_at_rest(&SVector::from([0.0])).unwrap();
+        for i in 1..ag.len() {
+            let _ = obs.try_step(
+                &mut e,
+                &SVector::from([ag[i]]),
+                &SVector::from_column_slice(&y[i]),
+            );
+        }
+        black_box(&e);
+    }
+    let tc = t.elapsed().as_secs_f64() / (reps * (ag.len() - 1)) as f64;
+    let t = Instant::now();
+    for _ in 0..reps {
+        let mut e = dobs.start_at_rest(&[0.0]).unwrap();
+        for i in 1..ag.len() {
+            let _ = dobs.try_step(&mut e, &[ag[i]], &y[i]);
+        }
+        black_box(&e);
+    }
+    let td = t.elapsed().as_secs_f64() / (reps * (ag.len() - 1)) as f64;
+    println!(
+        "step N = 5 (S = 10, O = 2): compiled {:.1} ns, run-time {:.1} ns ({:.2}×)",
+        tc * 1e9,
+        td * 1e9,
+        td / tc
+    );
+    // The full Kalman filter: Kalman vs DynKalman.
+    let kk = Kalman::<f64, 10, 1, 2>::new(&ss, &meas, &q, &r).unwrap();
+    let dq = DMatrix::<f64>::identity(10, 10) * 1e-8;
+    let dk = DynKalman::<f64>::new(&dss, &dmeas, &dq, &(DMatrix::identity(2, 2) * 0.01)).unwrap();
+    let reps = 200;
+    let t = Instant::now();
+    for _ in 0..reps {
+        let mut s = kk
+            .start(&SVector::zeros(), &SMatrix::zeros(), &SVector::from([0.0]))
+            .unwrap();
+        for i in 1..ag.len() {
+            let w = SVector::from([ag[i]]);
+            let _ = kk.try_step(&mut s, &w, &SVector::from_column_slice(&y[i]));
+        }
+        black_box(&s);
+    }
+    let tc = t.elapsed().as_secs_f64() / (reps * (ag.len() - 1)) as f64;
+    let t = Instant::now();
+    for _ in 0..reps {
+        let mut s = dk
+            .start(&[0.0; 10], &DMatrix::zeros(10, 10), &[0.0])
+            .unwrap();
+        for i in 1..ag.len() {
+            let _ = dk.try_step(&mut s, &[ag[i]], &y[i]);
+        }
+        black_box(&s);
+    }
+    let td = t.elapsed().as_secs_f64() / (reps * (ag.len() - 1)) as f64;
+    println!(
+        "Kalman step N = 5 (S = 10, O = 2): compiled {:.1} ns, run-time {:.1} ns ({:.2}×)",
+        tc * 1e9,
+        td * 1e9,
+        td / tc
+    );
+}
