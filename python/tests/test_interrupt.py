@@ -43,6 +43,12 @@ CALLS = {
         "ag = record(5_000_000)",
         "aemstep.shear_building(np.ones(n), c, 0.01, ag, k=2e3, fy=1e9, energy=False, histories=False)",
     ),
+    # The run-time-sized path (37 storeys, outside aemstep.SIZES): its loop polls too.
+    "shear_building_any_size": (
+        "n = 37; k = 2e3 * (2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)); "
+        "c = 0.01 * k + 0.1 * np.eye(n); ag = record(5_000_000)",
+        "aemstep.shear_building(np.ones(n), c, 0.01, ag, k=2e3, fy=1e9, energy=False, histories=False)",
+    ),
     "observe": (
         "ag = record(150_000); y = np.zeros((ag.size, 1))",
         "aemstep.observe(m, c, k, 0.01, ag, y, [n - 1], sigma_f=1.0, sigma_y=0.1, kalman=True)",
