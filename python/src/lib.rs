@@ -1072,6 +1072,23 @@ fn on_record(record: &[f64]) -> impl Fn(Error) -> Fail + '_ {
     }
 }
 
+/// The free-vibration tail after a record (`free_vibration`): one longest period of the
+/// last bank (the longest periods), the same for every bank so that a period's result does
+/// not depend on the bank it falls in; refused with `InvalidTimeStep` above
+/// [`MAX_FREE_VIBRATION_SAMPLES`](aemstep::spectrum::MAX_FREE_VIBRATION_SAMPLES), as the
+/// library's record-level calls do (a 3 s period at `h = 1e-300` asked for 2³² − 1 samples:
+/// hours of stepping).
+fn free_vibration_tail(free_vibration: bool, last: Option<&Bank<f64, CHUNK>>) -> Res<u32> {
+    let n = match (free_vibration, last) {
+        (true, Some(b)) => b.free_vibration_samples(),
+        _ => 0,
+    };
+    if n > aemstep::spectrum::MAX_FREE_VIBRATION_SAMPLES {
+        return Err(Error::InvalidTimeStep.into());
+    }
+    Ok(n)
+}
+
 /// Periods and damping checked (same length, periods non-decreasing) and cut into banks of
 /// `CHUNK`, the last padded with copies of the last period.
 fn chunks(periods: &[f64], damping: &[f64]) -> Res<Vec<([f64; CHUNK], [f64; CHUNK])>> {
@@ -1169,13 +1186,7 @@ fn spectra<'py>(
                     .map(|b| b.with_non_finite(policy))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        // One longest period of free vibration for every bank: the result of a period
-        // does not depend on the bank it falls in.
-        let fv = if free_vibration {
-            banks.last().map_or(0, |b| b.free_vibration_samples())
-        } else {
-            0
-        };
+        let fv = free_vibration_tail(free_vibration, banks.last())?;
         let jobs: Vec<(usize, usize)> = (0..records.len())
             .flat_map(|r| (0..banks.len()).map(move |b| (r, b)))
             .collect();
@@ -1287,11 +1298,7 @@ fn rotd<'py>(
                     .map(|b| b.with_non_finite(policy))
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let fv = if free_vibration {
-            banks.last().map_or(0, |b| b.free_vibration_samples())
-        } else {
-            0
-        };
+        let fv = free_vibration_tail(free_vibration, banks.last())?;
         let stop = || cancel.load(std::sync::atomic::Ordering::Relaxed);
         let angles = RotD::<f64, ROTD_ANGLES>::new();
         let parts = batch::map(&banks, threads, |bank| {

@@ -127,6 +127,17 @@ def test_empty_and_degenerate_inputs_raise_typed_errors_never_crash():
         aemstep.spectrum([0.5, 1.0], 0.05, 0.02, bad)
     assert e.value.step == 5
     assert np.all(np.isfinite(aemstep.spectrum([0.5, 1.0], 0.05, 0.02, bad, nan="skip").sd))
+    # A free-vibration tail longer than aemstep's MAX_FREE_VIBRATION_SAMPLES (2**20; one
+    # 3 s period at h = 1e-8 s is 3e8 samples, at 1e-300 s 2**32 - 1) is refused at once
+    # with InvalidTimeStep, as the Rust record-level calls do, not stepped for hours.
+    rec = [0.1, 0.2, 0.3]
+    for h in (1e-8, 1e-300):
+        with pytest.raises(aemstep.InvalidTimeStep):
+            aemstep.spectrum([3.0], 0.05, h, rec)
+        with pytest.raises(aemstep.InvalidTimeStep):
+            aemstep.rotd([3.0], 0.05, h, rec, rec)
+        # Without the tail, the record alone: three samples.
+        assert aemstep.spectrum([3.0], 0.05, h, rec, free_vibration=False).sd.shape == (1,)
 
 
 # ---------------------------------------------------------------------------------------
