@@ -8,8 +8,8 @@
 use aemstep::Error;
 use aemstep::nalgebra::{DMatrix, SMatrix, SVector};
 use aemstep::observer::{
-    DynKalman, DynObserver, DynStateSpace, DynSteadyState, Kalman, Observer, Outputs, StateSpace,
-    SteadyState,
+    DynKalman, DynMeasurement, DynObserver, DynStateSpace, DynSteadyState, Kalman, Measurement,
+    Observer, Outputs, StateSpace, SteadyState,
 };
 
 #[path = "../scenes/observer/any_size.rs"]
@@ -26,9 +26,21 @@ fn bits(a: &[f64]) -> Vec<u64> {
     a.iter().map(|v| v.to_bits()).collect()
 }
 
-/// Compiled size `N` (`S = 2N`) with `O` sensors at `dofs`: model, gain, covariance and
-/// 200 estimates bit for bit, `f64`; the first 50 estimates in `f32` too.
-fn same_at<const N: usize, const S: usize, const O: usize>(dofs: [usize; O]) {
+/// The `N`-storey scene with `O` accelerometers at `dofs`, built both ways: the compiled
+/// model (`S = 2N`) and its measurement, the run-time model and measurement, and the
+/// run-time noise (white forces of `SIGMA_F` on every floor, accelerometers of `SIGMA_Y`).
+struct Models<const N: usize, const S: usize, const O: usize> {
+    /// `M, C, K` as compiled matrices.
+    stiff: (SMatrix<f64, N, N>, SMatrix<f64, N, N>, SMatrix<f64, N, N>),
+    ss: StateSpace<N, S, 1>,
+    meas: Measurement<S, 1, O>,
+    dss: DynStateSpace,
+    dmeas: DynMeasurement,
+    dq: DMatrix<f64>,
+    dr: DMatrix<f64>,
+}
+
+fn models<const N: usize, const S: usize, const O: usize>(dofs: [usize; O]) -> Models<N, S, O> {
     let (m, c, k) = building(N);
     let b = ground(&m);
     let sm = |a: &DMatrix<f64>| SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)]);
@@ -41,6 +53,36 @@ fn same_at<const N: usize, const S: usize, const O: usize>(dofs: [usize; O]) {
             0,
         ))
         .unwrap();
+    let dss = DynStateSpace::aem(&m, &c, &k, &b, H).unwrap();
+    let dmeas = dss.absolute_accelerations(&dofs, 0).unwrap();
+    let dforces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(N, N), H).unwrap();
+    let dq = dforces
+        .input_noise(&(DMatrix::identity(N, N) * (SIGMA_F * SIGMA_F)))
+        .unwrap();
+    let dr = DMatrix::identity(O, O) * (SIGMA_Y * SIGMA_Y);
+    Models {
+        stiff: (ms, cs, ks),
+        ss,
+        meas,
+        dss,
+        dmeas,
+        dq,
+        dr,
+    }
+}
+
+/// Compiled size `N` (`S = 2N`) with `O` sensors at `dofs`: model, gain, covariance and
+/// 200 estimates bit for bit, `f64`; the first 50 estimates in `f32` too.
+fn same_at<const N: usize, const S: usize, const O: usize>(dofs: [usize; O]) {
+    let Models {
+        stiff: (ms, cs, ks),
+        ss,
+        meas,
+        dss,
+        dmeas,
+        dq,
+        dr,
+    } = models::<N, S, O>(dofs);
     let forces = StateSpace::<N, S, N>::aem(&ms, &cs, &ks, &SMatrix::identity(), H).unwrap();
     let qw: [[f64; N]; N] = core::array::from_fn(|i| {
         core::array::from_fn(|j| if i == j { SIGMA_F * SIGMA_F } else { 0.0 })
@@ -50,13 +92,6 @@ fn same_at<const N: usize, const S: usize, const O: usize>(dofs: [usize; O]) {
     let kf = SteadyState::new(&ss, &meas, &q, &r).unwrap();
     let obs = Observer::<f64, S, 1, O>::new(&ss, &meas, &kf.gain_matrix()).unwrap();
 
-    let dss = DynStateSpace::aem(&m, &c, &k, &b, H).unwrap();
-    let dmeas = dss.absolute_accelerations(&dofs, 0).unwrap();
-    let dforces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(N, N), H).unwrap();
-    let dq = dforces
-        .input_noise(&(DMatrix::identity(N, N) * (SIGMA_F * SIGMA_F)))
-        .unwrap();
-    let dr = DMatrix::identity(O, O) * (SIGMA_Y * SIGMA_Y);
     let dkf = DynSteadyState::new(&dss, &dmeas, &dq, &dr).unwrap();
     let dobs = DynObserver::<f64>::new(&dss, &dmeas, &dkf.gain_matrix()).unwrap();
 
@@ -431,25 +466,15 @@ fn bad_input_gives_the_compiled_paths_errors() {
 /// against `Kalman`, every estimate and covariance bit for bit over 120 steps (sample 7 of
 /// sensor 0 missing), in `f64` and in `f32`.
 fn kalman_same_at<const N: usize, const S: usize, const O: usize>(dofs: [usize; O]) {
-    let (m, c, k) = building(N);
-    let b = ground(&m);
-    let sm = |a: &DMatrix<f64>| SMatrix::<f64, N, N>::from_fn(|i, j| a[(i, j)]);
-    let (ms, cs, ks) = (sm(&m), sm(&c), sm(&k));
-    let bs = SMatrix::<f64, N, 1>::from_fn(|i, _| b[(i, 0)]);
-    let ss = StateSpace::<N, S, 1>::aem(&ms, &cs, &ks, &bs, H).unwrap();
-    let meas = ss
-        .outputs(&Outputs::absolute_accelerations(
-            Outputs::<N, 1, O>::select(dofs),
-            0,
-        ))
-        .unwrap();
-    let dss = DynStateSpace::aem(&m, &c, &k, &b, H).unwrap();
-    let dmeas = dss.absolute_accelerations(&dofs, 0).unwrap();
-    let dforces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(N, N), H).unwrap();
-    let dq = dforces
-        .input_noise(&(DMatrix::identity(N, N) * (SIGMA_F * SIGMA_F)))
-        .unwrap();
-    let dr = DMatrix::identity(O, O) * (SIGMA_Y * SIGMA_Y);
+    let Models {
+        ss,
+        meas,
+        dss,
+        dmeas,
+        dq,
+        dr,
+        ..
+    } = models::<N, S, O>(dofs);
     let q = SMatrix::<f64, S, S>::from_fn(|i, j| dq[(i, j)]);
     let r = SMatrix::<f64, O, O>::from_fn(|i, j| dr[(i, j)]);
     let (ag, y) = record(120, O);
