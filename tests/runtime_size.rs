@@ -7,6 +7,15 @@
 use aemstep::{DynLinear, Error, Linear, Stepper};
 use nalgebra::{DMatrix, DVector, SMatrix, SVector};
 
+/// `u`, `v`, `a` of the const-generic state (`fixed`) and the run-time one (`run`) equal
+/// bit for bit at step `step` of an `n`-DOF run (`f32` compared through its exact `f64`).
+fn same_uva<T: aemstep::Real>(fixed: [&[T]; 3], run: [&[T]; 3], n: usize, step: usize) {
+    let bits = |x: &[T]| x.iter().map(|x| x.as_f64().to_bits()).collect::<Vec<_>>();
+    for (name, (a, b)) in ["u", "v", "a"].into_iter().zip(fixed.into_iter().zip(run)) {
+        assert_eq!(bits(a), bits(b), "{name}, N = {n}, step {step}");
+    }
+}
+
 /// A deterministic, non-symmetric, well-conditioned test model of `n` degrees of freedom
 /// (kg, N·s/m, N/m): a chain with a mass matrix that is not diagonal, a stiffness chain
 /// plus a small coupling, and damping `0.1 M + 0.002 K` plus a small skew part.
@@ -79,7 +88,6 @@ fn same_histories<T: aemstep::Real, const N: usize>() {
     let p0 = t(&load(N, 0, H));
     let mut s = fixed.start(&sv(&u0), &sv(&v0), &sv(&p0)).unwrap();
     let mut d = dynamic.start(&u0, &v0, &p0).unwrap();
-    let bits = |x: &[T]| x.iter().map(|x| x.as_f64().to_bits()).collect::<Vec<_>>();
     for step in 0..=STEPS {
         if step > 0 {
             let p = t(&load(N, step, H));
@@ -91,20 +99,11 @@ fn same_histories<T: aemstep::Real, const N: usize>() {
                 dynamic.step(&mut d, &p).unwrap();
             }
         }
-        assert_eq!(
-            bits(s.u().as_slice()),
-            bits(d.u()),
-            "u, N = {N}, step {step}"
-        );
-        assert_eq!(
-            bits(s.v().as_slice()),
-            bits(d.v()),
-            "v, N = {N}, step {step}"
-        );
-        assert_eq!(
-            bits(s.a().as_slice()),
-            bits(d.a()),
-            "a, N = {N}, step {step}"
+        same_uva(
+            [s.u().as_slice(), s.v().as_slice(), s.a().as_slice()],
+            [d.u(), d.v(), d.a()],
+            N,
+            step,
         );
         assert_eq!(s.steps(), d.steps());
     }
@@ -448,7 +447,6 @@ mod building {
         let mut d = dyn_stepper
             .start(&dynamic, zero.as_slice(), zero.as_slice(), &p)
             .unwrap();
-        let bits = |x: &[T]| x.iter().map(|x| x.to_bits_u64()).collect::<Vec<_>>();
         let mut account = EnergyAccount::start(&fixed, &s, &history, &fixed.ground_load(ag(0)));
         let mut dyn_account = DynEnergyAccount::start(&dynamic, &d, &p);
         let energies = |e: [T; 6]| e.map(|x| x.as_f64());
@@ -476,20 +474,11 @@ mod building {
                     (a, b) => assert_eq!(a.err(), b.err(), "N = {N}, step {step}"),
                 }
             }
-            assert_eq!(
-                bits(s.u().as_slice()),
-                bits(d.u()),
-                "u, N = {N}, step {step}"
-            );
-            assert_eq!(
-                bits(s.v().as_slice()),
-                bits(d.v()),
-                "v, N = {N}, step {step}"
-            );
-            assert_eq!(
-                bits(s.a().as_slice()),
-                bits(d.a()),
-                "a, N = {N}, step {step}"
+            super::same_uva(
+                [s.u().as_slice(), s.v().as_slice(), s.a().as_slice()],
+                [d.u(), d.v(), d.a()],
+                N,
+                step,
             );
             assert_eq!(
                 history.as_slice(),
