@@ -625,7 +625,6 @@ pub(crate) const fn check_noise(
 
 /// The doubling's start without a cross covariance, `A₀ = Φᵀ`, `G₀ = sym(Hᵀ R⁻¹ H)`,
 /// `X₀ = sym(Q)` into `(a, g, x)`, with the LU of `R` from [`check_noise`] in `t.lu`.
-#[allow(clippy::too_many_arguments)]
 pub(crate) const fn plain_start(
     phi: &[f64],
     q: &[f64],
