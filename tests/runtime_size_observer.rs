@@ -643,3 +643,52 @@ fn run_time_kalman_gives_the_compiled_paths_errors() {
     );
     assert_eq!(before, (st.estimate().clone(), st.covariance_matrix()));
 }
+
+/// `DynSteadyState::new_with_stop` looks at its flag before every piece of the solve (more
+/// looks than doubling iterations), gives `new`'s gain bit for bit when the flag stays
+/// down, and `InvalidParameter(Cancelled)` when it is raised part-way, at any piece.
+#[test]
+fn the_gain_solve_answers_a_stop_flag_between_its_pieces() {
+    use aemstep::Param;
+    let n = 23;
+    let (m, c, k) = building(n);
+    let dss = DynStateSpace::aem(&m, &c, &k, &ground(&m), H).unwrap();
+    let dmeas = dss.absolute_accelerations(&[0, n - 1], 0).unwrap();
+    let forces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(n, n), H).unwrap();
+    let q = forces
+        .input_noise(&(DMatrix::identity(n, n) * (SIGMA_F * SIGMA_F)))
+        .unwrap();
+    let r = DMatrix::identity(2, 2) * (SIGMA_Y * SIGMA_Y);
+    let plain = DynSteadyState::new(&dss, &dmeas, &q, &r).unwrap();
+    let mut looks = 0u32;
+    let polled = DynSteadyState::new_with_stop(&dss, &dmeas, &q, &r, &mut || {
+        looks += 1;
+        false
+    })
+    .unwrap();
+    assert_eq!(bits(polled.gain()), bits(plain.gain()));
+    assert_eq!(
+        bits(polled.covariance_matrix().as_slice()),
+        bits(plain.covariance_matrix().as_slice())
+    );
+    // One look a doubling iteration, then at least a verification pass and its Stein
+    // squarings, then the end.
+    assert!(
+        looks > plain.iterations() + 2,
+        "{looks} looks, {} iterations",
+        plain.iterations()
+    );
+    for at in [1, 2, plain.iterations() + 1, looks] {
+        let mut seen = 0u32;
+        let stopped = DynSteadyState::new_with_stop(&dss, &dmeas, &q, &r, &mut || {
+            seen += 1;
+            seen >= at
+        });
+        assert_eq!(
+            stopped.err(),
+            Some(Error::InvalidParameter(Param::Cancelled)),
+            "stopped at look {at}"
+        );
+        assert_eq!(seen, at);
+    }
+}

@@ -21,6 +21,7 @@ CHUNK: int
 MAX_TRUNCATED_MODES: int
 #: Most sensors an observer takes.
 MAX_SENSORS: int
+MAX_OBSERVE_DOFS: int
 #: Rotation angles of RotD (180: 1° apart).
 ROTD_ANGLES: int
 #: Most states of a design model (``lqr``; with the delay, states + inputs).
@@ -223,9 +224,9 @@ def observe(
     ``steps×sensors``; NaN: missing) and the ground acceleration (m/s²): steady-state
     Kalman-gain observer or full Kalman filter; process noise sigma_f (N, white forces
     on every floor), sensor noise sigma_y (m/s²). Returns (u m, v m/s, gain
-    ``2n×sensors``, empty for the Kalman filter). Both take any n and any number of
-    sensors (outside SIZES or above MAX_SENSORS on the run-time-sized DynObserver /
-    DynKalman, same arithmetic)."""
+    ``2n×sensors``, empty for the Kalman filter). Both take any n up to
+    MAX_OBSERVE_DOFS and any number of sensors (outside SIZES or above MAX_SENSORS on the
+    run-time-sized DynObserver / DynKalman, same arithmetic)."""
 
 def zero_order_hold(m: F64, c: F64, k: F64, b: F64, h: float) -> Tuple[F64, F64]:
     """Exact sampled model of M u'' + C u' + K u = B f with f held over each step of h s

@@ -61,6 +61,14 @@ pub const MAX_TRUNCATED_MODES: usize = 3;
 /// outside [`SIZES`], run on the run-time-sized `DynObserver` / `DynKalman`).
 pub const MAX_SENSORS: usize = 3;
 
+/// The largest model `observe` takes (`n` DOFs, `2n` states). Its gain solve costs
+/// about `2400 n³` multiply-adds and looks at Ctrl-C between pieces of at most `80 n³`
+/// (a doubling iteration); its model and noise build (`O(n³)`) and a Kalman step
+/// (`O(n³)`) are not split. At `n = 200` each of those is a fraction of a second on the
+/// development machine (`python/tests/test_interrupt.py`); above, Ctrl-C would wait
+/// seconds and the gain minutes: reduce the model (e.g. to its lowest modes) first.
+pub const MAX_OBSERVE_DOFS: usize = 200;
+
 /// Rotation angles of RotD50/RotD100 (1° increments over 180°).
 pub const ROTD_ANGLES: usize = 180;
 
@@ -1654,7 +1662,10 @@ fn observe_any(job: &ObserveJob, n: usize, stop: &AtomicBool) -> Res<ObserveOut>
             .map_err(at(0))?;
         x.extend_from_slice(s.estimate().x());
         for i in 1..steps {
-            stopped(stop, i)?;
+            // A step is O(S³) here: the flag is looked at every step.
+            if stop.load(Ordering::Relaxed) {
+                return Err(Fail::Cancelled);
+            }
             filter
                 .try_step(&mut s, &[job.ag[i]], &job.y[i * o..(i + 1) * o])
                 .map_err(at(i))?;
@@ -1662,7 +1673,9 @@ fn observe_any(job: &ObserveJob, n: usize, stop: &AtomicBool) -> Res<ObserveOut>
         }
         return Ok((x, vec![]));
     }
-    let gain = DynSteadyState::new(&model, &meas, &q, &r)?;
+    // The gain solve looks at the stop flag before each piece (`10 S³` flops at most).
+    let gain =
+        DynSteadyState::new_with_stop(&model, &meas, &q, &r, &mut || stop.load(Ordering::Relaxed))?;
     let obs = DynObserver::<f64>::new(&model, &meas, &gain.gain_matrix())?;
     let mut x = buffer(steps, 2 * n)?;
     let mut e = obs.start_at_rest(&[job.ag[0]]).map_err(at(0))?;
@@ -1716,6 +1729,11 @@ fn observe<'py>(
 )> {
     let prepare = || -> Res<(ObserveJob, usize)> {
         let n = m.as_array().dim().0;
+        if n > MAX_OBSERVE_DOFS {
+            return shape(format!(
+                "observe takes models of at most MAX_OBSERVE_DOFS = {MAX_OBSERVE_DOFS} DOFs, got n = {n}: reduce the model (e.g. to its lowest modes) first"
+            ));
+        }
         // The estimate (2n a step) and its split into u and v, checked before allocating.
         let steps = ag.as_array().dim();
         fits("observe", &[(steps, 2 * n), (steps, n), (steps, n)])?;
@@ -1758,7 +1776,8 @@ fn observe<'py>(
     let (job, n) = prepare().map_err(|f| f.raise(py))?;
     let (x, gain) = interruptible(
         py,
-        work_units(job.ag.len(), n, 3),
+        // A step is up to `n³` units (the Kalman filter's), the gain solve about `2400 n³`.
+        work_units(job.ag.len().saturating_add(2400), n, 3),
         |stop| by_size!(n, observe_n(&job, stop) else observe_any(&job, n, stop)),
     )?;
     let steps = job.ag.len();
@@ -1790,6 +1809,7 @@ fn _aemstep(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SIZES", SIZES.to_vec())?;
     m.add("CHUNK", CHUNK)?;
     m.add("MAX_SENSORS", MAX_SENSORS)?;
+    m.add("MAX_OBSERVE_DOFS", MAX_OBSERVE_DOFS)?;
     m.add("MAX_TRUNCATED_MODES", MAX_TRUNCATED_MODES)?;
     m.add("ROTD_ANGLES", ROTD_ANGLES)?;
     m.add_function(wrap_pyfunction!(linear_response, m)?)?;

@@ -11,6 +11,8 @@ Riccati recursion iterated to convergence and the fixed-gain loop; the time-vary
 filter (Joseph form) — with a missing sample.
 """
 
+import time
+
 import numpy as np
 import pytest
 
@@ -157,3 +159,15 @@ def test_bad_noise_raises_the_compiled_paths_error_at_any_size():
             bad[20] = np.inf
             aemstep.observe(m, c, k, H, bad, y, [n - 1], sigma_f=SIGMA_F, sigma_y=SIGMA_Y)
         assert err.value.step == 20
+
+
+def test_a_model_above_the_observe_bound_raises_before_any_work():
+    # MAX_OBSERVE_DOFS + 1 storeys: refused at once (the gain solve would take minutes).
+    # (The bound itself is taken: test_interrupt.py runs and stops its gain solve.)
+    n = aemstep.MAX_OBSERVE_DOFS + 1
+    m, c, k = building(n)
+    ag, y = record(50, 1)
+    t = time.perf_counter()
+    with pytest.raises(aemstep.ShapeError, match="MAX_OBSERVE_DOFS"):
+        aemstep.observe(m, c, k, H, ag, y, [n - 1], sigma_f=SIGMA_F, sigma_y=SIGMA_Y)
+    assert time.perf_counter() - t < 0.5

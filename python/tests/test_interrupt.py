@@ -53,6 +53,19 @@ CALLS = {
         "ag = record(150_000); y = np.zeros((ag.size, 1))",
         "aemstep.observe(m, c, k, 0.01, ag, y, [n - 1], sigma_f=1.0, sigma_y=0.1, kalman=True)",
     ),
+    # The run-time-sized observer's gain solve (200 DOFs, 400 states: about 15 s alone),
+    # one library call that looks at the stop flag between its pieces.
+    "observe_gain_any_size": (
+        "n = 200; k = 2e3 * (2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)); "
+        "m = np.eye(n); c = 0.01 * k + 0.1 * m; ag = record(10); y = np.zeros((10, 1))",
+        "aemstep.observe(m, c, k, 0.01, ag, y, [n - 1], sigma_f=1.0, sigma_y=0.1)",
+    ),
+    # Its Kalman filter at 120 DOFs (a step of O(n³), about 15 ms): the flag every step.
+    "observe_kalman_any_size": (
+        "n = 120; k = 2e3 * (2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)); "
+        "m = np.eye(n); c = 0.01 * k + 0.1 * m; ag = record(2000); y = np.zeros((2000, 1))",
+        "aemstep.observe(m, c, k, 0.01, ag, y, [n - 1], sigma_f=1.0, sigma_y=0.1, kalman=True)",
+    ),
     "mr_building": (
         "ag = record(1_000_000)",
         "aemstep.mr_building(m, c, k, ag, 0.01, law='on')",

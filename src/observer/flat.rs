@@ -316,17 +316,30 @@ pub(crate) struct Scratch<'a> {
     pub(crate) lu: LuFlat<'a>,
 }
 
-/// [`stein`](super::riccati::stein) on flat slices: `x = A x Aᵀ + W` by doubling in
-/// balanced coordinates into `x`; `false` if `A` is not certified stable. Uses
-/// `m[0..3]` and `d` of `s`.
-pub(crate) const fn stein_flat(
+/// What one turn of an iterative solve did: go on, finished, or broke down.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Turn {
+    /// Not finished: take another turn.
+    Again,
+    /// Finished with a usable result.
+    Done,
+    /// Broke down (or, for Stein, the closed loop is not certified stable).
+    Failed,
+}
+
+/// Squarings of the Stein iteration at most ([`stein_flat`]).
+const STEIN_TURNS: u32 = 64;
+
+/// The start of [`stein_flat`]: `A` balanced into `m[0]` (`D` into `d`) and `W` in balanced
+/// coordinates into `x`.
+pub(crate) const fn stein_begin(
     a: &[f64],
     w: &[f64],
     n: usize,
     x: &mut [f64],
     s: &mut Scratch<'_>,
-) -> bool {
-    let [b, t1, t2, ..] = &mut s.m;
+) {
+    let [b, ..] = &mut s.m;
     let d = &mut *s.d;
     copy_flat(b, a);
     balance_flat(b, d, n);
@@ -339,37 +352,115 @@ pub(crate) const fn stein_flat(
         }
         i += 1;
     }
-    let mut k = 0;
-    while k < 64 {
-        let nrm = inf_norm_flat(b, n);
-        if !nrm.is_finite() || !all_finite_flat(x) {
-            return false;
-        }
-        if nrm <= A_SMALL {
-            let mut i = 0;
-            while i < n {
-                let mut j = 0;
-                while j < n {
-                    x[i * n + j] = x[i * n + j] * d[i] * d[j];
-                    j += 1;
-                }
-                i += 1;
+}
+
+/// One turn of [`stein_flat`] after [`stein_begin`]: `Done` (with `x` scaled back) once the
+/// balanced power `A_k` is small, `Failed` on a power or a sum that is not finite, else
+/// `x ← x + A_k x A_kᵀ`, `A_{k+1} = A_k²` and `Again`. Cost: `3 n³` multiply-adds.
+pub(crate) const fn stein_turn(n: usize, x: &mut [f64], s: &mut Scratch<'_>) -> Turn {
+    let [b, t1, t2, ..] = &mut s.m;
+    let d = &*s.d;
+    let nrm = inf_norm_flat(b, n);
+    if !nrm.is_finite() || !all_finite_flat(x) {
+        return Turn::Failed;
+    }
+    if nrm <= A_SMALL {
+        let mut i = 0;
+        while i < n {
+            let mut j = 0;
+            while j < n {
+                x[i * n + j] = x[i * n + j] * d[i] * d[j];
+                j += 1;
             }
-            return all_finite_flat(x);
+            i += 1;
         }
-        mul_into(t1, x, false, b, true, n, n, n);
-        mul_into(t2, b, false, t1, false, n, n, n);
-        add_scaled_flat(x, 1.0, t2);
-        mul_into(t1, b, false, b, false, n, n, n);
-        copy_flat(b, t1);
+        return if all_finite_flat(x) {
+            Turn::Done
+        } else {
+            Turn::Failed
+        };
+    }
+    mul_into(t1, x, false, b, true, n, n, n);
+    mul_into(t2, b, false, t1, false, n, n, n);
+    add_scaled_flat(x, 1.0, t2);
+    mul_into(t1, b, false, b, false, n, n, n);
+    copy_flat(b, t1);
+    Turn::Again
+}
+
+/// [`stein`](super::riccati::stein) on flat slices: `x = A x Aᵀ + W` by doubling in
+/// balanced coordinates into `x`; `false` if `A` is not certified stable. Uses
+/// `m[0..3]` and `d` of `s`.
+pub(crate) const fn stein_flat(
+    a: &[f64],
+    w: &[f64],
+    n: usize,
+    x: &mut [f64],
+    s: &mut Scratch<'_>,
+) -> bool {
+    stein_begin(a, w, n, x, s);
+    let mut k = 0;
+    while k < STEIN_TURNS {
+        match stein_turn(n, x, s) {
+            Turn::Again => {}
+            Turn::Done => return true,
+            Turn::Failed => return false,
+        }
         k += 1;
     }
     false
 }
 
-/// The doubling algorithm (see [`doubling_solution`](super::riccati::doubling_solution))
-/// in place on `(a, g, x)`: `Some((iterations, converged))`, `None` when `W` is singular
-/// or an iterate is not finite. Uses `m[0..5]` and the LU of `s`.
+/// One iteration of the doubling algorithm (see
+/// [`doubling_solution`](super::riccati::doubling_solution)) in place on `(a, g, x)`:
+/// `Failed` when `W` is singular or an iterate is not finite, `Done` once converged,
+/// else `Again`. Uses `m[0..5]` and the LU of `s`. Cost: about `10 n³` flops.
+pub(crate) const fn doubling_turn(
+    a: &mut [f64],
+    g: &mut [f64],
+    x: &mut [f64],
+    n: usize,
+    s: &mut Scratch<'_>,
+) -> Turn {
+    let [w, wa, wg, t1, t2, ..] = &mut s.m;
+    mul_into(t1, g, false, x, false, n, n, n);
+    identity_into(w, n);
+    add_scaled_flat(w, 1.0, t1);
+    if !s.lu.factor_of(w, n) {
+        return Turn::Failed;
+    }
+    s.lu.solve(a, n, wa);
+    s.lu.solve(g, n, wg);
+    // X₁ = sym(X + Aᵀ (X W⁻¹A)) into w.
+    mul_into(t1, x, false, wa, false, n, n, n);
+    mul_into(t2, a, true, t1, false, n, n, n);
+    copy_flat(w, x);
+    add_scaled_flat(w, 1.0, t2);
+    symmetrize_flat(w, n);
+    // G₁ = sym(G + A (W⁻¹G Aᵀ)) in place.
+    mul_into(t1, wg, false, a, true, n, n, n);
+    mul_into(t2, a, false, t1, false, n, n, n);
+    add_scaled_flat(g, 1.0, t2);
+    symmetrize_flat(g, n);
+    // A₁ = A W⁻¹A into t1.
+    mul_into(t1, a, false, wa, false, n, n, n);
+    if !(all_finite_flat(w) && all_finite_flat(g) && all_finite_flat(t1)) {
+        return Turn::Failed;
+    }
+    copy_flat(t2, w);
+    add_scaled_flat(t2, -1.0, x);
+    let diff = max_abs_flat(t2);
+    copy_flat(x, w);
+    copy_flat(a, t1);
+    if diff <= 4.0 * f64::EPSILON * max_abs_flat(x) && inf_norm_flat(a, n) <= A_SMALL {
+        Turn::Done
+    } else {
+        Turn::Again
+    }
+}
+
+/// The doubling algorithm in place on `(a, g, x)`, at most `max` iterations of
+/// [`doubling_turn`]: `Some((iterations, converged))`, `None` when it breaks down.
 pub(crate) const fn doubling_flat(
     a: &mut [f64],
     g: &mut [f64],
@@ -378,44 +469,38 @@ pub(crate) const fn doubling_flat(
     max: u32,
     s: &mut Scratch<'_>,
 ) -> Option<(u32, bool)> {
-    let [w, wa, wg, t1, t2, ..] = &mut s.m;
     let mut k = 0;
     while k < max {
         k += 1;
-        mul_into(t1, g, false, x, false, n, n, n);
-        identity_into(w, n);
-        add_scaled_flat(w, 1.0, t1);
-        if !s.lu.factor_of(w, n) {
-            return None;
-        }
-        s.lu.solve(a, n, wa);
-        s.lu.solve(g, n, wg);
-        // X₁ = sym(X + Aᵀ (X W⁻¹A)) into w.
-        mul_into(t1, x, false, wa, false, n, n, n);
-        mul_into(t2, a, true, t1, false, n, n, n);
-        copy_flat(w, x);
-        add_scaled_flat(w, 1.0, t2);
-        symmetrize_flat(w, n);
-        // G₁ = sym(G + A (W⁻¹G Aᵀ)) in place.
-        mul_into(t1, wg, false, a, true, n, n, n);
-        mul_into(t2, a, false, t1, false, n, n, n);
-        add_scaled_flat(g, 1.0, t2);
-        symmetrize_flat(g, n);
-        // A₁ = A W⁻¹A into t1.
-        mul_into(t1, a, false, wa, false, n, n, n);
-        if !(all_finite_flat(w) && all_finite_flat(g) && all_finite_flat(t1)) {
-            return None;
-        }
-        copy_flat(t2, w);
-        add_scaled_flat(t2, -1.0, x);
-        let diff = max_abs_flat(t2);
-        copy_flat(x, w);
-        copy_flat(a, t1);
-        if diff <= 4.0 * f64::EPSILON * max_abs_flat(x) && inf_norm_flat(a, n) <= A_SMALL {
-            return Some((k, true));
+        match doubling_turn(a, g, x, n, s) {
+            Turn::Again => {}
+            Turn::Done => return Some((k, true)),
+            Turn::Failed => return None,
         }
     }
     Some((k, false))
+}
+
+/// The end of the doubling: `false` unless it `converged` to a covariance `x`; then `x`
+/// plus `sym(q_cross)` when given (the a-priori covariance). Uses `m[0..3]` of `s`.
+const fn doubling_finish(
+    x: &mut [f64],
+    n: usize,
+    converged: bool,
+    q_cross: Option<&[f64]>,
+    s: &mut Scratch<'_>,
+) -> bool {
+    let [b, l, t, ..] = &mut s.m;
+    if !(converged && is_covariance_flat(x, n, b, l)) {
+        return false;
+    }
+    if let Some(q) = q_cross {
+        copy_flat(t, q);
+        symmetrize_flat(t, n);
+        add_scaled_flat(x, 1.0, t);
+        symmetrize_flat(x, n);
+    }
+    true
 }
 
 /// [`doubling_solution`](super::riccati::doubling_solution) on flat slices: the
@@ -429,21 +514,10 @@ pub(crate) const fn doubling_solution_flat(
     s: &mut Scratch<'_>,
 ) -> Option<u32> {
     let [a, g, x] = start;
-    let (k, converged) = match doubling_flat(a, g, x, n, max, s) {
-        Some(v) => v,
-        None => return None,
-    };
-    let [b, l, t, ..] = &mut s.m;
-    if !(converged && is_covariance_flat(x, n, b, l)) {
-        return None;
+    match doubling_flat(a, g, x, n, max, s) {
+        Some((k, converged)) if doubling_finish(x, n, converged, q_cross, s) => Some(k),
+        _ => None,
     }
-    if let Some(q) = q_cross {
-        copy_flat(t, q);
-        symmetrize_flat(t, n);
-        add_scaled_flat(x, 1.0, t);
-        symmetrize_flat(x, n);
-    }
-    Some(k)
 }
 
 /// The measurement side of the Riccati solve: `H` (`o×n`), `R` (`o×o`) and the cross
@@ -643,81 +717,184 @@ pub(crate) const fn plain_start(
     symmetrize_flat(x, n);
 }
 
-/// The solution `(P, L)` of the steady-state Kalman filter, written into `cov` and `gain`
-/// (`n×n`, `n×o`), from the doubling's start in `(a, g, x)`: the doubling solution, then
-/// the verification and up to three Newton (Hewer) refinements of
+/// Where a Riccati solve ([`RiccatiRun`]) stands.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    /// Doubling iterations.
+    Doubling,
+    /// The start of a verification/refinement pass: the gain, the residual, the Stein start.
+    Refine,
+    /// Squarings of the pass's Stein equation.
+    Stein,
+    /// Done: the best iterate is the answer.
+    Finished,
+}
+
+/// The buffers of a Riccati solve from its doubling start ([`RiccatiRun::advance`]).
+pub(crate) struct RiccatiParts<'a, 'b> {
+    /// `Φ` (`n×n`).
+    pub(crate) phi: &'a [f64],
+    /// `Q` (`n×n`).
+    pub(crate) q: &'a [f64],
+    /// States `n`.
+    pub(crate) n: usize,
+    /// The measurement side.
+    pub(crate) sn: &'a Sensors<'a>,
+    /// Whether the start is the cross-covariance one (the solution is then `Y + Q`).
+    pub(crate) q_cross: bool,
+    /// The doubling's start `(A, G, X)`; `A` then holds the closed loop, `X` the iterate `P`.
+    pub(crate) start: [&'b mut [f64]; 3],
+    /// `(P, L)`: the answer (`n×n`, `n×o`).
+    pub(crate) out: (&'b mut [f64], &'b mut [f64]),
+    /// The residual, its size, the Newton correction (`n×n`) and the best gain (`n×o`).
+    pub(crate) work: [&'b mut [f64]; 4],
+    /// `n×n` scratch.
+    pub(crate) s: &'b mut Scratch<'b>,
+    /// Output-side scratch.
+    pub(crate) t: &'b mut OutScratch<'b>,
+}
+
+/// The solution `(P, L)` of the steady-state Kalman filter, one bounded piece of work at a
+/// time ([`advance`](Self::advance)), so a caller can look at a stop flag between pieces
+/// (the run-time-sized [`DynSteadyState`](super::DynSteadyState) from Python: Ctrl-C) while
+/// the const path ([`solve_from_start`]) runs it through: the same pieces in the same order.
+///
+/// From the doubling's start in `(a, g, x)`: the doubling solution, then the verification
+/// and up to three Newton (Hewer) refinements of
 /// [`SteadyState::from_parts`](super::SteadyState::from_parts), keeping the best iterate.
-/// Returns the doubling iterations. Errors: [`Error::RiccatiNotConverged`],
-/// [`Error::OperatorOverflow`].
-#[allow(clippy::too_many_arguments)]
-pub(crate) const fn solve_from_start(
-    phi: &[f64],
-    q: &[f64],
-    n: usize,
-    sn: &Sensors<'_>,
-    q_cross: bool,
-    start: [&mut [f64]; 3],
-    out: (&mut [f64], &mut [f64]),
-    work: [&mut [f64]; 4],
-    s: &mut Scratch<'_>,
-    t: &mut OutScratch<'_>,
-) -> Result<u32, Error> {
-    let [a, g, p] = start;
-    let (cov, gain) = out;
-    let [res, bound, delta, best_gain] = work;
-    let qc = if q_cross { Some(q) } else { None };
-    let k = match doubling_solution_flat(
-        [&mut *a, &mut *g, &mut *p],
-        n,
-        RICCATI_MAX_ITERATIONS,
-        qc,
-        s,
-    ) {
-        Some(k) => k,
-        None => return Err(Error::RiccatiNotConverged),
-    };
-    // `a` and `g` are free from here: `a` holds the closed loop.
-    let acl = a;
-    let (mut has_best, mut best_units) = (false, f64::INFINITY);
-    let mut step = 0;
-    while step <= RICCATI_REFINEMENTS {
-        if !gain_of_flat(p, n, sn, gain, t) {
-            break;
+pub(crate) struct RiccatiRun {
+    stage: Stage,
+    /// Doubling iterations taken.
+    iterations: u32,
+    /// The refinement pass.
+    step: u32,
+    /// Stein squarings taken in this pass.
+    turns: u32,
+    /// This pass's residual, in units.
+    units: f64,
+    has_best: bool,
+    best_units: f64,
+}
+
+impl RiccatiRun {
+    /// A solve at its start.
+    pub(crate) const fn new() -> Self {
+        Self {
+            stage: Stage::Doubling,
+            iterations: 0,
+            step: 0,
+            turns: 0,
+            units: f64::INFINITY,
+            has_best: false,
+            best_units: f64::INFINITY,
         }
-        if !all_finite_flat(gain) {
-            if !has_best && step == 0 {
-                return Err(Error::OperatorOverflow);
-            }
-            break;
-        }
-        joseph_residual_flat(phi, q, p, gain, n, sn, [res, bound, acl], s, t);
-        let units = residual_units_flat(res, bound, n);
-        if !stein_flat(acl, res, n, delta, s) {
-            break;
-        }
-        let better = if has_best {
-            units < best_units
-        } else {
-            units <= f64::INFINITY
-        };
-        let [b, l, ..] = &mut s.m;
-        if better && is_covariance_flat(p, n, b, l) {
-            copy_flat(cov, p);
-            copy_flat(best_gain, gain);
-            best_units = units;
-            has_best = true;
-        }
-        if units <= RICCATI_RESIDUAL_REFINE {
-            break;
-        }
-        add_scaled_flat(p, 1.0, delta);
-        symmetrize_flat(p, n);
-        step += 1;
     }
-    if has_best && best_units <= RICCATI_RESIDUAL_UNITS {
-        copy_flat(gain, best_gain);
-        Ok(k)
-    } else {
-        Err(Error::RiccatiNotConverged)
+
+    /// One piece of the solve: a doubling iteration (`10 n³` flops), the start of a
+    /// verification pass (the gain and the residual, about `4 n³`), or a Stein squaring
+    /// (`3 n³`). `None` while there is more to do; then `Some` of the doubling iterations,
+    /// or [`Error::RiccatiNotConverged`] / [`Error::OperatorOverflow`], with `(P, L)` in
+    /// `out`. Call it with the same buffers every time.
+    pub(crate) const fn advance(
+        &mut self,
+        b: &mut RiccatiParts<'_, '_>,
+    ) -> Option<Result<u32, Error>> {
+        let n = b.n;
+        let [a, g, p] = &mut b.start;
+        let (cov, gain) = &mut b.out;
+        let [res, bound, delta, best_gain] = &mut b.work;
+        match self.stage {
+            Stage::Doubling => {
+                let mut converged = false;
+                if self.iterations < RICCATI_MAX_ITERATIONS {
+                    self.iterations += 1;
+                    match doubling_turn(a, g, p, n, b.s) {
+                        Turn::Again => return None,
+                        Turn::Failed => return Some(Err(Error::RiccatiNotConverged)),
+                        Turn::Done => converged = true,
+                    }
+                }
+                let qc = if b.q_cross { Some(b.q) } else { None };
+                if !doubling_finish(p, n, converged, qc, b.s) {
+                    return Some(Err(Error::RiccatiNotConverged));
+                }
+                // `a` and `g` are free from here: `a` holds the closed loop.
+                self.stage = Stage::Refine;
+            }
+            Stage::Refine => {
+                if self.step > RICCATI_REFINEMENTS || !gain_of_flat(p, n, b.sn, gain, b.t) {
+                    self.stage = Stage::Finished;
+                } else if !all_finite_flat(gain) {
+                    if !self.has_best && self.step == 0 {
+                        return Some(Err(Error::OperatorOverflow));
+                    }
+                    self.stage = Stage::Finished;
+                } else {
+                    joseph_residual_flat(b.phi, b.q, p, gain, n, b.sn, [res, bound, a], b.s, b.t);
+                    self.units = residual_units_flat(res, bound, n);
+                    stein_begin(a, res, n, delta, b.s);
+                    self.turns = 0;
+                    self.stage = Stage::Stein;
+                }
+            }
+            Stage::Stein => {
+                if self.turns >= STEIN_TURNS {
+                    self.stage = Stage::Finished;
+                    return None;
+                }
+                self.turns += 1;
+                match stein_turn(n, delta, b.s) {
+                    Turn::Again => return None,
+                    Turn::Failed => {
+                        self.stage = Stage::Finished;
+                        return None;
+                    }
+                    Turn::Done => {}
+                }
+                let better = if self.has_best {
+                    self.units < self.best_units
+                } else {
+                    self.units <= f64::INFINITY
+                };
+                let [m0, m1, ..] = &mut b.s.m;
+                if better && is_covariance_flat(p, n, m0, m1) {
+                    copy_flat(cov, p);
+                    copy_flat(best_gain, gain);
+                    self.best_units = self.units;
+                    self.has_best = true;
+                }
+                if self.units <= RICCATI_RESIDUAL_REFINE {
+                    self.stage = Stage::Finished;
+                } else {
+                    add_scaled_flat(p, 1.0, delta);
+                    symmetrize_flat(p, n);
+                    self.step += 1;
+                    self.stage = Stage::Refine;
+                }
+            }
+            Stage::Finished => {
+                return Some(
+                    if self.has_best && self.best_units <= RICCATI_RESIDUAL_UNITS {
+                        copy_flat(gain, best_gain);
+                        Ok(self.iterations)
+                    } else {
+                        Err(Error::RiccatiNotConverged)
+                    },
+                );
+            }
+        }
+        None
+    }
+}
+
+/// The solution `(P, L)` of the steady-state Kalman filter ([`RiccatiRun`] run through),
+/// written into `cov` and `gain` (`n×n`, `n×o`). Returns the doubling iterations. Errors:
+/// [`Error::RiccatiNotConverged`], [`Error::OperatorOverflow`].
+pub(crate) const fn solve_from_start(b: &mut RiccatiParts<'_, '_>) -> Result<u32, Error> {
+    let mut run = RiccatiRun::new();
+    loop {
+        if let Some(r) = run.advance(b) {
+            return r;
+        }
     }
 }

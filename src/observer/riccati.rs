@@ -25,7 +25,7 @@
 use nalgebra::SMatrix;
 
 use super::flat::{
-    LuFlat, OutScratch, Scratch, Sensors, abs_into, balance_flat, check_noise,
+    LuFlat, OutScratch, RiccatiParts, Scratch, Sensors, abs_into, balance_flat, check_noise,
     doubling_solution_flat, inf_norm_flat, plain_start, solve_from_start, stein_flat,
 };
 use super::kalman_core::{
@@ -401,27 +401,27 @@ impl<const S: usize, const O: usize> SteadyState<S, O> {
         let (mut covariance, mut gain) = ([[0.0; S]; S], [[0.0; O]; S]);
         let (mut res, mut bound, mut delta, mut best) =
             ([[0.0; S]; S], [[0.0; S]; S], [[0.0; S]; S], [[0.0; O]; S]);
-        match solve_from_start(
-            model.phi.as_flattened(),
-            q.as_flattened(),
-            S,
-            &sn,
-            n.is_some(),
-            [
+        match solve_from_start(&mut RiccatiParts {
+            phi: model.phi.as_flattened(),
+            q: q.as_flattened(),
+            n: S,
+            sn: &sn,
+            q_cross: n.is_some(),
+            start: [
                 a.as_flattened_mut(),
                 g.as_flattened_mut(),
                 x.as_flattened_mut(),
             ],
-            (covariance.as_flattened_mut(), gain.as_flattened_mut()),
-            [
+            out: (covariance.as_flattened_mut(), gain.as_flattened_mut()),
+            work: [
                 res.as_flattened_mut(),
                 bound.as_flattened_mut(),
                 delta.as_flattened_mut(),
                 best.as_flattened_mut(),
             ],
-            &mut s,
-            &mut t,
-        ) {
+            s: &mut s,
+            t: &mut t,
+        }) {
             Ok(k) => Ok(Self {
                 covariance,
                 gain,
