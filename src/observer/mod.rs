@@ -23,7 +23,9 @@
 //! - `DynStateSpace`, `DynSteadyState`, `DynObserver` (feature `std`): the AEM model, its
 //!   steady-state gain and the fixed-gain observer at sizes chosen at run time, on the same
 //!   flat-slice build and step rows as the const-generic types (bit-identical where both
-//!   serve; `tests/runtime_size_observer.rs`).
+//!   serve; `tests/runtime_size_observer.rs`). Their gain solve costs `O(S³)` a piece;
+//!   `DynSteadyState::new_with_stop` looks at a stop flag between pieces (Ctrl-C, a time
+//!   budget).
 //!
 //! Sizes are const generics: `N` degrees of freedom, `S` states (`S = 2N`, `3N` for
 //! generalized-α, or `2R` modal —
