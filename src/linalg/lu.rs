@@ -154,15 +154,19 @@ pub(crate) const fn factor(lu: &mut [f64], n: usize, s: &mut [f64], perm: &mut [
 /// and `x` row-major `n×c`: forward and back substitution, column by column. The one
 /// solve behind [`Lu::solve`] and the run-time-sized build. Cost: `n²·c` multiply-adds.
 pub(crate) const fn solve_flat(lu: &[f64], perm: &[usize], b: &[f64], c: usize, x: &mut [f64]) {
-    let n = perm.len();
+    // (`lu.len()` read once: in the compiler's evaluator each call is a step.)
+    let (n, lu_len) = (perm.len(), lu.len());
     let mut col = 0;
     while col < c {
         // L y = P b (row offsets and column strides hoisted, see `factor`)
         let mut i = 0;
         while i < n {
             let mut s = b[perm[i] * c + col];
-            // s −= lu[i][k]·x[k][col] for k < i, by running flat indices.
+            // s −= lu[i][k]·x[k][col] for k < i, by running flat indices (`end` checked
+            // once: the loop's `lu[l]` needs no bounds check, a traced call in the fuzz
+            // build).
             let (mut l, end, mut xk) = (i * n, i * n + i, col);
+            assert!(end <= lu_len);
             while l < end {
                 s -= lu[l] * x[xk];
                 xk += c;
@@ -179,6 +183,7 @@ pub(crate) const fn solve_flat(lu: &[f64], perm: &[usize], b: &[f64], c: usize, 
             let mut s = x[i * c + col];
             // s −= lu[i][k]·x[k][col] for k > i, by running flat indices.
             let (mut l, end, mut xk) = (li + i + 1, li + n, (i + 1) * c + col);
+            assert!(end <= lu_len);
             while l < end {
                 s -= lu[l] * x[xk];
                 xk += c;
