@@ -394,7 +394,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         };
         let tol = settings.tolerance;
         let masses = building.masses();
-        let zero_off = [[T::zero(); L]; N];
+        let m_coefficients: [T; N] = core::array::from_fn(|i| masses[i]);
         let m_diag: [[T; L]; N] = lanes_of(masses);
         // A lane still iterating.
         let mut running = active;
@@ -442,7 +442,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                 }
             }
             Self::trial(building, band, history, &mut w);
-            band_mul_diagonal(&m_diag, &zero_off, &w.q, &mut mq);
+            band_mul_coefficients(&m_coefficients, &[T::zero(); N], &w.q, &mut mq);
             // Whole-batch tests first: a lane's own test only when one fails (rare).
             if !all_finite(&w.force, 0) {
                 let f_finite = finite(&w.force, 0);
@@ -765,7 +765,8 @@ fn factor<T: Real, const N: usize, const L: usize>(
             } else {
                 d[i][l] - li * e[i][l]
             };
-            accepted[l] &= di > tiny[l] && di.is_finite();
+            // `di − di == 0`: `di` finite (see `all_finite`).
+            accepted[l] &= di > tiny[l] && di - di == T::zero();
             prev[l] = T::one() / di;
             f.multiplier[i][l] = li;
             f.inverse[i][l] = prev[l];
@@ -800,15 +801,18 @@ fn substitute<T: Real, const N: usize, const L: usize>(
 }
 
 /// Every entry from DOF `from` on, in every lane, finite: one test of the whole batch.
+/// `x − x` is `+0` exactly for a finite `x` and NaN otherwise, so the lanes' sums of it are
+/// all zero exactly when every entry is finite: packed subtractions and additions and one
+/// compare (`is_finite` is an integer compare, which AVX packs only 2 wide).
 #[inline(always)]
 fn all_finite<T: Real, const N: usize, const L: usize>(x: &[[T; L]; N], from: usize) -> bool {
-    let mut ok = true;
+    let mut sum = [T::zero(); L];
     for row in x.iter().skip(from) {
-        for v in row {
-            ok &= v.is_finite();
+        for l in 0..L {
+            sum[l] += row[l] - row[l];
         }
     }
-    ok
+    sum.iter().all(|&s| s == T::zero())
 }
 
 /// Each lane's entries from DOF `from` on are all finite.
@@ -836,15 +840,21 @@ fn band_mul<T: Real, const N: usize, const L: usize>(
     x: &[[T; L]; N],
     y: &mut [[T; L]; N],
 ) {
-    band_mul_diagonal(&lanes_of(&a.diagonal), &lanes_of(&a.off), x, y);
+    band_mul_coefficients(
+        &core::array::from_fn(|i| a.diagonal[i]),
+        &core::array::from_fn(|i| a.off[i]),
+        x,
+        y,
+    );
 }
 
-/// `y = A x` in every lane, `A` symmetric tridiagonal with diagonal `d[i][lane]` and
-/// off-diagonal `e[i][lane]`, each row summed in column order as [`SymTridiagonal::mul`].
+/// `y = A x` in every lane, `A` symmetric tridiagonal with diagonal `d[i]` and
+/// off-diagonal `e[i]` (the same in every lane), each row summed in column order as
+/// [`SymTridiagonal::mul`].
 #[inline(always)]
-fn band_mul_diagonal<T: Real, const N: usize, const L: usize>(
-    d: &[[T; L]; N],
-    e: &[[T; L]; N],
+fn band_mul_coefficients<T: Real, const N: usize, const L: usize>(
+    d: &[T; N],
+    e: &[T; N],
     x: &[[T; L]; N],
     y: &mut [[T; L]; N],
 ) {
@@ -852,11 +862,11 @@ fn band_mul_diagonal<T: Real, const N: usize, const L: usize>(
         for l in 0..L {
             let mut s = T::zero();
             if i > 0 {
-                s = e[i][l] * x[i - 1][l];
+                s = e[i] * x[i - 1][l];
             }
-            s += d[i][l] * x[i][l];
+            s += d[i] * x[i][l];
             if i + 1 < N {
-                s += e[i + 1][l] * x[i + 1][l];
+                s += e[i + 1] * x[i + 1][l];
             }
             y[i][l] = s;
         }

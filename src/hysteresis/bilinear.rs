@@ -188,10 +188,13 @@ impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
     ) -> crate::lanes::LaneTrial<T, BilinearHistory<T>, L> {
         let two = T::one() + T::one();
         let half = T::one() / two;
+        // The stiffnesses read once (a select between two fields read per lane became
+        // a select of their addresses and eight scalar loads).
+        let (k, kt) = (self.k, self.kt);
         // One operation over all lanes at a time (the compiler packs such loops; one loop
         // of the whole trial a lane was left scalar, with jumps).
         let dp_h: [T; L] = core::array::from_fn(|l| committed[l].plastic * half);
-        let f_h: [T; L] = core::array::from_fn(|l| self.k * (d[l] * half - dp_h[l]));
+        let f_h: [T; L] = core::array::from_fn(|l| k * (d[l] * half - dp_h[l]));
         let xi_h: [T; L] = core::array::from_fn(|l| f_h[l] - self.hard * dp_h[l]);
         let excess_h: [T; L] = core::array::from_fn(|l| xi_h[l].abs() - self.fy * half);
         let s: [T; L] = core::array::from_fn(|l| {
@@ -208,7 +211,7 @@ impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
         let plastic: [bool; L] = core::array::from_fn(|l| excess_h[l] > T::zero());
         crate::lanes::LaneTrial {
             force: core::array::from_fn(|l| if plastic[l] { f_p[l] } else { f_h[l] * two }),
-            stiffness: core::array::from_fn(|l| if plastic[l] { self.kt } else { self.k }),
+            stiffness: core::array::from_fn(|l| if plastic[l] { kt } else { k }),
             damping: [T::zero(); L],
             history: core::array::from_fn(|l| BilinearHistory {
                 plastic: if plastic[l] {
