@@ -766,7 +766,7 @@ fn factor<T: Real, const N: usize, const L: usize>(
                 d[i][l] - li * e[i][l]
             };
             // `di − di == 0`: `di` finite (see `all_finite`).
-            accepted[l] &= di > tiny[l] && di - di == T::zero();
+            accepted[l] &= di > tiny[l] && finite_zero(di) == T::zero();
             prev[l] = T::one() / di;
             f.multiplier[i][l] = li;
             f.inverse[i][l] = prev[l];
@@ -800,6 +800,14 @@ fn substitute<T: Real, const N: usize, const L: usize>(
     }
 }
 
+/// `x − x`: `+0` exactly for a finite `x`, NaN for an infinite or NaN one (a packed
+/// subtraction, where `is_finite` is an integer compare that AVX packs only 2 wide).
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x − x` is the test, not a mistake
+fn finite_zero<T: Real>(x: T) -> T {
+    x - x
+}
+
 /// Every entry from DOF `from` on, in every lane, finite: one test of the whole batch.
 /// `x − x` is `+0` exactly for a finite `x` and NaN otherwise, so the lanes' sums of it are
 /// all zero exactly when every entry is finite: packed subtractions and additions and one
@@ -809,7 +817,7 @@ fn all_finite<T: Real, const N: usize, const L: usize>(x: &[[T; L]; N], from: us
     let mut sum = [T::zero(); L];
     for row in x.iter().skip(from) {
         for l in 0..L {
-            sum[l] += row[l] - row[l];
+            sum[l] += finite_zero(row[l]);
         }
     }
     sum.iter().all(|&s| s == T::zero())
