@@ -357,9 +357,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
             let s = laws[i].trial_lanes(&history[i], &d, &r);
             for l in 0..L {
                 w.force[i][l] += s.force[l];
-                if s.inelastic[l] {
-                    w.branch[l] |= 1 << (i % 64);
-                }
+                w.branch[l] |= u64::from(s.inelastic[l]) << (i % 64);
                 w.k_diag[i][l] += s.stiffness[l];
                 w.c_diag[i][l] += s.damping[l];
             }
@@ -396,16 +394,18 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         };
         let tol = settings.tolerance;
         let masses = building.masses();
-        let zero_off = [[T::zero(); L]; N];
+        let m_coefficients: [T; N] = core::array::from_fn(|i| masses[i]);
         let m_diag: [[T; L]; N] = lanes_of(masses);
         // A lane still iterating.
         let mut running = active;
         let p_size = norm_inf(p);
-        let p_finite = finite(p, 0);
-        for (l, run) in running.iter_mut().enumerate() {
-            if *run && !p_finite[l] {
-                out[l] = Some(Err(Error::NonFiniteInput));
-                *run = false;
+        if !all_finite(p, 0) {
+            let p_finite = finite(p, 0);
+            for (l, run) in running.iter_mut().enumerate() {
+                if *run && !p_finite[l] {
+                    out[l] = Some(Err(Error::NonFiniteInput));
+                    *run = false;
+                }
             }
         }
         let mut w = Work {
@@ -442,18 +442,23 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                 }
             }
             Self::trial(building, band, history, &mut w);
-            band_mul_diagonal(&m_diag, &zero_off, &w.q, &mut mq);
-            let f_finite = finite(&w.force, 0);
-            for l in 0..L {
-                if running[l] && !f_finite[l] {
-                    out[l] = Some(Err(Error::NonFiniteForce));
-                    running[l] = false;
+            band_mul_coefficients(&m_coefficients, &[T::zero(); N], &w.q, &mut mq);
+            // Whole-batch tests first: a lane's own test only when one fails (rare).
+            if !all_finite(&w.force, 0) {
+                let f_finite = finite(&w.force, 0);
+                for l in 0..L {
+                    if running[l] && !f_finite[l] {
+                        out[l] = Some(Err(Error::NonFiniteForce));
+                        running[l] = false;
+                    }
                 }
-                if iterations > 0 && w.branch[l] != last_branch[l] {
-                    branch_changes[l] += 1;
-                }
-                last_branch[l] = w.branch[l];
             }
+            if iterations > 0 {
+                for l in 0..L {
+                    branch_changes[l] += u32::from(w.branch[l] != last_branch[l]);
+                }
+            }
+            last_branch = w.branch;
             for i in 0..N {
                 for l in 0..L {
                     r[i][l] = mq[i][l] + w.force[i][l] - p[i][l];
@@ -464,30 +469,44 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                 [T::zero(); L]
             } else {
                 let (nq, nu, nv) = (norm_inf(&w.q), norm_inf(&w.u), norm_inf(&w.v));
+                // Every branch computed in every lane, then selected (no per-lane jumps).
                 core::array::from_fn(|l| {
                     let reference = nq[l].max(nu[l] / c).max(nv[l] / b);
-                    if last_delta[l] <= T::zero() {
-                        T::zero()
-                    } else if reference > T::zero() {
-                        last_delta[l] / reference
+                    let ratio = last_delta[l] / reference;
+                    let moved = if reference > T::zero() {
+                        ratio
                     } else {
                         T::one()
+                    };
+                    if last_delta[l] <= T::zero() {
+                        T::zero()
+                    } else {
+                        moved
                     }
                 })
             };
             // The lanes that finish here: their outcome as the single step's, and those
             // that converged to a finite state committed together (masked copies).
-            let state_finite = {
-                let (fu, fv, fq) = (finite(&w.u, 0), finite(&w.v, 0), finite(&w.q, 0));
-                core::array::from_fn::<bool, L, _>(|l| fu[l] && fv[l] && fq[l])
-            };
-            let mut commit = [false; L];
-            for l in 0..L {
-                if !running[l] {
-                    continue;
-                }
-                let converged = residual[l] <= tol || (iterations > 0 && correction[l] <= tol);
-                if iterations >= budget || (!fixed && converged) {
+            let over = iterations >= budget;
+            let converged: [bool; L] = core::array::from_fn(|l| {
+                residual[l] <= tol || (iterations > 0 && correction[l] <= tol)
+            });
+            let finishing: [bool; L] =
+                core::array::from_fn(|l| running[l] & (over | (!fixed & converged[l])));
+            if finishing.iter().any(|&x| x) {
+                let state_finite: [bool; L] =
+                    if all_finite(&w.u, 0) && all_finite(&w.v, 0) && all_finite(&w.q, 0) {
+                        [true; L]
+                    } else {
+                        let (fu, fv, fq) = (finite(&w.u, 0), finite(&w.v, 0), finite(&w.q, 0));
+                        core::array::from_fn(|l| fu[l] && fv[l] && fq[l])
+                    };
+                let mut commit = [false; L];
+                for l in 0..L {
+                    if !finishing[l] {
+                        continue;
+                    }
+                    let converged = converged[l];
                     running[l] = false;
                     out[l] = Some(if !state_finite[l] {
                         Err(Error::NonFiniteState)
@@ -504,21 +523,20 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                         })
                     });
                 }
-            }
-            if commit.iter().any(|&x| x) {
-                Self::commit(state, history, &w, &commit);
+                if commit.iter().any(|&x| x) {
+                    Self::commit(state, history, &w, &commit);
+                }
             }
             if !running.iter().any(|&x| x) {
                 break;
             }
             let mut delta = r;
-            for (l, failed) in solve(&w, &m_diag, b, c, &running, &mut delta)
-                .iter()
-                .enumerate()
-            {
-                if let (true, Some(e)) = (running[l], failed) {
-                    out[l] = Some(Err(*e));
-                    running[l] = false;
+            if let Some(failed) = solve(&w, &m_diag, b, c, &running, &mut delta) {
+                for (l, failed) in failed.iter().enumerate() {
+                    if let (true, Some(e)) = (running[l], failed) {
+                        out[l] = Some(Err(*e));
+                        running[l] = false;
+                    }
                 }
             }
             for i in 0..N {
@@ -541,6 +559,17 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         w: &Work<T, H, N, L>,
         commit: &[bool; L],
     ) {
+        if commit.iter().all(|&x| x) {
+            // Every lane: plain copies (the usual case, every lane converging together).
+            state.u = w.u;
+            state.v = w.v;
+            state.a = w.q;
+            *history = w.history;
+            for n in state.n.iter_mut() {
+                *n = n.wrapping_add(1);
+            }
+            return;
+        }
         for i in 0..N {
             for l in 0..L {
                 let c = commit[l];
@@ -628,8 +657,10 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
 
 /// The Newton correction `r ← J⁻¹ r` of every lane, `J = M + b ∂F/∂v + c ∂F/∂u` on the
 /// bands of the last trial, as the single step forms and solves it: `L D Lᵀ`, and pivoted
-/// LU of the same `J` in a lane where that declines. Returns each lane's error
-/// ([`Error::NonFiniteForce`] for a tangent entry, [`Error::SingularJacobian`]).
+/// LU of the same `J` in a lane where that declines. Returns `None` when every lane solved
+/// by `L D Lᵀ` with a finite tangent (the usual case: one whole-batch test), else each
+/// lane's error ([`Error::NonFiniteForce`] for a tangent entry,
+/// [`Error::SingularJacobian`]).
 #[inline(always)]
 fn solve<T: Real, H, const N: usize, const L: usize>(
     w: &Work<T, H, N, L>,
@@ -638,19 +669,11 @@ fn solve<T: Real, H, const N: usize, const L: usize>(
     c: T,
     running: &[bool; L],
     r: &mut [[T; L]; N],
-) -> [Option<Error>; L] {
-    let mut failed = [None; L];
-    let [kd, cd, ko, co] = [
-        finite(&w.k_diag, 0),
-        finite(&w.c_diag, 0),
-        finite(&w.k_off, 1),
-        finite(&w.c_off, 1),
-    ];
-    for (l, f) in failed.iter_mut().enumerate() {
-        if !(kd[l] && cd[l] && ko[l] && co[l]) {
-            *f = Some(Error::NonFiniteForce);
-        }
-    }
+) -> Option<[Option<Error>; L]> {
+    let tangent_finite = all_finite(&w.k_diag, 0)
+        && all_finite(&w.c_diag, 0)
+        && all_finite(&w.k_off, 1)
+        && all_finite(&w.c_off, 1);
     // J and its scale, term by term as the single step (`M` has no off-diagonal).
     let mut scale = [T::zero(); L];
     let mut j_diag = [[T::zero(); L]; N];
@@ -669,8 +692,26 @@ fn solve<T: Real, H, const N: usize, const L: usize>(
             }
         }
     }
+    let (factors, positive) = factor(&j_diag, &j_off, &scale);
+    if tangent_finite && positive.iter().all(|&x| x) {
+        substitute(&factors, &j_off, r);
+        return None;
+    }
+    // Some lane declines: each lane's outcome, as the single step's.
+    let mut failed = [None; L];
+    let [kd, cd, ko, co] = [
+        finite(&w.k_diag, 0),
+        finite(&w.c_diag, 0),
+        finite(&w.k_off, 1),
+        finite(&w.c_off, 1),
+    ];
+    for (l, f) in failed.iter_mut().enumerate() {
+        if !(kd[l] && cd[l] && ko[l] && co[l]) {
+            *f = Some(Error::NonFiniteForce);
+        }
+    }
     let rhs = *r;
-    let positive = solve_positive(&j_diag, &j_off, r, &scale);
+    substitute(&factors, &j_off, r);
     for l in 0..L {
         if positive[l] || failed[l].is_some() || !running[l] {
             continue;
@@ -689,23 +730,32 @@ fn solve<T: Real, H, const N: usize, const L: usize>(
             failed[l] = Some(Error::SingularJacobian);
         }
     }
-    failed
+    Some(failed)
 }
 
-/// `A x = b` in place for the symmetric tridiagonal `A` of every lane (diagonal `d`,
-/// off-diagonal `e`), by `L D Lᵀ` exactly as the single step's solve; a lane whose pivot
-/// is not finite or not above `N·ε·scale` is reported `false` (its `b` unspecified).
+/// The `L D Lᵀ` factors of every lane's symmetric tridiagonal `A` (diagonal `d`,
+/// off-diagonal `e`): the multipliers `l_i = e_i / d_{i−1}` (as `e_i · (1/d_{i−1})`) and
+/// the pivots' reciprocals, exactly as the single step's solve forms them.
+struct Factors<T, const N: usize, const L: usize> {
+    multiplier: [[T; L]; N],
+    inverse: [[T; L]; N],
+}
+
+/// [`Factors`] of every lane, and whether each lane's pivots are all finite and above
+/// `N·ε·scale` (else its solve is unspecified).
 #[inline(always)]
-fn solve_positive<T: Real, const N: usize, const L: usize>(
+fn factor<T: Real, const N: usize, const L: usize>(
     d: &[[T; L]; N],
     e: &[[T; L]; N],
-    x: &mut [[T; L]; N],
     scale: &[T; L],
-) -> [bool; L] {
+) -> (Factors<T, N, L>, [bool; L]) {
     let n_eps = T::from_f64_rounded(N as f64) * T::default_epsilon();
     let tiny: [T; L] = core::array::from_fn(|l| n_eps * scale[l]);
     let mut accepted = [true; L];
-    let mut inv = [[T::zero(); L]; N];
+    let mut f = Factors {
+        multiplier: [[T::zero(); L]; N],
+        inverse: [[T::zero(); L]; N],
+    };
     let mut prev = [T::zero(); L];
     for i in 0..N {
         for l in 0..L {
@@ -715,12 +765,27 @@ fn solve_positive<T: Real, const N: usize, const L: usize>(
             } else {
                 d[i][l] - li * e[i][l]
             };
-            accepted[l] &= di > tiny[l] && di.is_finite();
-            if i > 0 {
-                x[i][l] -= li * x[i - 1][l];
-            }
+            // `di − di == 0`: `di` finite (see `all_finite`).
+            accepted[l] &= di > tiny[l] && finite_zero(di) == T::zero();
             prev[l] = T::one() / di;
-            inv[i][l] = prev[l];
+            f.multiplier[i][l] = li;
+            f.inverse[i][l] = prev[l];
+        }
+    }
+    (f, accepted)
+}
+
+/// `x ← A⁻¹ x` in every lane from the [`Factors`] of `A` (off-diagonal `e`): forward and
+/// back substitution in the single step's order.
+#[inline(always)]
+fn substitute<T: Real, const N: usize, const L: usize>(
+    f: &Factors<T, N, L>,
+    e: &[[T; L]; N],
+    x: &mut [[T; L]; N],
+) {
+    for i in 1..N {
+        for l in 0..L {
+            x[i][l] -= f.multiplier[i][l] * x[i - 1][l];
         }
     }
     for i in (0..N).rev() {
@@ -730,10 +795,32 @@ fn solve_positive<T: Real, const N: usize, const L: usize>(
             } else {
                 T::zero()
             };
-            x[i][l] = (x[i][l] - upper) * inv[i][l];
+            x[i][l] = (x[i][l] - upper) * f.inverse[i][l];
         }
     }
-    accepted
+}
+
+/// `x − x`: `+0` exactly for a finite `x`, NaN for an infinite or NaN one (a packed
+/// subtraction, where `is_finite` is an integer compare that AVX packs only 2 wide).
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x − x` is the test, not a mistake
+fn finite_zero<T: Real>(x: T) -> T {
+    x - x
+}
+
+/// Every entry from DOF `from` on, in every lane, finite: one test of the whole batch.
+/// `x − x` is `+0` exactly for a finite `x` and NaN otherwise, so the lanes' sums of it are
+/// all zero exactly when every entry is finite: packed subtractions and additions and one
+/// compare (`is_finite` is an integer compare, which AVX packs only 2 wide).
+#[inline(always)]
+fn all_finite<T: Real, const N: usize, const L: usize>(x: &[[T; L]; N], from: usize) -> bool {
+    let mut sum = [T::zero(); L];
+    for row in x.iter().skip(from) {
+        for l in 0..L {
+            sum[l] += finite_zero(row[l]);
+        }
+    }
+    sum.iter().all(|&s| s == T::zero())
 }
 
 /// Each lane's entries from DOF `from` on are all finite.
@@ -761,15 +848,21 @@ fn band_mul<T: Real, const N: usize, const L: usize>(
     x: &[[T; L]; N],
     y: &mut [[T; L]; N],
 ) {
-    band_mul_diagonal(&lanes_of(&a.diagonal), &lanes_of(&a.off), x, y);
+    band_mul_coefficients(
+        &core::array::from_fn(|i| a.diagonal[i]),
+        &core::array::from_fn(|i| a.off[i]),
+        x,
+        y,
+    );
 }
 
-/// `y = A x` in every lane, `A` symmetric tridiagonal with diagonal `d[i][lane]` and
-/// off-diagonal `e[i][lane]`, each row summed in column order as [`SymTridiagonal::mul`].
+/// `y = A x` in every lane, `A` symmetric tridiagonal with diagonal `d[i]` and
+/// off-diagonal `e[i]` (the same in every lane), each row summed in column order as
+/// [`SymTridiagonal::mul`].
 #[inline(always)]
-fn band_mul_diagonal<T: Real, const N: usize, const L: usize>(
-    d: &[[T; L]; N],
-    e: &[[T; L]; N],
+fn band_mul_coefficients<T: Real, const N: usize, const L: usize>(
+    d: &[T; N],
+    e: &[T; N],
     x: &[[T; L]; N],
     y: &mut [[T; L]; N],
 ) {
@@ -777,11 +870,11 @@ fn band_mul_diagonal<T: Real, const N: usize, const L: usize>(
         for l in 0..L {
             let mut s = T::zero();
             if i > 0 {
-                s = e[i][l] * x[i - 1][l];
+                s = e[i] * x[i - 1][l];
             }
-            s += d[i][l] * x[i][l];
+            s += d[i] * x[i][l];
             if i + 1 < N {
-                s += e[i + 1][l] * x[i + 1][l];
+                s += e[i + 1] * x[i + 1][l];
             }
             y[i][l] = s;
         }

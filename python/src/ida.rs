@@ -33,13 +33,13 @@ use pyo3::types::{PyDict, PyList};
 use crate::laws::{self, WithLaws};
 use crate::{Fail, Res, SIZES, out1, out2, read1, read2, rows, shape, square};
 
-/// Analyses stepped together by [`LaneStepper`], one a lane: `f64 × 8`, two AVX registers
-/// (four SSE2 ones), whose two independent chains hide the latency of the Newton solve's
-/// divisions. The width `xtask/benches/lanes.rs` measures fastest a lane step (see
-/// `docs/performance.md`, lanes); 8 lanes a batch leaves 110 batches of the 880-analysis IDA
-/// to share between threads. (4 lanes measured fastest before the lanes' step ran AVX code
-/// at all: it was compiled as SSE2, outside the dispatch.)
-const LANES: usize = 8;
+/// Analyses stepped together by [`LaneStepper`], one a lane: `f64 × 4`, one AVX register
+/// (two SSE2 ones). The width `xtask/benches/lanes.rs` measures fastest a lane step since
+/// the lane step's masks and tests became whole-batch operations (see
+/// `docs/performance.md`, lanes): 8 lanes hold twice the arrays, which no longer fit the
+/// registers, and gain nothing on the 880-analysis IDA; 4 lanes a batch leave 220 batches
+/// of it to share between threads, and half the code of every law and size.
+const LANES: usize = 4;
 
 /// The intensities to run: fixed stripes, or a hunt-and-fill trace.
 enum Plan {

@@ -188,31 +188,39 @@ impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
     ) -> crate::lanes::LaneTrial<T, BilinearHistory<T>, L> {
         let two = T::one() + T::one();
         let half = T::one() / two;
-        let mut out = crate::lanes::LaneTrial {
-            force: [T::zero(); L],
-            stiffness: [T::zero(); L],
-            damping: [T::zero(); L],
-            history: *committed,
-            inelastic: [false; L],
-        };
-        for l in 0..L {
-            let dp_h = committed[l].plastic * half;
-            let f_h = self.k * (d[l] * half - dp_h);
-            let xi_h = f_h - self.hard * dp_h;
-            let excess_h = xi_h.abs() - self.fy * half;
-            let plastic = excess_h > T::zero();
-            let s = if xi_h > T::zero() {
+        // The stiffnesses read once (a select between two fields read per lane became
+        // a select of their addresses and eight scalar loads).
+        let (k, kt) = (self.k, self.kt);
+        // One operation over all lanes at a time (the compiler packs such loops; one loop
+        // of the whole trial a lane was left scalar, with jumps).
+        let dp_h: [T; L] = core::array::from_fn(|l| committed[l].plastic * half);
+        let f_h: [T; L] = core::array::from_fn(|l| k * (d[l] * half - dp_h[l]));
+        let xi_h: [T; L] = core::array::from_fn(|l| f_h[l] - self.hard * dp_h[l]);
+        let excess_h: [T; L] = core::array::from_fn(|l| xi_h[l].abs() - self.fy * half);
+        let s: [T; L] = core::array::from_fn(|l| {
+            if xi_h[l] > T::zero() {
                 T::one()
             } else {
                 -T::one()
-            };
-            let f_p = (f_h - s * self.one_minus_alpha * excess_h) * two;
-            let dp_p = (dp_h + s * self.compliance_p * excess_h) * two;
-            out.force[l] = if plastic { f_p } else { f_h * two };
-            out.stiffness[l] = if plastic { self.kt } else { self.k };
-            out.history[l].plastic = if plastic { dp_p } else { committed[l].plastic };
-            out.inelastic[l] = plastic;
+            }
+        });
+        let f_p: [T; L] =
+            core::array::from_fn(|l| (f_h[l] - s[l] * self.one_minus_alpha * excess_h[l]) * two);
+        let dp_p: [T; L] =
+            core::array::from_fn(|l| (dp_h[l] + s[l] * self.compliance_p * excess_h[l]) * two);
+        let plastic: [bool; L] = core::array::from_fn(|l| excess_h[l] > T::zero());
+        crate::lanes::LaneTrial {
+            force: core::array::from_fn(|l| if plastic[l] { f_p[l] } else { f_h[l] * two }),
+            stiffness: core::array::from_fn(|l| if plastic[l] { kt } else { k }),
+            damping: [T::zero(); L],
+            history: core::array::from_fn(|l| BilinearHistory {
+                plastic: if plastic[l] {
+                    dp_p[l]
+                } else {
+                    committed[l].plastic
+                },
+            }),
+            inelastic: plastic,
         }
-        out
     }
 }
