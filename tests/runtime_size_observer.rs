@@ -40,6 +40,24 @@ struct Models<const N: usize, const S: usize, const O: usize> {
     dr: DMatrix<f64>,
 }
 
+/// The run-time scene of `n` storeys with accelerometers at `dofs`: the model, its
+/// measurement, and the noise (white forces of `SIGMA_F` on every floor, accelerometers
+/// of `SIGMA_Y`).
+fn dyn_scene(
+    n: usize,
+    dofs: &[usize],
+) -> (DynStateSpace, DynMeasurement, DMatrix<f64>, DMatrix<f64>) {
+    let (m, c, k) = building(n);
+    let dss = DynStateSpace::aem(&m, &c, &k, &ground(&m), H).unwrap();
+    let dmeas = dss.absolute_accelerations(dofs, 0).unwrap();
+    let forces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(n, n), H).unwrap();
+    let q = forces
+        .input_noise(&(DMatrix::identity(n, n) * (SIGMA_F * SIGMA_F)))
+        .unwrap();
+    let r = DMatrix::identity(dofs.len(), dofs.len()) * (SIGMA_Y * SIGMA_Y);
+    (dss, dmeas, q, r)
+}
+
 fn models<const N: usize, const S: usize, const O: usize>(dofs: [usize; O]) -> Models<N, S, O> {
     let (m, c, k) = building(N);
     let b = ground(&m);
@@ -53,13 +71,7 @@ fn models<const N: usize, const S: usize, const O: usize>(dofs: [usize; O]) -> M
             0,
         ))
         .unwrap();
-    let dss = DynStateSpace::aem(&m, &c, &k, &b, H).unwrap();
-    let dmeas = dss.absolute_accelerations(&dofs, 0).unwrap();
-    let dforces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(N, N), H).unwrap();
-    let dq = dforces
-        .input_noise(&(DMatrix::identity(N, N) * (SIGMA_F * SIGMA_F)))
-        .unwrap();
-    let dr = DMatrix::identity(O, O) * (SIGMA_Y * SIGMA_Y);
+    let (dss, dmeas, dq, dr) = dyn_scene(N, &dofs);
     Models {
         stiff: (ms, cs, ks),
         ss,
@@ -260,11 +272,7 @@ fn a_size_outside_the_list_matches_the_reference_written_from_the_equations() {
     // S κ ε ≈ 1e-13 (measured 1.2e-14).
     assert!(errs.iter().all(|&e| e < 1e-13), "{errs:?}");
 
-    let forces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(n, n), H).unwrap();
-    let q = forces
-        .input_noise(&(DMatrix::identity(n, n) * (SIGMA_F * SIGMA_F)))
-        .unwrap();
-    let r = DMatrix::identity(3, 3) * (SIGMA_Y * SIGMA_Y);
+    let (_, _, q, r) = dyn_scene(n, &dofs);
     let kf = DynSteadyState::new(&ss, &meas, &q, &r).unwrap();
     let (p, l) = (kf.covariance_matrix(), kf.gain_matrix());
     // The DARE on the reference matrices: P = Φ (P − P Hᵀ Σ⁻¹ H P) Φᵀ + Q, L = P Hᵀ Σ⁻¹.
@@ -539,11 +547,7 @@ fn run_time_kalman_outside_the_list_matches_a_filter_written_from_the_equations(
     let ss = DynStateSpace::aem(&m, &c, &k, &b, H).unwrap();
     let meas = ss.absolute_accelerations(&dofs, 0).unwrap();
     let [phi, gamma, hm, d] = reference_model(&m, &c, &k, &b, &dofs);
-    let forces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(n, n), H).unwrap();
-    let q = forces
-        .input_noise(&(DMatrix::identity(n, n) * (SIGMA_F * SIGMA_F)))
-        .unwrap();
-    let r = DMatrix::identity(4, 4) * (SIGMA_Y * SIGMA_Y);
+    let (_, _, q, r) = dyn_scene(n, &dofs);
     let kf = DynKalman::<f64>::new(&ss, &meas, &q, &r).unwrap();
     let (ag, y) = record(300, 4);
     let s2 = 2 * n;
@@ -651,14 +655,7 @@ fn run_time_kalman_gives_the_compiled_paths_errors() {
 fn the_gain_solve_answers_a_stop_flag_between_its_pieces() {
     use aemstep::Param;
     let n = 23;
-    let (m, c, k) = building(n);
-    let dss = DynStateSpace::aem(&m, &c, &k, &ground(&m), H).unwrap();
-    let dmeas = dss.absolute_accelerations(&[0, n - 1], 0).unwrap();
-    let forces = DynStateSpace::aem(&m, &c, &k, &DMatrix::identity(n, n), H).unwrap();
-    let q = forces
-        .input_noise(&(DMatrix::identity(n, n) * (SIGMA_F * SIGMA_F)))
-        .unwrap();
-    let r = DMatrix::identity(2, 2) * (SIGMA_Y * SIGMA_Y);
+    let (dss, dmeas, q, r) = dyn_scene(n, &[0, n - 1]);
     let plain = DynSteadyState::new(&dss, &dmeas, &q, &r).unwrap();
     let mut looks = 0u32;
     let polled = DynSteadyState::new_with_stop(&dss, &dmeas, &q, &r, &mut || {
