@@ -108,6 +108,16 @@ pub struct LaneTrial<T, H, const L: usize> {
 /// not packed); [`Bilinear`](crate::hysteresis::Bilinear) computes both of its branches in
 /// every lane and selects, so its trials run as packed instructions.
 pub trait LaneLaw<T: Real>: Law<T> {
+    /// The tangent `(stiffness, damping)` that every trial on the elastic branch
+    /// (`inelastic == false`) returns, whatever the deformation and history, when the law
+    /// has one: then [`LaneStepper::run`] forms the Newton matrix of an all-elastic
+    /// building once instead of every step (the same numbers, so the same bits). `None`
+    /// (the default): the law's elastic tangent varies, and the matrix is formed every
+    /// solve. Cost: O(1).
+    fn elastic_tangent(&self) -> Option<(T, T)> {
+        None
+    }
+
     /// The trials at deformations `d` and rates `rate` from the `committed` histories, one
     /// lane each. Cost: `L` law trials.
     #[inline(always)]
@@ -249,12 +259,124 @@ struct Work<T, H, const N: usize, const L: usize> {
     v: [[T; L]; N],
     force: [[T; L]; N],
     history: [[H; L]; N],
-    /// The tangent's stiffness and damping bands (diagonal, off-diagonal).
+    /// Each storey's tangent stiffness and damping (`[storey][lane]`), assembled into
+    /// the Newton matrix's bands only when a solve needs them ([`Tangent::of`]).
+    stiffness: [[T; L]; N],
+    damping: [[T; L]; N],
+    /// The branch signatures (bit `i mod 64`: storey `i` inelastic), formed for reports.
+    branch: [u64; L],
+    /// Some storey inelastic, in each lane.
+    inelastic: [bool; L],
+    /// The factors of an all-elastic trial's Newton matrix, when formed beforehand.
+    elastic: Option<ElasticSolve<T, N, L>>,
+}
+
+impl<T: Real, H: Copy, const N: usize, const L: usize> Work<T, H, N, L> {
+    /// Scratch for a step from the committed `history` (every field is written before it
+    /// is read; zeros and the committed histories only make it initialised).
+    fn new(history: &[[H; L]; N], elastic: Option<ElasticSolve<T, N, L>>) -> Self {
+        let zero = [[T::zero(); L]; N];
+        Self {
+            vh: zero,
+            uh: zero,
+            q: zero,
+            u: zero,
+            v: zero,
+            force: zero,
+            history: *history,
+            stiffness: zero,
+            damping: zero,
+            branch: [0; L],
+            inelastic: [false; L],
+            elastic,
+        }
+    }
+}
+
+/// The tangent's stiffness and damping bands (diagonal, off-diagonal; `[dof][lane]`).
+struct Tangent<T, const N: usize, const L: usize> {
     k_diag: [[T; L]; N],
     k_off: [[T; L]; N],
     c_diag: [[T; L]; N],
     c_off: [[T; L]; N],
-    branch: [u64; L],
+}
+
+impl<T: Real, const N: usize, const L: usize> Tangent<T, N, L> {
+    /// The bands from the storeys' tangents, summed in the order of [`ShearBuilding`]'s
+    /// trial (storey by storey: its own DOF, then the one below), on the damping band.
+    #[inline(always)]
+    fn of(band: &SymTridiagonal<T, N>, stiffness: &[[T; L]; N], damping: &[[T; L]; N]) -> Self {
+        let mut t = Self {
+            k_diag: [[T::zero(); L]; N],
+            k_off: [[T::zero(); L]; N],
+            c_diag: lanes_of(&band.diagonal),
+            c_off: lanes_of(&band.off),
+        };
+        for i in 0..N {
+            for l in 0..L {
+                t.k_diag[i][l] += stiffness[i][l];
+                t.c_diag[i][l] += damping[i][l];
+            }
+            if i > 0 {
+                for l in 0..L {
+                    t.k_diag[i - 1][l] += stiffness[i][l];
+                    t.k_off[i][l] -= stiffness[i][l];
+                    t.c_diag[i - 1][l] += damping[i][l];
+                    t.c_off[i][l] -= damping[i][l];
+                }
+            }
+        }
+        t
+    }
+
+    /// Every band entry, in every lane, finite (one whole-batch test).
+    #[inline(always)]
+    fn finite(&self) -> bool {
+        all_finite(&self.k_diag, 0)
+            && all_finite(&self.c_diag, 0)
+            && all_finite(&self.k_off, 1)
+            && all_finite(&self.c_off, 1)
+    }
+
+    /// `J = M + b ∂F/∂v + c ∂F/∂u` (diagonal, off-diagonal) and its scale
+    /// `max(|M| + b |∂F/∂v| + c |∂F/∂u|)`, term by term as the single step (`M` diagonal).
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    fn newton_matrix(
+        &self,
+        m_diag: &[[T; L]; N],
+        b: T,
+        c: T,
+    ) -> ([[T; L]; N], [[T; L]; N], [T; L]) {
+        let mut scale = [T::zero(); L];
+        let mut j_diag = [[T::zero(); L]; N];
+        let mut j_off = [[T::zero(); L]; N];
+        for i in 0..N {
+            for l in 0..L {
+                let (m, d, k) = (m_diag[i][l], self.c_diag[i][l], self.k_diag[i][l]);
+                j_diag[i][l] = m + b * d + c * k;
+                scale[l] = scale[l].max(m.abs() + b * d.abs() + c * k.abs());
+            }
+            if i > 0 {
+                for l in 0..L {
+                    let (m, d, k) = (T::zero(), self.c_off[i][l], self.k_off[i][l]);
+                    j_off[i][l] = m + b * d + c * k;
+                    scale[l] = scale[l].max(m.abs() + b * d.abs() + c * k.abs());
+                }
+            }
+        }
+        (j_diag, j_off, scale)
+    }
+}
+
+/// The Newton matrix's `L D Lᵀ` factors when every storey is on its elastic branch (whose
+/// tangent [`LaneLaw::elastic_tangent`] states): the same values in every lane and every
+/// step, so [`LaneStepper::run`] forms them once. Bit for bit what [`solve`] forms from an
+/// all-elastic trial (the same operations on the same numbers); `None` when that solve
+/// would not take `L D Lᵀ` (a tangent entry not finite, a pivot too small).
+struct ElasticSolve<T, const N: usize, const L: usize> {
+    factors: Factors<T, N, L>,
+    j_off: [[T; L]; N],
 }
 
 impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
@@ -298,14 +420,29 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         p: &[[T; L]; N],
         active: [bool; L],
     ) -> LaneReports<T, L> {
+        let mut w = Work::new(history, None);
+        // `inline(always)`: the closure's body must be inlined into the AVX-compiled
+        // caller of the dispatch, else it is one out-of-line SSE2 function called from
+        // it and the lanes never run 4 wide (measured: the whole step was SSE2 code).
+        crate::linalg::wide(
+            #[inline(always)]
+            || self.step_with::<Lw, true>(building, state, history, p, active, &mut w),
+        )
+    }
+
+    /// [`LaneStepper::step`] with the elastic factors formed beforehand ([`ElasticSolve`]).
+    #[inline(always)]
+    fn step_with<Lw: LaneLaw<T>, const REPORT: bool>(
+        &self,
+        building: &ShearBuilding<T, Lw, N>,
+        state: &mut LaneState<T, N, L>,
+        history: &mut LaneHistory<Lw::History, N, L>,
+        p: &[[T; L]; N],
+        active: [bool; L],
+        w: &mut Work<T, Lw::History, N, L>,
+    ) -> LaneReports<T, L> {
         if let Some(band) = building.band() {
-            // `inline(always)`: the closure's body must be inlined into the AVX-compiled
-            // caller of the dispatch, else it is one out-of-line SSE2 function called from
-            // it and the lanes never run 4 wide (measured: the whole step was SSE2 code).
-            return crate::linalg::wide(
-                #[inline(always)]
-                || self.banded(building, band, state, history, p, active),
-            );
+            return self.banded::<Lw, REPORT>(building, band, state, history, p, active, w);
         }
         // A dense-damping building: each active lane by the single step.
         core::array::from_fn(|l| {
@@ -328,22 +465,41 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         })
     }
 
+    /// The factors of the Newton matrix of an all-elastic trial (see [`ElasticSolve`]):
+    /// `None` for a dense-damping building, a law without [`LaneLaw::elastic_tangent`],
+    /// or a matrix the `L D Lᵀ` solve declines. Cost: one solve's factorisation.
+    fn elastic_solve<Lw: LaneLaw<T>>(
+        &self,
+        building: &ShearBuilding<T, Lw, N>,
+    ) -> Option<ElasticSolve<T, N, L>> {
+        let band = building.band()?;
+        let mut stiffness = [[T::zero(); L]; N];
+        let mut damping = [[T::zero(); L]; N];
+        for (i, law) in building.laws().iter().enumerate() {
+            let (k, d) = law.elastic_tangent()?;
+            (stiffness[i], damping[i]) = ([k; L], [d; L]);
+        }
+        let t = Tangent::of(band, &stiffness, &damping);
+        let m_diag: [[T; L]; N] = lanes_of(building.masses());
+        let (j_diag, j_off, scale) = t.newton_matrix(&m_diag, self.kin.half_h, self.kin.quarter_h2);
+        let (factors, positive) = factor(&j_diag, &j_off, &scale);
+        (t.finite() && positive.iter().all(|&x| x)).then_some(ElasticSolve { factors, j_off })
+    }
+
     /// The trial of every lane at `(w.u, w.v)` from the committed `history`: `C v` on
     /// the band, the storeys' forces, histories, branches and tangent bands, in the order
     /// of [`ShearBuilding`]'s trial.
     #[inline(always)]
-    fn trial<Lw: LaneLaw<T>>(
+    fn trial<Lw: LaneLaw<T>, const REPORT: bool>(
         building: &ShearBuilding<T, Lw, N>,
         band: &SymTridiagonal<T, N>,
         history: &LaneHistory<Lw::History, N, L>,
         w: &mut Work<T, Lw::History, N, L>,
     ) {
         band_mul(band, &w.v, &mut w.force);
-        w.c_diag = lanes_of(&band.diagonal);
-        w.c_off = lanes_of(&band.off);
-        w.k_diag = [[T::zero(); L]; N];
-        w.k_off = [[T::zero(); L]; N];
         w.branch = [0; L];
+        // A local (kept in a register): or-ing into `w` stalled on store forwarding.
+        let mut inelastic = [false; L];
         let laws = building.laws();
         for i in 0..N {
             // δ_i = u_i − u_{i−1} (δ_0 = u_0), as the building's trial.
@@ -357,26 +513,29 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
             let s = laws[i].trial_lanes(&history[i], &d, &r);
             for l in 0..L {
                 w.force[i][l] += s.force[l];
-                w.branch[l] |= u64::from(s.inelastic[l]) << (i % 64);
-                w.k_diag[i][l] += s.stiffness[l];
-                w.c_diag[i][l] += s.damping[l];
+                inelastic[l] |= s.inelastic[l];
+            }
+            if REPORT {
+                for l in 0..L {
+                    w.branch[l] |= u64::from(s.inelastic[l]) << (i % 64);
+                }
             }
             if i > 0 {
                 for l in 0..L {
                     w.force[i - 1][l] -= s.force[l];
-                    w.k_diag[i - 1][l] += s.stiffness[l];
-                    w.k_off[i][l] -= s.stiffness[l];
-                    w.c_diag[i - 1][l] += s.damping[l];
-                    w.c_off[i][l] -= s.damping[l];
                 }
             }
+            w.stiffness[i] = s.stiffness;
+            w.damping[i] = s.damping;
             w.history[i] = s.history;
         }
+        w.inelastic = inelastic;
     }
 
     /// The banded Newton step of every active lane (see [`LaneStepper::step`]).
     #[inline(always)]
-    fn banded<Lw: LaneLaw<T>>(
+    #[allow(clippy::too_many_arguments)] // the step's operands, each a different borrow
+    fn banded<Lw: LaneLaw<T>, const REPORT: bool>(
         &self,
         building: &ShearBuilding<T, Lw, N>,
         band: &SymTridiagonal<T, N>,
@@ -384,6 +543,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         history: &mut LaneHistory<Lw::History, N, L>,
         p: &[[T; L]; N],
         active: [bool; L],
+        w: &mut Work<T, Lw::History, N, L>,
     ) -> LaneReports<T, L> {
         let mut out: LaneReports<T, L> = [None; L];
         let settings = self.single.settings();
@@ -408,20 +568,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                 }
             }
         }
-        let mut w = Work {
-            vh: [[T::zero(); L]; N],
-            uh: [[T::zero(); L]; N],
-            q: state.a,
-            u: [[T::zero(); L]; N],
-            v: [[T::zero(); L]; N],
-            force: [[T::zero(); L]; N],
-            history: *history,
-            k_diag: [[T::zero(); L]; N],
-            k_off: [[T::zero(); L]; N],
-            c_diag: [[T::zero(); L]; N],
-            c_off: [[T::zero(); L]; N],
-            branch: [0; L],
-        };
+        w.q = state.a;
         for i in 0..N {
             for l in 0..L {
                 (w.vh[i][l], w.uh[i][l]) =
@@ -441,7 +588,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                     (w.v[i][l], w.u[i][l]) = self.kin.correct(w.vh[i][l], w.uh[i][l], w.q[i][l]);
                 }
             }
-            Self::trial(building, band, history, &mut w);
+            Self::trial::<Lw, REPORT>(building, band, history, w);
             band_mul_coefficients(&m_coefficients, &[T::zero(); N], &w.q, &mut mq);
             // Whole-batch tests first: a lane's own test only when one fails (rare).
             if !all_finite(&w.force, 0) {
@@ -453,19 +600,24 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                     }
                 }
             }
-            if iterations > 0 {
-                for l in 0..L {
-                    branch_changes[l] += u32::from(w.branch[l] != last_branch[l]);
+            if REPORT {
+                if iterations > 0 {
+                    for l in 0..L {
+                        branch_changes[l] += u32::from(w.branch[l] != last_branch[l]);
+                    }
                 }
+                last_branch = w.branch;
             }
-            last_branch = w.branch;
             for i in 0..N {
                 for l in 0..L {
                     r[i][l] = mq[i][l] + w.force[i][l] - p[i][l];
                 }
             }
             let residual = relative_residual(&r, &mq, &w.force, &p_size);
-            let correction: [T; L] = if iterations == 0 {
+            // Without reports (`run`), the correction only decides a lane whose residual
+            // did not: when every running lane's did, it is not formed.
+            let decided = !REPORT && (0..L).all(|l| !running[l] || residual[l] <= tol);
+            let correction: [T; L] = if iterations == 0 || decided {
                 [T::zero(); L]
             } else {
                 let (nq, nu, nv) = (norm_inf(&w.q), norm_inf(&w.u), norm_inf(&w.v));
@@ -494,13 +646,12 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
             let finishing: [bool; L] =
                 core::array::from_fn(|l| running[l] & (over | (!fixed & converged[l])));
             if finishing.iter().any(|&x| x) {
-                let state_finite: [bool; L] =
-                    if all_finite(&w.u, 0) && all_finite(&w.v, 0) && all_finite(&w.q, 0) {
-                        [true; L]
-                    } else {
-                        let (fu, fv, fq) = (finite(&w.u, 0), finite(&w.v, 0), finite(&w.q, 0));
-                        core::array::from_fn(|l| fu[l] && fv[l] && fq[l])
-                    };
+                let state_finite: [bool; L] = if all_finite_of([&w.u, &w.v, &w.q], 0) {
+                    [true; L]
+                } else {
+                    let (fu, fv, fq) = (finite(&w.u, 0), finite(&w.v, 0), finite(&w.q, 0));
+                    core::array::from_fn(|l| fu[l] && fv[l] && fq[l])
+                };
                 let mut commit = [false; L];
                 for l in 0..L {
                     if !finishing[l] {
@@ -524,14 +675,27 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                     });
                 }
                 if commit.iter().any(|&x| x) {
-                    Self::commit(state, history, &w, &commit);
+                    Self::commit(state, history, w, &commit);
                 }
             }
             if !running.iter().any(|&x| x) {
                 break;
             }
             let mut delta = r;
-            if let Some(failed) = solve(&w, &m_diag, b, c, &running, &mut delta) {
+            let cached = w
+                .elastic
+                .as_ref()
+                .filter(|_| (0..L).all(|l| !running[l] || !w.inelastic[l]));
+            if let Some(e) = cached {
+                substitute(&e.factors, &e.j_off, &mut delta);
+            } else if let Some(failed) = solve(
+                &Tangent::of(band, &w.stiffness, &w.damping),
+                &m_diag,
+                b,
+                c,
+                &running,
+                &mut delta,
+            ) {
                 for (l, failed) in failed.iter().enumerate() {
                     if let (true, Some(e)) = (running[l], failed) {
                         out[l] = Some(Err(*e));
@@ -598,7 +762,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         building: &ShearBuilding<T, Lw, N>,
         steps: [u64; L],
         mut ground: G,
-        mut observe: O,
+        observe: O,
     ) -> [Result<(), Failure>; L]
     where
         Lw: LaneLaw<T>,
@@ -630,7 +794,47 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                 Err(error) => outcome[l] = Err(Failure { step: 0, error }),
             }
         }
+        let mut w = Work::new(&history, self.elastic_solve(building));
         let last = steps.iter().copied().max().unwrap_or(0);
+        // The whole loop, with `ground` and `observe`, under the AVX dispatch (one call).
+        crate::linalg::wide(
+            #[inline(always)]
+            || {
+                self.steps(
+                    building,
+                    &mut state,
+                    &mut history,
+                    &mut w,
+                    last,
+                    steps,
+                    &mut outcome,
+                    ground,
+                    observe,
+                )
+            },
+        );
+        outcome
+    }
+
+    /// [`LaneStepper::run`]'s steps `1 ..= last`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn steps<Lw, G, O>(
+        &self,
+        building: &ShearBuilding<T, Lw, N>,
+        state: &mut LaneState<T, N, L>,
+        history: &mut LaneHistory<Lw::History, N, L>,
+        w: &mut Work<T, Lw::History, N, L>,
+        last: u64,
+        steps: [u64; L],
+        outcome: &mut [Result<(), Failure>; L],
+        mut ground: G,
+        mut observe: O,
+    ) where
+        Lw: LaneLaw<T>,
+        G: FnMut(usize, u64) -> T,
+        O: FnMut(&LaneState<T, N, L>, &[bool; L]),
+    {
         for n in 1..=last {
             let active: [bool; L] = core::array::from_fn(|l| outcome[l].is_ok() && n <= steps[l]);
             if !active.iter().any(|&a| a) {
@@ -639,7 +843,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
             let ag: [T; L] =
                 core::array::from_fn(|l| if active[l] { ground(l, n) } else { T::zero() });
             let p = Self::ground_loads(building, &ag);
-            let reports = self.step(building, &mut state, &mut history, &p, active);
+            let reports = self.step_with::<Lw, false>(building, state, history, &p, active, w);
             for (l, report) in reports.iter().enumerate() {
                 if let Some(Err(error)) = report {
                     outcome[l] = Err(Failure {
@@ -649,9 +853,8 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                 }
             }
             let stepped: [bool; L] = core::array::from_fn(|l| matches!(reports[l], Some(Ok(_))));
-            observe(&state, &stepped);
+            observe(state, &stepped);
         }
-        outcome
     }
 }
 
@@ -662,36 +865,16 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
 /// lane's error ([`Error::NonFiniteForce`] for a tangent entry,
 /// [`Error::SingularJacobian`]).
 #[inline(always)]
-fn solve<T: Real, H, const N: usize, const L: usize>(
-    w: &Work<T, H, N, L>,
+fn solve<T: Real, const N: usize, const L: usize>(
+    w: &Tangent<T, N, L>,
     m_diag: &[[T; L]; N],
     b: T,
     c: T,
     running: &[bool; L],
     r: &mut [[T; L]; N],
 ) -> Option<[Option<Error>; L]> {
-    let tangent_finite = all_finite(&w.k_diag, 0)
-        && all_finite(&w.c_diag, 0)
-        && all_finite(&w.k_off, 1)
-        && all_finite(&w.c_off, 1);
-    // J and its scale, term by term as the single step (`M` has no off-diagonal).
-    let mut scale = [T::zero(); L];
-    let mut j_diag = [[T::zero(); L]; N];
-    let mut j_off = [[T::zero(); L]; N];
-    for i in 0..N {
-        for l in 0..L {
-            let (m, d, k) = (m_diag[i][l], w.c_diag[i][l], w.k_diag[i][l]);
-            j_diag[i][l] = m + b * d + c * k;
-            scale[l] = scale[l].max(m.abs() + b * d.abs() + c * k.abs());
-        }
-        if i > 0 {
-            for l in 0..L {
-                let (m, d, k) = (T::zero(), w.c_off[i][l], w.k_off[i][l]);
-                j_off[i][l] = m + b * d + c * k;
-                scale[l] = scale[l].max(m.abs() + b * d.abs() + c * k.abs());
-            }
-        }
-    }
+    let tangent_finite = w.finite();
+    let (j_diag, j_off, scale) = w.newton_matrix(m_diag, b, c);
     let (factors, positive) = factor(&j_diag, &j_off, &scale);
     if tangent_finite && positive.iter().all(|&x| x) {
         substitute(&factors, &j_off, r);
@@ -817,10 +1000,27 @@ fn all_finite<T: Real, const N: usize, const L: usize>(x: &[[T; L]; N], from: us
     let mut sum = [T::zero(); L];
     for row in x.iter().skip(from) {
         for l in 0..L {
-            sum[l] += finite_zero(row[l]);
+            sum[l] += row[l];
         }
     }
-    sum.iter().all(|&s| s == T::zero())
+    sum.iter().all(|&s| finite_zero(s) == T::zero())
+}
+
+/// [`all_finite`] of several arrays, with one test: the sum over all of them.
+#[inline(always)]
+fn all_finite_of<T: Real, const N: usize, const L: usize, const K: usize>(
+    xs: [&[[T; L]; N]; K],
+    from: usize,
+) -> bool {
+    let mut sum = [T::zero(); L];
+    for x in xs {
+        for row in x.iter().skip(from) {
+            for l in 0..L {
+                sum[l] += row[l];
+            }
+        }
+    }
+    sum.iter().all(|&s| finite_zero(s) == T::zero())
 }
 
 /// Each lane's entries from DOF `from` on are all finite.

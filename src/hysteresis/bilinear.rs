@@ -179,6 +179,11 @@ impl<T: Real> Law<T> for Bilinear<T> {
 /// computed by exactly the operations of the scalar trial, so every lane has its bits,
 /// and the loop has no branch (packed instructions).
 impl<T: Real> crate::lanes::LaneLaw<T> for Bilinear<T> {
+    /// `(k, 0)`: the elastic branch's tangent is the initial stiffness, without damping.
+    fn elastic_tangent(&self) -> Option<(T, T)> {
+        Some((self.k, T::zero()))
+    }
+
     #[inline(always)]
     fn trial_lanes<const L: usize>(
         &self,
