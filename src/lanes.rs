@@ -424,7 +424,8 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         // `inline(always)`: the closure's body must be inlined into the AVX-compiled
         // caller of the dispatch, else it is one out-of-line SSE2 function called from
         // it and the lanes never run 4 wide (measured: the whole step was SSE2 code).
-        crate::linalg::wide(
+        crate::linalg::wide_lanes(
+            L * core::mem::size_of::<T>(),
             #[inline(always)]
             || self.step_with::<Lw, true>(building, state, history, p, active, &mut w),
         )
@@ -483,7 +484,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         let m_diag: [[T; L]; N] = lanes_of(building.masses());
         let (j_diag, j_off, scale) = t.newton_matrix(&m_diag, self.kin.half_h, self.kin.quarter_h2);
         let (factors, positive) = factor(&j_diag, &j_off, &scale);
-        (t.finite() && positive.iter().all(|&x| x)).then_some(ElasticSolve { factors, j_off })
+        (t.finite() && all(&positive)).then_some(ElasticSolve { factors, j_off })
     }
 
     /// The trial of every lane at `(w.u, w.v)` from the committed `history`: `C v` on
@@ -582,7 +583,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         let mut last_branch = [0u64; L];
         let mut mq = [[T::zero(); L]; N];
         let mut r = [[T::zero(); L]; N];
-        while running.iter().any(|&x| x) {
+        while any(&running) {
             for i in 0..N {
                 for l in 0..L {
                     (w.v[i][l], w.u[i][l]) = self.kin.correct(w.vh[i][l], w.uh[i][l], w.q[i][l]);
@@ -616,7 +617,10 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
             let residual = relative_residual(&r, &mq, &w.force, &p_size);
             // Without reports (`run`), the correction only decides a lane whose residual
             // did not: when every running lane's did, it is not formed.
-            let decided = !REPORT && (0..L).all(|l| !running[l] || residual[l] <= tol);
+            let decided = !REPORT
+                && all::<L>(&core::array::from_fn(|l| {
+                    !running[l] | (residual[l] <= tol)
+                }));
             let correction: [T; L] = if iterations == 0 || decided {
                 [T::zero(); L]
             } else {
@@ -645,7 +649,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
             });
             let finishing: [bool; L] =
                 core::array::from_fn(|l| running[l] & (over | (!fixed & converged[l])));
-            if finishing.iter().any(|&x| x) {
+            if any(&finishing) {
                 let state_finite: [bool; L] = if all_finite_of([&w.u, &w.v, &w.q], 0) {
                     [true; L]
                 } else {
@@ -674,18 +678,18 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
                         })
                     });
                 }
-                if commit.iter().any(|&x| x) {
+                if any(&commit) {
                     Self::commit(state, history, w, &commit);
                 }
             }
-            if !running.iter().any(|&x| x) {
+            if !any(&running) {
                 break;
             }
             let mut delta = r;
             let cached = w
                 .elastic
                 .as_ref()
-                .filter(|_| (0..L).all(|l| !running[l] || !w.inelastic[l]));
+                .filter(|_| all::<L>(&core::array::from_fn(|l| !running[l] | !w.inelastic[l])));
             if let Some(e) = cached {
                 substitute(&e.factors, &e.j_off, &mut delta);
             } else if let Some(failed) = solve(
@@ -723,7 +727,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         w: &Work<T, H, N, L>,
         commit: &[bool; L],
     ) {
-        if commit.iter().all(|&x| x) {
+        if all(commit) {
             // Every lane: plain copies (the usual case, every lane converging together).
             state.u = w.u;
             state.v = w.v;
@@ -797,7 +801,8 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         let mut w = Work::new(&history, self.elastic_solve(building));
         let last = steps.iter().copied().max().unwrap_or(0);
         // The whole loop, with `ground` and `observe`, under the AVX dispatch (one call).
-        crate::linalg::wide(
+        crate::linalg::wide_lanes(
+            L * core::mem::size_of::<T>(),
             #[inline(always)]
             || {
                 self.steps(
@@ -837,7 +842,7 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
     {
         for n in 1..=last {
             let active: [bool; L] = core::array::from_fn(|l| outcome[l].is_ok() && n <= steps[l]);
-            if !active.iter().any(|&a| a) {
+            if !any(&active) {
                 break;
             }
             let ag: [T; L] =
@@ -876,7 +881,7 @@ fn solve<T: Real, const N: usize, const L: usize>(
     let tangent_finite = w.finite();
     let (j_diag, j_off, scale) = w.newton_matrix(m_diag, b, c);
     let (factors, positive) = factor(&j_diag, &j_off, &scale);
-    if tangent_finite && positive.iter().all(|&x| x) {
+    if tangent_finite && all(&positive) {
         substitute(&factors, &j_off, r);
         return None;
     }
@@ -1003,7 +1008,7 @@ fn all_finite<T: Real, const N: usize, const L: usize>(x: &[[T; L]; N], from: us
             sum[l] += row[l];
         }
     }
-    sum.iter().all(|&s| finite_zero(s) == T::zero())
+    all_zero_finite(&sum)
 }
 
 /// [`all_finite`] of several arrays, with one test: the sum over all of them.
@@ -1020,7 +1025,40 @@ fn all_finite_of<T: Real, const N: usize, const L: usize, const K: usize>(
             }
         }
     }
-    sum.iter().all(|&s| finite_zero(s) == T::zero())
+    all_zero_finite(&sum)
+}
+
+/// Every lane's `x` finite: `x − x == 0` in every lane, and-ed without a short cut (a
+/// short-circuiting `all` made the compiler sum the lanes one at a time, each with its
+/// own jump).
+#[inline(always)]
+fn all_zero_finite<T: Real, const L: usize>(x: &[T; L]) -> bool {
+    let mut ok = true;
+    for &v in x {
+        ok &= finite_zero(v) == T::zero();
+    }
+    ok
+}
+
+/// Some lane's flag set: or-ed over all lanes without a short cut (one packed test; a
+/// short-circuiting `any` became a jump a lane).
+#[inline(always)]
+fn any<const L: usize>(x: &[bool; L]) -> bool {
+    let mut a = false;
+    for &v in x {
+        a |= v;
+    }
+    a
+}
+
+/// Every lane's flag set, and-ed without a short cut (see [`any`]).
+#[inline(always)]
+fn all<const L: usize>(x: &[bool; L]) -> bool {
+    let mut a = true;
+    for &v in x {
+        a &= v;
+    }
+    a
 }
 
 /// Each lane's entries from DOF `from` on are all finite.
@@ -1110,4 +1148,133 @@ fn relative_residual<T: Real, const N: usize, const L: usize>(
             T::zero()
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use std::vec::Vec;
+
+    use super::*;
+    use crate::hysteresis::Bilinear;
+    use crate::linalg::avx::tests::at_each_level;
+    use crate::models;
+
+    /// The yielding 5-storey building of the benchmark IDA (bilinear storeys yielding at
+    /// 3 MN), in `T`.
+    fn building<T: Real>() -> ShearBuilding<T, Bilinear<T>, 5> {
+        let (m, c, _k) = models::five_storey_building();
+        let law = Bilinear::<T>::new(models::FIVE_STOREY_STIFFNESS, 3.0e6, 0.05).unwrap();
+        let masses = models::floor_masses(&m);
+        ShearBuilding::new(masses, [law; 5], &c).unwrap()
+    }
+
+    /// A ground acceleration (m/s²) at step `n` of lane `l`: two sines under a decaying
+    /// envelope, from elastic (lane 0) to far past yield; lane 5's record is NaN at step
+    /// 150 (that lane fails there); lengths differ by lane.
+    fn ground<T: Real>(l: usize, n: u64) -> T {
+        if l == 5 && n == 150 {
+            return T::from_f64_rounded(f64::NAN);
+        }
+        let t = n as f64 * 0.005;
+        let a =
+            (1.0 + 2.5 * l as f64) * (-t / 2.0).exp() * ((7.0 * t).sin() + 0.5 * (19.0 * t).cos());
+        T::from_f64_rounded(a)
+    }
+
+    /// Every lane's state after every step and its outcome, by `run`.
+    #[allow(clippy::type_complexity)]
+    fn lanes<T: Real, const L: usize>() -> (Vec<Vec<[T; 15]>>, [Result<(), Failure>; L]) {
+        let b = building::<T>();
+        let stepper = LaneStepper::<T, 5, L>::new(
+            0.005,
+            NewtonSettings::up_to(50, T::default_epsilon() * T::from_f64_rounded(1e4)),
+        )
+        .unwrap();
+        let steps: [u64; L] = core::array::from_fn(|l| 300 + 40 * (l as u64 % 5));
+        let mut seen = std::vec![Vec::new(); L];
+        let out = stepper.run(&b, steps, ground::<T>, |s, stepped| {
+            for l in 0..L {
+                if stepped[l] {
+                    seen[l].push(core::array::from_fn(|k| [s.u, s.v, s.a][k / 5][k % 5][l]));
+                }
+            }
+        });
+        (seen, out)
+    }
+
+    /// The same analyses one at a time by the single stepper.
+    #[allow(clippy::type_complexity)]
+    fn singles<T: Real, const L: usize>() -> (Vec<Vec<[T; 15]>>, [Result<bool, Failure>; L]) {
+        let b = building::<T>();
+        let lanes = LaneStepper::<T, 5, 1>::new(
+            0.005,
+            NewtonSettings::up_to(50, T::default_epsilon() * T::from_f64_rounded(1e4)),
+        )
+        .unwrap();
+        let mut seen = Vec::new();
+        let out = core::array::from_fn(|l| {
+            let single = lanes.single();
+            let zero = SVector::<T, 5>::zeros();
+            let mut states = Vec::new();
+            let outcome = (|| {
+                let (mut s, mut h) = single
+                    .start_with_history(
+                        &b,
+                        &zero,
+                        &zero,
+                        &b.ground_load(ground(l, 0)),
+                        &b.initial_history(),
+                    )
+                    .map_err(|error| Failure { step: 0, error })?;
+                for n in 1..=300 + 40 * (l as u64 % 5) {
+                    single
+                        .try_step_with_history(&b, &mut s, &mut h, &b.ground_load(ground(l, n)))
+                        .map_err(|error| Failure { step: n, error })?;
+                    states.push(core::array::from_fn(|k| [s.u, s.v, s.a][k / 5][k % 5]));
+                }
+                // The analysis yielded: some storey's history left the virgin one.
+                Ok(std::format!("{h:?}") != std::format!("{:?}", b.initial_history()))
+            })();
+            seen.push(states);
+            outcome
+        });
+        (seen, out)
+    }
+
+    /// `L` lanes at every dispatch level this CPU has (plain SSE2, AVX, AVX-512) give the
+    /// single analyses' states bit for bit, in `f64` at L = 4 and 8 and `f32` at 8 and 16
+    /// (the widths below, at and above a 512-bit register), including a failing lane.
+    #[test]
+    fn every_dispatch_level_gives_the_single_analyses_bits() {
+        fn check<T: Real, const L: usize>() {
+            let want = singles::<T, L>();
+            assert!(want.1[5 % L].is_err() == (L > 5));
+            // Lane 0 stays elastic, lanes 1 on yield: batches all elastic in some steps
+            // (the factors formed once), mixed in others.
+            assert!(want.1[0] == Ok(false), "{:?}", want.1);
+            assert!(want.1[1..].iter().all(|o| *o != Ok(false)), "{:?}", want.1);
+            let levels = at_each_level(lanes::<T, L>);
+            assert!(!levels.is_empty());
+            for (level, got) in levels {
+                assert_eq!(
+                    got.1,
+                    want.1.map(|o| o.map(|_| ())),
+                    "level {level}, L = {L}"
+                );
+                for l in 0..L {
+                    // `{:?}` of a float round-trips: equal text is equal bits.
+                    let (g, w) = (
+                        std::format!("{:?}", got.0[l]),
+                        std::format!("{:?}", want.0[l]),
+                    );
+                    assert!(g == w, "level {level}, L = {L}, lane {l}");
+                }
+            }
+        }
+        check::<f64, 4>();
+        check::<f64, 8>();
+        check::<f32, 8>();
+        check::<f32, 16>();
+    }
 }

@@ -39,7 +39,7 @@ use crate::{Fail, Res, SIZES, out1, out2, read1, read2, rows, shape, square};
 /// `docs/performance.md`, lanes): 8 lanes hold twice the arrays, which no longer fit the
 /// registers, and gain nothing on the 880-analysis IDA; 4 lanes a batch leave 220 batches
 /// of it to share between threads, and half the code of every law and size.
-const LANES: usize = 4;
+const LANES: usize = 8;
 
 /// The intensities to run: fixed stripes, or a hunt-and-fill trace.
 enum Plan {
@@ -109,15 +109,15 @@ fn peak_drifts<const N: usize, L: LaneLaw<f64>>(
                 .and_then(|&(ag, scale)| ag.get(n).map(|a| a * scale))
                 .unwrap_or(0.0)
         };
+        // Storey by storey over all lanes at once (packed), a lane that did not step
+        // keeping its peak: the same maxima in the same order as lane by lane.
         let observe = |state: &LaneState<f64, N, LANES>, stepped: &[bool; LANES]| {
-            let u = state.u();
-            for (l, p) in peak.iter_mut().enumerate() {
-                if stepped[l] {
-                    let mut below = 0.0f64;
-                    for ui in u {
-                        *p = p.max((ui[l] - below).abs());
-                        below = ui[l];
-                    }
+            let mut below = [0.0f64; LANES];
+            for ui in state.u() {
+                for l in 0..LANES {
+                    let p = peak[l].max((ui[l] - below[l]).abs());
+                    peak[l] = if stepped[l] { p } else { peak[l] };
+                    below[l] = ui[l];
                 }
             }
         };

@@ -43,6 +43,22 @@ pub(crate) fn wide<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 
+/// [`wide`] for loops over lane arrays of `bytes` bytes ([`LaneStepper`]'s step): on
+/// x86-64 also AVX-512 when the arrays fill a 512-bit register and the CPU has it
+/// ([`avx::run_lanes`]: same bits). Cost: as [`wide`].
+///
+/// [`LaneStepper`]: crate::lanes::LaneStepper
+#[inline(always)]
+pub(crate) fn wide_lanes<R>(bytes: usize, f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    return avx::run_lanes(bytes, f);
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = bytes;
+        f()
+    }
+}
+
 /// A row-major `N×N` matrix of `f64` (`a[i][j]`: row `i`, column `j`), the form the
 /// `const fn` constructors (`from_rows`) take.
 ///
