@@ -8,9 +8,10 @@
 //! instruction. [`LaneStepper`] keeps each quantity of the `L` analyses side by side,
 //! structure-of-arrays (`[T; L]` per degree of freedom: [`LaneState`], [`LaneHistory`]),
 //! and writes every operation of the single analysis as a plain loop over the lanes, which
-//! the compiler turns into packed instructions (`f64 × 2` on SSE2, `× 4` with AVX, chosen
-//! at run time by the crate's one dispatch point, `f32` twice as wide); elsewhere the same
-//! loops run as they are.
+//! the compiler turns into packed instructions (`f64 × 2` on SSE2, `× 4` with AVX, and
+//! `× 8` with AVX-512 when a lane array fills its 512-bit register, chosen at run time by
+//! the crate's one dispatch point; `f32` twice as wide); elsewhere the same loops run as
+//! they are.
 //!
 //! **The same bits as one analysis.** Every lane performs exactly the operations of the
 //! single step, in the same order: the predictor and corrector ([`Nonlinear`]'s
@@ -20,7 +21,15 @@
 //! and its `L D Lᵀ` solve (a lane whose matrix is not positive definite takes the same
 //! pivoted LU as the single step). Packed `add`/`mul`/`div`/`max`/compare round each lane
 //! as the scalar instruction does and Rust never fuses a multiply and an add, so the
-//! results are identical at any `L` and on any CPU feature level (`tests/lanes.rs`).
+//! results are identical at any `L` and on any CPU feature level (`tests/lanes.rs`; the
+//! unit test runs every level the CPU has).
+//!
+//! **Formed once.** In a step where every storey of every lane is on its elastic branch,
+//! the Newton matrix `M + b C + c K₀` is the same numbers every time: for a law that states
+//! its elastic tangent ([`LaneLaw::elastic_tangent`]: [`Bilinear`](crate::hysteresis::Bilinear)),
+//! [`LaneStepper::run`] forms its `L D Lᵀ` factors once, by the operations a step would use,
+//! and the step takes them instead (the same bits); otherwise the step assembles the tangent
+//! and factors it, as the single step does.
 //!
 //! **Masks.** Newton iterates until every lane is done; a lane that has converged (or
 //! spent its budget) is committed and frozen while the others iterate. A lane that fails
@@ -35,8 +44,11 @@
 //!
 //! Cost per step, `k` the largest Newton iteration count of the active lanes: that of
 //! one single step of `k` iterations ([`Nonlinear`]: `(k + 1)` trials and `26N k` flops),
-//! each operation on `L` lanes at once. Stack: about twelve `N × L` arrays of `T` and the
-//! lanes' trial histories. No allocation, no panic.
+//! each operation on `L` lanes at once; in [`LaneStepper::run`], an all-elastic iteration's
+//! solve is the substitution only (about `5N` flops instead of about `30N` and `N`
+//! divisions).
+//! Stack: about twelve `N × L` arrays of `T` and the lanes' trial histories. No
+//! allocation, no panic.
 //!
 //! ```
 //! use aemstep::hysteresis::{Bilinear, ShearBuilding};

@@ -2,9 +2,10 @@
 //! (`Nonlinear::try_step_with_history`, the independent reference here: the lanes share
 //! none of its Newton code): every lane's state, history, Newton report and failure, bit
 //! for bit (`to_bits`), at L = 1, 2, 3, 4, 8, with records of different lengths and
-//! failing lanes. Run also under the SSE2-only control build
-//! (`RUSTFLAGS='--cfg aemstep_control="sse2-only"'`), where the lanes are 2 wide instead
-//! of 4: the same bits.
+//! failing lanes, at the dispatch level the CPU gives each width (AVX-512 for `f64` at
+//! L = 8 where the CPU has it). The unit test `lanes::tests` runs every level (SSE2, AVX,
+//! AVX-512) in one process; the SSE2-only control build
+//! (`RUSTFLAGS='--cfg aemstep_control="sse2-only"'`) runs these too: the same bits.
 
 #[path = "../scenes/modal/elcentro.rs"]
 mod elcentro;

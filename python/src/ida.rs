@@ -33,12 +33,12 @@ use pyo3::types::{PyDict, PyList};
 use crate::laws::{self, WithLaws};
 use crate::{Fail, Res, SIZES, out1, out2, read1, read2, rows, shape, square};
 
-/// Analyses stepped together by [`LaneStepper`], one a lane: `f64 × 4`, one AVX register
-/// (two SSE2 ones). The width `xtask/benches/lanes.rs` measures fastest a lane step since
-/// the lane step's masks and tests became whole-batch operations (see
-/// `docs/performance.md`, lanes): 8 lanes hold twice the arrays, which no longer fit the
-/// registers, and gain nothing on the 880-analysis IDA; 4 lanes a batch leave 220 batches
-/// of it to share between threads, and half the code of every law and size.
+/// Analyses stepped together by [`LaneStepper`], one a lane: `f64 × 8`, one AVX-512
+/// register where the CPU has it (two AVX ones, four SSE2 ones otherwise). The width
+/// `xtask/benches/lanes.rs` measures fastest on the 880-analysis IDA since the lane step
+/// takes AVX-512 for lane arrays that fill a 512-bit register (`docs/performance.md`,
+/// lanes): 8 lanes are as fast as 4 on AVX alone, faster with AVX-512; 110 batches of the
+/// IDA to share between threads.
 const LANES: usize = 8;
 
 /// The intensities to run: fixed stripes, or a hunt-and-fill trace.

@@ -11,16 +11,14 @@
 //!
 //! [`run_lanes`] takes one step further for loops whose lane arrays fill a 512-bit
 //! register (`f64 × 8`, `f32 × 16`: [`LaneStepper`](crate::lanes::LaneStepper) at
-//! `L = 8`): compiled with AVX-512 (F, DQ, BW, VL) when the CPU has it, one instruction
-//! does what took two on AVX. Measured on the benchmark IDA's 5-storey building
-//! (`cargo bench -p xtask --bench lanes`): the `L = 8` lane step is about 12 % faster than
-//! the same code on AVX (34.0–34.7 against 39.0 ns an analysis-step in one quiet run).
-//! Narrower loops stay on AVX, where AVX-512's mask registers cost more than they save
-//! (the `L = 4` step measured 96 against 76 ns). The same argument for the bits holds:
-//! the 512-bit `add`/`sub`/`mul`/`div`/`max`/compare round each lane as the scalar
-//! instructions do, and nothing is fused (AVX-512 implies FMA, which Rust never emits for
-//! `a * b + c`); `tests/lanes.rs` and this module's tests check lanes against single
-//! analyses at every level the CPU has.
+//! `L = 8` in `f64`): compiled with AVX-512 (F, DQ, BW, VL) when the CPU has it, one
+//! instruction does what took two on AVX; `docs/performance.md` (lanes) measures it against
+//! the benchmark's AVX-only control build (`--cfg aemstep_control="avx-only"`). Narrower
+//! loops stay on AVX, where AVX-512's mask registers cost more than they save (the `L = 4`
+//! step ran slower with it). The same argument for the bits holds: the 512-bit
+//! `add`/`sub`/`mul`/`div`/`max`/compare round each lane as the scalar instructions do,
+//! and nothing is fused (AVX-512 implies FMA, which Rust never emits for `a * b + c`); the
+//! lanes' unit test runs every level the CPU has against single analyses, bit for bit.
 //!
 //! # Why `unsafe`, and why it is sound
 //!
@@ -59,6 +57,10 @@ pub(crate) const MIN_BYTES: usize = 1536;
 /// the benchmark's SSE2-only control build (`--cfg aemstep_control="sse2-only"`): either
 /// way the plain loop runs.
 const PLAIN_ONLY: bool = cfg!(target_feature = "avx") || cfg!(aemstep_control = "sse2-only");
+
+/// The benchmark's AVX-only control build (`--cfg aemstep_control="avx-only"`): the lanes
+/// never take AVX-512, to measure what it adds.
+const NO_AVX512: bool = cfg!(aemstep_control = "avx-only");
 
 /// Cached answer of [`detect`]: 0 not yet asked, else [`NONE`], [`AVX`] or [`AVX512`].
 static LEVEL: AtomicU8 = AtomicU8::new(0);
@@ -160,7 +162,7 @@ pub(crate) fn run<R>(f: impl FnOnce() -> R) -> R {
 /// [`LaneStepper`]: crate::lanes::LaneStepper
 #[inline(always)]
 pub(crate) fn run_lanes<R>(bytes: usize, f: impl FnOnce() -> R) -> R {
-    if !PLAIN_ONLY && bytes >= 64 && level() == AVX512 {
+    if !PLAIN_ONLY && !NO_AVX512 && bytes >= 64 && level() == AVX512 {
         // SAFETY: `level()` is AVX512: the CPU reports AVX-512 F, DQ, BW and VL and the
         // OS saves their registers (module docs), the precondition of `run_avx512`.
         unsafe { run_avx512(f) }
