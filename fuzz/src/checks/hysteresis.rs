@@ -9,6 +9,7 @@ use std::fmt::Debug;
 use aemstep::hysteresis::{
     Bilinear, BoucWen, BoucWenHistory, Friction, HistoryModel, Law, Parallel, ShearBuilding,
 };
+use aemstep::lanes::{Failure, LaneLaw, LaneStepper};
 use aemstep::nalgebra::{SMatrix, SVector};
 use aemstep::{Error, NewtonSettings, Nonlinear, Real};
 
@@ -242,7 +243,7 @@ fn drive_law<T: Real, L: Law<T> + Debug>(
     }
 }
 
-fn building<T: Real, L: Law<T> + Copy + Debug>(l: L, name: &str, d: &LawData)
+fn building<T: Real, L: LaneLaw<T> + Copy + Debug>(l: L, name: &str, d: &LawData)
 where
     L::History: Debug,
 {
@@ -278,6 +279,8 @@ where
     let Ok(st) = Nonlinear::<T, 2>::new(d.h, NewtonSettings::default()) else {
         return;
     };
+    lanes_match::<T, L, 4>(&b, &st, name, d);
+    lanes_match::<T, L, 8>(&b, &st, name, d);
     let zero = SVector::<T, 2>::zeros();
     let Ok((mut x, mut hist)) =
         st.start_with_history(&b, &zero, &zero, &zero, &b.initial_history())
@@ -319,5 +322,71 @@ where
                 }
             }
         }
+    }
+}
+
+/// The building's analyses from rest under `ag` scaled per lane (1, −1, ½, 2, … cycling;
+/// records of 4, 3, 2, 1 … steps), by `LaneStepper::run` with `W` lanes (`f64 × 8`: the
+/// AVX-512 path where the CPU has it) and one at a time by `st`: every state after every
+/// step and every outcome bit for bit (the all-elastic factors formed once, laws,
+/// failures).
+fn lanes_match<T: Real, L: LaneLaw<T> + Copy + Debug, const W: usize>(
+    b: &ShearBuilding<T, L, 2>,
+    st: &Nonlinear<T, 2>,
+    name: &str,
+    d: &LawData,
+) where
+    L::History: Debug,
+{
+    let Ok(lanes) = LaneStepper::<T, 2, W>::new(d.h, st.settings()) else {
+        panic!(
+            "property broken: {HY}: LaneStepper::new refused what Nonlinear::new took\n  data: {}",
+            context()
+        );
+    };
+    let scale = |l: usize| [1.0, -1.0, 0.5, 2.0][l % 4] * (1 + l / 4) as f64;
+    let ground = |l: usize, n: u64| {
+        let a = if n == 0 {
+            0.0
+        } else {
+            d.ag[(n as usize - 1) % 4]
+        };
+        T::from_f64_rounded(a * scale(l))
+    };
+    let steps: [u64; W] = core::array::from_fn(|l| 4 - (l as u64 % 4));
+    let mut seen: Vec<Vec<String>> = vec![Vec::new(); W];
+    let out = lanes.run(b, steps, ground, |s, stepped| {
+        for (l, lane) in seen.iter_mut().enumerate() {
+            if stepped[l] {
+                lane.push(bits(&s.lane(l)));
+            }
+        }
+    });
+    let zero = SVector::<T, 2>::zeros();
+    for l in 0..W {
+        let mut want = Vec::new();
+        let outcome = (|| {
+            let (mut x, mut h) = st
+                .start_with_history(
+                    b,
+                    &zero,
+                    &zero,
+                    &b.ground_load(ground(l, 0)),
+                    &b.initial_history(),
+                )
+                .map_err(|error| Failure { step: 0, error })?;
+            for n in 1..=steps[l] {
+                st.try_step_with_history(b, &mut x, &mut h, &b.ground_load(ground(l, n)))
+                    .map_err(|error| Failure { step: n, error })?;
+                want.push(bits(&Some(x)));
+            }
+            Ok(())
+        })();
+        count(HY, "lane analyses");
+        check!(
+            out[l] == outcome && seen[l] == want,
+            "{HY}: {name}: lane {l} of {W} differs from its single analysis: {:?} against {outcome:?}",
+            out[l]
+        );
     }
 }
