@@ -62,8 +62,9 @@ pub const MAX_TRUNCATED_MODES: usize = 3;
 pub const MAX_SENSORS: usize = 3;
 
 /// The largest model `observe` takes (`n` DOFs, `2n` states). Its gain solve costs
-/// about `2400 n³` multiply-adds and looks at Ctrl-C between pieces of at most `80 n³`
-/// (a doubling iteration); its model and noise build (`O(n³)`) and a Kalman step
+/// about `2400 n³` multiply-adds and looks at Ctrl-C between pieces of at most `40 n³`
+/// multiply-adds (a doubling iteration's `10 S³` flops, `S = 2n` states, a multiply-add
+/// two flops); its model and noise build (`O(n³)`) and a Kalman step
 /// (`O(n³)`) are not split. At `n = 200` each of those is a fraction of a second on the
 /// development machine (`python/tests/test_interrupt.py`); above, Ctrl-C would wait
 /// seconds and the gain minutes: reduce the model (e.g. to its lowest modes) first.
