@@ -33,7 +33,7 @@ def fuzz_section(path):
         linear_family="`Linear` (new, from_rows_f32/_f64), `AForm`, `CompensatedLinear`, `LinearInput`, `Newmark` (β, γ; three presets), `GeneralizedAlpha` (ρ∞, HHT), `Exact`; N = 1, 2, 3",
         modal="`Modal` (new, with_modes, from_rows_f32/_f64, from_rows_with_modes_f32/_f64; every `Damping`); N = 2, 3",
         nonlinear="`Nonlinear` (cubic springs, analytic or finite-difference tangent; Newton settings), `Varying`; N = 1, 2",
-        hysteresis="`Bilinear`, `BoucWen`, `Friction`, `Parallel` (trials along a path), `ShearBuilding`, its `Nonlinear` steps with history",
+        hysteresis="`Bilinear`, `BoucWen`, `Friction`, `Parallel` (trials along a path), `ShearBuilding`, its `Nonlinear` steps with history, the same analyses in `LaneStepper` lanes (4 and 8, every lane bit for bit its single analysis)",
         observer="`StateSpace` (aem, from_rows_aem, exact, modal; wrong S), outputs, `SteadyState`, `Observer` (new, from_parts_f32/_f64), `Kalman`, `Readout`",
         spectrum="`Bank` (new, with: both schemes, every sub-step rule), `RotD`, `batch::spectra`, `inelastic::Yielding` (with, at_rest, step, constant_strength, constant_ductility), the record readers (`records::at2`, `column`, `read_into`, `column_into`), IDA tracing (`ida::trace`, `fractiles`)",
         estimation="`InputModel` (from_parts, zero_dynamics), `InputStateGains` (solve, new), `InputStateObserver` (new, from_parts_f32/_f64), `InputStateFilter`, `DualGains`, `DualFilter` (new, from_parts_f32/_f64), `AugmentedModel`, `FixedLag` (new, from_parts_f32/_f64); S = 2, 4, O = 1 … 3",
