@@ -443,7 +443,11 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         )
     }
 
-    /// [`LaneStepper::step`] with the elastic factors formed beforehand ([`ElasticSolve`]).
+    /// The step of [`LaneStepper::step`] on the scratch `w` (with the all-elastic factors
+    /// when [`LaneStepper::run`] formed them, [`ElasticSolve`]), inside the caller's
+    /// dispatch. `REPORT`: the reports' correction and branch changes are formed (`step`);
+    /// without (`run`, which reads only the errors), the correction is formed only where
+    /// it decides convergence.
     #[inline(always)]
     fn step_with<Lw: LaneLaw<T>, const REPORT: bool>(
         &self,
