@@ -514,7 +514,9 @@ impl<T: Real, const N: usize, const L: usize> LaneStepper<T, N, L> {
         w: &mut Work<T, Lw::History, N, L>,
     ) {
         band_mul(band, &w.v, &mut w.force);
-        w.branch = [0; L];
+        if REPORT {
+            w.branch = [0; L];
+        }
         // A local (kept in a register): or-ing into `w` stalled on store forwarding.
         let mut inelastic = [false; L];
         let laws = building.laws();
@@ -1012,22 +1014,19 @@ fn finite_zero<T: Real>(x: T) -> T {
     x - x
 }
 
-/// Every entry from DOF `from` on, in every lane, finite: one test of the whole batch.
-/// `x − x` is `+0` exactly for a finite `x` and NaN otherwise, so the lanes' sums of it are
-/// all zero exactly when every entry is finite: packed subtractions and additions and one
-/// compare (`is_finite` is an integer compare, which AVX packs only 2 wide).
+/// Every entry from DOF `from` on, in every lane, finite: one test of the whole batch
+/// ([`all_finite_of`] of one array).
 #[inline(always)]
 fn all_finite<T: Real, const N: usize, const L: usize>(x: &[[T; L]; N], from: usize) -> bool {
-    let mut sum = [T::zero(); L];
-    for row in x.iter().skip(from) {
-        for l in 0..L {
-            sum[l] += row[l];
-        }
-    }
-    all_zero_finite(&sum)
+    all_finite_of([x], from)
 }
 
-/// [`all_finite`] of several arrays, with one test: the sum over all of them.
+/// Every entry from DOF `from` on of every array in `xs`, in every lane, finite, with one
+/// test: the lanes' sums of all the entries are finite only if every entry is (a NaN
+/// makes a sum NaN, an infinity makes it infinite or NaN), so finite sums clear the batch
+/// with packed additions and one packed `x − x == 0`. A sum that overflowed is a false
+/// alarm; every caller then takes the exact per-lane test ([`finite`]), as for a
+/// non-finite entry (rare either way).
 #[inline(always)]
 fn all_finite_of<T: Real, const N: usize, const L: usize, const K: usize>(
     xs: [&[[T; L]; N]; K],
